@@ -1,0 +1,44 @@
+// Resource bindings and push constants shared by scene.vert and scene.frag.
+// Mirrors src/gpu/layout.rs (std430): change both together.
+#ifndef SUNSHADE_BINDINGS_GLSL
+#define SUNSHADE_BINDINGS_GLSL
+
+// BRDF kinds (MaterialGpu.kind.x); values match gpu::layout::BRDF_*.
+#define BRDF_LAMBERT 0u
+
+struct MaterialGpu {
+    vec4 kd;     // rgb: Lambertian albedo (dimensionless); w unused
+    vec4 ks;     // reserved for specular BRDFs
+    vec4 params; // reserved for specular BRDFs
+    uvec4 kind;  // x: BRDF kind; y: 1 if double-sided
+};
+
+struct SunGpu {
+    vec4 direction;  // xyz: unit vector towards the sun (world); w: angular diameter [rad]
+    vec4 irradiance; // rgb: E_perp [W/m^2]; w: 1 if the sun is present, else 0
+};
+
+struct DiskGpu {
+    vec4 center_radius; // xyz: centre [m]; w: radius R [m]
+    vec4 direction;     // xyz: unit emission direction; w unused
+    vec4 radiance;      // rgb: L0 [W/(m^2 sr)]; w unused
+};
+
+layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
+    MaterialGpu materials[];
+};
+
+layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
+    SunGpu sun;
+    vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
+    uvec4 counts; // x: number of disk lights
+    DiskGpu disks[];
+} lights;
+
+layout(push_constant) uniform PushConstants {
+    mat4 clip_from_world; // world -> Vulkan clip space (f32, column-major)
+    vec4 viewer;          // (eye, 1) for perspective; (unit direction towards the viewer, 0) for orthographic
+    uint material;        // index into materials[]
+} pc;
+
+#endif

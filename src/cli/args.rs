@@ -1,0 +1,189 @@
+//! Flags shared by `render`, `reference` and `bench`: the scene, image size, camera, lights and output.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use glam::DVec3;
+
+use crate::film::Exposure;
+use crate::settings::{CameraOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
+
+/// `x,y,z` → a finite vector.
+pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers x,y,z, got '{s}'"
+        ));
+    }
+    let mut v = [0.0; 3];
+    for (slot, p) in v.iter_mut().zip(&parts) {
+        *slot = p
+            .parse::<f64>()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("'{p}' is not finite"));
+        }
+    }
+    Ok(DVec3::from_array(v))
+}
+
+/// `r,g,b` → three finite non-negative factors.
+pub fn parse_rgb(s: &str) -> Result<[f64; 3], String> {
+    let v = parse_vec3(s)?;
+    if v.min_element() < 0.0 {
+        return Err(format!("'{s}': components must be non-negative"));
+    }
+    Ok(v.to_array())
+}
+
+/// A finite number.
+pub fn parse_finite(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a finite number")),
+    }
+}
+
+/// A finite number > 0.
+pub fn parse_positive(s: &str) -> Result<f64, String> {
+    let v = parse_finite(s)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("'{s}' must be greater than 0"))
+    }
+}
+
+/// Everything that defines the image: scene, size, camera, lights.
+#[derive(Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// glTF 2.0 scene (.gltf with its .bin files or data URIs, or .glb).
+    pub scene: PathBuf,
+
+    /// Image width [pixels].
+    #[arg(long, default_value_t = DEFAULT_WIDTH, value_parser = clap::value_parser!(u32).range(1..))]
+    pub width: u32,
+
+    /// Image height [pixels].
+    #[arg(long, default_value_t = DEFAULT_HEIGHT, value_parser = clap::value_parser!(u32).range(1..))]
+    pub height: u32,
+
+    /// Which glTF scene of the file to render (default: the file's default scene).
+    #[arg(long = "scene", value_name = "N")]
+    pub scene_index: Option<usize>,
+
+    /// Use glTF camera N (as placed by the scene's nodes) instead of the first one.
+    #[arg(long, value_name = "N")]
+    pub camera: Option<usize>,
+
+    /// Camera position x,y,z [m] (world, +Y up).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub eye: Option<DVec3>,
+
+    /// Point the camera looks at x,y,z [m].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub target: Option<DVec3>,
+
+    /// Camera up vector x,y,z.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub up: Option<DVec3>,
+
+    /// Vertical field of view [degrees] (perspective cameras; the automatic camera uses 45).
+    #[arg(long, value_parser = parse_positive, value_name = "DEGREES")]
+    pub fov: Option<f64>,
+
+    /// Direction towards the sun x,y,z (world, +Y up; need not be normalised).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z",
+          conflicts_with_all = ["sun_elevation", "sun_azimuth"])]
+    pub sun_dir: Option<DVec3>,
+
+    /// Sun elevation above the horizontal XZ plane [degrees] (default 45 when only --sun-azimuth is given).
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
+    pub sun_elevation: Option<f64>,
+
+    /// Sun azimuth [degrees]: 0 = towards +Z, 90 = towards +X.
+    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
+    pub sun_azimuth: Option<f64>,
+
+    /// Sun irradiance on a surface facing it, E⊥ [W/m²] (default 1000, or the scene's directional light).
+    #[arg(long, value_parser = parse_finite, value_name = "W/M2", conflicts_with = "sun_radiance")]
+    pub sun_irradiance: Option<f64>,
+
+    /// Sun radiance L_sun [W/(m²·sr)]; E⊥ = L_sun·π·sin²(δ/2) ≈ L_sun·Ω_sun.
+    #[arg(long, value_parser = parse_finite, value_name = "W/(M2·SR)")]
+    pub sun_radiance: Option<f64>,
+
+    /// Sun angular diameter δ [degrees].
+    #[arg(long, value_parser = parse_positive, value_name = "DEGREES")]
+    pub sun_diameter: Option<f64>,
+
+    /// Per-channel factors on E⊥, r,g,b.
+    #[arg(long, value_parser = parse_rgb, value_name = "R,G,B")]
+    pub sun_color: Option<[f64; 3]>,
+}
+
+impl SceneArgs {
+    pub fn camera_options(&self) -> CameraOptions {
+        CameraOptions {
+            camera: self.camera,
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov_degrees: self.fov,
+        }
+    }
+
+    pub fn sun_options(&self) -> SunOptions {
+        SunOptions {
+            direction: self.sun_dir,
+            elevation_degrees: self.sun_elevation,
+            azimuth_degrees: self.sun_azimuth,
+            irradiance: self.sun_irradiance,
+            radiance: self.sun_radiance,
+            diameter_degrees: self.sun_diameter,
+            color: self.sun_color,
+        }
+    }
+}
+
+/// Where the image goes.
+#[derive(Args, Clone, Debug)]
+pub struct OutputArgs {
+    /// Output image: .exr (float32 RGBA radiance), .pfm (float32 RGB), .png (8-bit sRGB, see --exposure).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+
+    /// PNG exposure: EV stops (display value = radiance × 2^EV) or 'auto'.
+    #[arg(
+        long,
+        default_value = "auto",
+        allow_hyphen_values = true,
+        value_name = "EV|auto"
+    )]
+    pub exposure: Exposure,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vectors_parse_strictly() {
+        assert_eq!(
+            parse_vec3("0.3,1,-0.5").unwrap(),
+            DVec3::new(0.3, 1.0, -0.5)
+        );
+        assert_eq!(
+            parse_vec3(" 1 , 2 , 3 ").unwrap(),
+            DVec3::new(1.0, 2.0, 3.0)
+        );
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,2,3,4").is_err());
+        assert!(parse_vec3("1,x,3").is_err());
+        assert!(parse_vec3("1,nan,3").is_err());
+        assert!(parse_rgb("1,-1,0").is_err());
+        assert!(parse_positive("0").is_err());
+        assert!(parse_finite("inf").is_err());
+    }
+}

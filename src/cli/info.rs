@@ -1,0 +1,61 @@
+//! `sunshade info`: the Vulkan devices, the one chosen, and the limits that matter here.
+
+use clap::Args;
+
+use super::CliError;
+use crate::gpu::{list_devices, ContextOptions};
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Show which device this selector picks: an index or part of a name.
+    #[arg(long, value_name = "INDEX|NAME")]
+    pub device: Option<String>,
+}
+
+pub fn run(a: &InfoArgs) -> Result<(), CliError> {
+    let options = ContextOptions {
+        device: a.device.clone(),
+        ..ContextOptions::from_env()
+    };
+    let (devices, chosen) = list_devices(&options)?;
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    for d in &devices {
+        let mark = if chosen.as_ref().is_ok_and(|c| *c == d.index) {
+            "*"
+        } else {
+            " "
+        };
+        println!(
+            "{mark} {}: {} [{}], Vulkan {}.{}.{}",
+            d.index,
+            d.name,
+            d.type_name(),
+            d.api_version.0,
+            d.api_version.1,
+            d.api_version.2
+        );
+        println!("      driver: {} {}", d.driver_name, d.driver_info);
+        println!(
+            "      subPixelPrecisionBits {}, viewportSubPixelBits {}, maxImageDimension2D {}, maxViewportDimensions {}x{}",
+            d.sub_pixel_precision_bits,
+            d.viewport_sub_pixel_bits,
+            d.max_image_dimension_2d,
+            d.max_viewport_dimensions[0],
+            d.max_viewport_dimensions[1]
+        );
+        println!(
+            "      device-local heap {:.2} GiB, maxMemoryAllocationSize {:.2} GiB, maxPushConstantsSize {} B",
+            gib(d.device_local_heap_bytes),
+            gib(d.max_memory_allocation_size),
+            d.max_push_constants_size
+        );
+        if let Some(why) = &d.unusable {
+            println!("      not usable: {why}");
+        }
+    }
+    match chosen {
+        Ok(i) => println!("chosen: device {i} (* above)"),
+        Err(e) => return Err(CliError::Failure(anyhow::anyhow!(e))),
+    }
+    Ok(())
+}

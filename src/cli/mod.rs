@@ -1,0 +1,116 @@
+//! The command line: `render`, `info` (and the subcommands of later stages). One file per subcommand.
+//!
+//! Exit codes: 0 success, 1 failure, 2 usage error. Every error is one line on stderr that names the file or the
+//! flag at fault.
+
+mod args;
+mod info;
+mod render;
+
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use clap::{Parser, Subcommand};
+
+use crate::scene::{self, LoadOptions, Scene};
+use crate::settings::{self, RenderSettings};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "sunshade",
+    version,
+    about = "Offscreen glTF rendering in physical units (radiance in W/(m²·sr)), checked against a CPU reference"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a glTF scene on the GPU (Vulkan) to an image of radiance.
+    Render(render::RenderArgs),
+    /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
+    Info(info::InfoArgs),
+}
+
+/// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
+#[derive(Debug)]
+pub enum CliError {
+    Usage(String),
+    Failure(anyhow::Error),
+}
+
+impl<E: Into<anyhow::Error>> From<E> for CliError {
+    fn from(e: E) -> Self {
+        CliError::Failure(e.into())
+    }
+}
+
+/// Runs the command line and returns the process exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(a) => render::run(&a),
+        Command::Info(a) => info::run(&a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Usage(msg)) => {
+            eprintln!("sunshade: error: {msg}");
+            ExitCode::from(2)
+        }
+        Err(CliError::Failure(e)) => {
+            eprintln!("sunshade: error: {}", one_line(&e));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The error and its causes on one line.
+fn one_line(e: &anyhow::Error) -> String {
+    format!("{e:#}").replace('\n', "; ")
+}
+
+/// Loads the scene and resolves the render settings; prints the loader's warnings.
+fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
+    let t = Instant::now();
+    let scene = scene::load_with_options(
+        &a.scene,
+        &LoadOptions {
+            scene: a.scene_index,
+        },
+    )?;
+    let load_time = t.elapsed();
+    for w in &scene.warnings {
+        eprintln!("sunshade: warning: {}: {w}", a.scene.display());
+    }
+    let settings = settings::resolve(
+        &scene,
+        a.width,
+        a.height,
+        &a.camera_options(),
+        &a.sun_options(),
+    )
+    .map_err(|e| CliError::Usage(e.to_string()))?;
+    Ok((scene, settings, load_time))
+}
+
+/// Refuses an output path whose extension names no supported format, before any work is done.
+fn check_output_path(path: &std::path::Path) -> Result<(), CliError> {
+    if crate::film::ImageFormat::from_path(path).is_none() {
+        return Err(CliError::Usage(format!(
+            "{}: unsupported output extension (use .exr, .pfm or .png)",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Prints phase timings as a small table on stderr.
+fn print_phases(phases: &[(&str, Duration)]) {
+    let total: Duration = phases.iter().map(|(_, d)| *d).sum();
+    for (name, d) in phases.iter().chain(std::iter::once(&("total", total))) {
+        eprintln!("  {name:<15} {:>9.2} ms", d.as_secs_f64() * 1e3);
+    }
+}

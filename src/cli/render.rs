@@ -1,0 +1,71 @@
+//! `sunshade render`: the GPU image.
+
+use std::time::Instant;
+
+use clap::Args;
+
+use super::args::{OutputArgs, SceneArgs};
+use super::{check_output_path, load_scene, print_phases, CliError};
+use crate::film::write_image;
+use crate::gpu::{ContextOptions, Renderer};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub output: OutputArgs,
+    /// Vulkan device: an index from `sunshade info`, or part of its name.
+    #[arg(long, value_name = "INDEX|NAME")]
+    pub device: Option<String>,
+    /// Print the device and the time of each phase (instance, shader compile, upload, render, readback, encode).
+    #[arg(short, long)]
+    pub verbose: bool,
+}
+
+pub fn run(a: &RenderArgs) -> Result<(), CliError> {
+    check_output_path(&a.output.output)?;
+    let (scene, settings, load_time) = load_scene(&a.scene)?;
+    let options = ContextOptions {
+        device: a.device.clone(),
+        ..ContextOptions::from_env()
+    };
+    let mut renderer = Renderer::new(&options)?;
+    renderer.check_size(settings.width, settings.height)?;
+    let t_upload = Instant::now();
+    let gpu_scene = renderer.upload(&scene)?;
+    let upload_time = t_upload.elapsed();
+    let (image, frame) = renderer.render(&gpu_scene, &settings)?;
+    let t_encode = Instant::now();
+    write_image(&image, &a.output.output, a.output.exposure)?;
+    let encode_time = t_encode.elapsed();
+    if a.verbose {
+        let info = renderer.device_info();
+        eprintln!(
+            "sunshade: device {}: {} ({}, {} {})",
+            info.index,
+            info.name,
+            info.type_name(),
+            info.driver_name,
+            info.driver_info
+        );
+        eprintln!(
+            "sunshade: {} triangles, {}x{} pixels, {} covered",
+            scene.triangle_count(),
+            settings.width,
+            settings.height,
+            image.covered_count()
+        );
+        let setup = renderer.setup_timings();
+        print_phases(&[
+            ("load", load_time),
+            ("instance", setup.instance),
+            ("shader compile", setup.shader_compile),
+            ("upload", upload_time),
+            ("render", frame.render),
+            ("readback", frame.readback),
+            ("encode", encode_time),
+        ]);
+    }
+    Ok(())
+}

@@ -1,0 +1,316 @@
+//! Reading and writing images: the format follows the file extension.
+//!
+//! - `.exr`: OpenEXR, float32 RGBA, linear radiance, unscaled. Read back bit for bit.
+//! - `.pfm`: Portable Float Map, float32 RGB (no alpha: read back with alpha 1), little-endian, bottom row first as
+//!   the format requires.
+//! - `.png`: 8-bit sRGB of `radiance × 2^EV` (see [`super::Exposure`]), alpha = coverage. Read back as code values
+//!   `c/255` (not linearised), which is what an 8-bit comparison measures.
+//!
+//! Every write is atomic (see [`super::write_atomically`]).
+
+use std::io::{self, BufRead, Write};
+use std::path::{Path, PathBuf};
+
+use super::{srgb_encode, write_atomically, Exposure, Image};
+
+/// The file formats sunshade reads and writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    Exr,
+    Pfm,
+    Png,
+}
+
+impl ImageFormat {
+    /// The format named by the path's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "exr" => Some(Self::Exr),
+            "pfm" => Some(Self::Pfm),
+            "png" => Some(Self::Png),
+            _ => None,
+        }
+    }
+}
+
+/// An image file that could not be read or written; the message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageIoError {
+    #[error("{path}: unsupported image extension (use .exr, .pfm or .png)")]
+    UnsupportedExtension { path: PathBuf },
+    #[error("{path}: {source}")]
+    Io { path: PathBuf, source: io::Error },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+impl ImageIoError {
+    fn invalid(path: &Path, message: impl Into<String>) -> Self {
+        Self::Invalid {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Writes `image` to `path` in the format its extension names. `exposure` applies to PNG only.
+pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(), ImageIoError> {
+    let format =
+        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension {
+            path: path.to_path_buf(),
+        })?;
+    let io_err = |source| ImageIoError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    match format {
+        ImageFormat::Exr => {
+            let data: Vec<f32> = image.pixels().iter().flatten().copied().collect();
+            let buf = ::image::Rgba32FImage::from_raw(image.width(), image.height(), data)
+                .ok_or_else(|| {
+                    ImageIoError::invalid(path, "pixel buffer does not match the image size")
+                })?;
+            write_atomically(path, |w| {
+                ::image::DynamicImage::ImageRgba32F(buf)
+                    .write_to(w, ::image::ImageFormat::OpenExr)
+                    .map_err(io::Error::other)
+            })
+            .map_err(io_err)
+        }
+        ImageFormat::Pfm => write_atomically(path, |w| write_pfm(image, w)).map_err(io_err),
+        ImageFormat::Png => {
+            let scale = exposure.scale_for(image);
+            let mut data = Vec::with_capacity(image.pixels().len() * 4);
+            for p in image.pixels() {
+                for c in &p[..3] {
+                    data.push(srgb_encode(*c as f64 * scale));
+                }
+                data.push((p[3].clamp(0.0, 1.0) * 255.0).round() as u8);
+            }
+            let buf = ::image::RgbaImage::from_raw(image.width(), image.height(), data)
+                .ok_or_else(|| {
+                    ImageIoError::invalid(path, "pixel buffer does not match the image size")
+                })?;
+            write_atomically(path, |w| {
+                ::image::DynamicImage::ImageRgba8(buf)
+                    .write_to(w, ::image::ImageFormat::Png)
+                    .map_err(io::Error::other)
+            })
+            .map_err(io_err)
+        }
+    }
+}
+
+/// Reads an image in the format its extension names.
+pub fn read_image(path: &Path) -> Result<Image, ImageIoError> {
+    let format =
+        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension {
+            path: path.to_path_buf(),
+        })?;
+    let io_err = |source| ImageIoError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    match format {
+        ImageFormat::Pfm => {
+            let file = std::fs::File::open(path).map_err(io_err)?;
+            read_pfm(&mut io::BufReader::new(file)).map_err(|e| match e.kind() {
+                io::ErrorKind::InvalidData | io::ErrorKind::UnexpectedEof => {
+                    ImageIoError::invalid(path, e.to_string())
+                }
+                _ => ImageIoError::Io {
+                    path: path.to_path_buf(),
+                    source: e,
+                },
+            })
+        }
+        ImageFormat::Exr | ImageFormat::Png => {
+            let decoded = ::image::ImageReader::open(path)
+                .map_err(io_err)?
+                .with_guessed_format()
+                .map_err(io_err)?
+                .decode()
+                .map_err(|e| ImageIoError::invalid(path, e.to_string()))?;
+            let (w, h) = (decoded.width(), decoded.height());
+            let pixels: Vec<[f32; 4]> = if format == ImageFormat::Png {
+                decoded
+                    .into_rgba8()
+                    .pixels()
+                    .map(|p| p.0.map(|c| c as f32 / 255.0))
+                    .collect()
+            } else {
+                decoded.into_rgba32f().pixels().map(|p| p.0).collect()
+            };
+            Image::from_pixels(w, h, pixels)
+                .ok_or_else(|| ImageIoError::invalid(path, "decoded size mismatch"))
+        }
+    }
+}
+
+/// PFM: header `PF\n<w> <h>\n-1.0\n` (negative scale = little-endian), then RGB rows from the bottom up.
+fn write_pfm(image: &Image, w: &mut impl Write) -> io::Result<()> {
+    write!(w, "PF\n{} {}\n-1.0\n", image.width(), image.height())?;
+    let width = image.width() as usize;
+    let mut row = Vec::with_capacity(width * 12);
+    for y in (0..image.height() as usize).rev() {
+        row.clear();
+        for p in &image.pixels()[y * width..(y + 1) * width] {
+            for c in &p[..3] {
+                row.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        w.write_all(&row)?;
+    }
+    Ok(())
+}
+
+fn read_pfm(r: &mut impl BufRead) -> io::Result<Image> {
+    let bad = |m: &str| io::Error::new(io::ErrorKind::InvalidData, m.to_string());
+    let magic = read_token(r)?;
+    let channels = match magic.as_str() {
+        "PF" => 3,
+        "Pf" => 1,
+        _ => return Err(bad("not a PFM file (magic is not PF or Pf)")),
+    };
+    let width: u32 = read_token(r)?.parse().map_err(|_| bad("bad PFM width"))?;
+    let height: u32 = read_token(r)?.parse().map_err(|_| bad("bad PFM height"))?;
+    let scale: f64 = read_token(r)?.parse().map_err(|_| bad("bad PFM scale"))?;
+    if width == 0 || height == 0 || scale == 0.0 || !scale.is_finite() {
+        return Err(bad("PFM header has a zero size or scale"));
+    }
+    let little_endian = scale < 0.0;
+    let count = (width as usize)
+        .checked_mul(height as usize)
+        .and_then(|n| n.checked_mul(channels * 4))
+        .ok_or_else(|| bad("PFM size overflows"))?;
+    let mut data = vec![0u8; count];
+    r.read_exact(&mut data)
+        .map_err(|_| bad("PFM file is shorter than its header says"))?;
+    let mut pixels = vec![[0.0f32; 4]; width as usize * height as usize];
+    for (i, chunk) in data.chunks_exact(channels * 4).enumerate() {
+        let mut px = [0.0f32, 0.0, 0.0, 1.0];
+        for c in 0..channels {
+            let b: [u8; 4] = chunk[c * 4..c * 4 + 4]
+                .try_into()
+                .expect("chunk of 4 bytes");
+            px[c] = if little_endian {
+                f32::from_le_bytes(b)
+            } else {
+                f32::from_be_bytes(b)
+            };
+        }
+        if channels == 1 {
+            px[1] = px[0];
+            px[2] = px[0];
+        }
+        let (x, y_from_bottom) = (i % width as usize, i / width as usize);
+        pixels[(height as usize - 1 - y_from_bottom) * width as usize + x] = px;
+    }
+    Ok(Image::from_pixels(width, height, pixels).expect("size computed from the header"))
+}
+
+/// One whitespace-separated header token; the single whitespace byte after it is consumed too.
+fn read_token(r: &mut impl BufRead) -> io::Result<String> {
+    let mut token = Vec::new();
+    let mut byte = [0u8; 1];
+    loop {
+        if r.read(&mut byte)? == 0 {
+            return Err(io::Error::new(
+                io::ErrorKind::UnexpectedEof,
+                "PFM header ends early",
+            ));
+        }
+        if byte[0].is_ascii_whitespace() {
+            if token.is_empty() {
+                continue;
+            }
+            break;
+        }
+        token.push(byte[0]);
+        if token.len() > 32 {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                "PFM header token too long",
+            ));
+        }
+    }
+    String::from_utf8(token)
+        .map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "PFM header is not ASCII"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Image {
+        let mut img = Image::new(3, 2);
+        img.set(0, 0, [1.5, 2.25e6, -0.0, 1.0]);
+        img.set(2, 1, [1e-30, 3.0, f32::MAX, 1.0]);
+        img
+    }
+
+    fn tmp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("sunshade-io-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn exr_round_trip_is_bitwise() {
+        let path = tmp("a.exr");
+        write_image(&sample(), &path, Exposure::Ev(0.0)).unwrap();
+        let back = read_image(&path).unwrap();
+        let bits = |i: &Image| {
+            i.pixels()
+                .iter()
+                .flatten()
+                .map(|v| v.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&back), bits(&sample()));
+        std::fs::remove_file(path).unwrap();
+    }
+
+    #[test]
+    fn pfm_round_trip_keeps_rgb_and_orientation() {
+        let path = tmp("a.pfm");
+        write_image(&sample(), &path, Exposure::Ev(0.0)).unwrap();
+        let back = read_image(&path).unwrap();
+        assert_eq!(back.get(0, 0), [1.5, 2.25e6, -0.0, 1.0]);
+        assert_eq!(back.get(2, 1), [1e-30, 3.0, f32::MAX, 1.0]);
+        assert_eq!(back.get(1, 0), [0.0, 0.0, 0.0, 1.0]);
+        std::fs::remove_file(path).unwrap();
+    }
+
+    #[test]
+    fn png_applies_exposure_and_coverage() {
+        let path = tmp("a.png");
+        let mut img = Image::new(2, 1);
+        img.set(0, 0, [0.5, 1.0, 4.0, 1.0]);
+        write_image(&img, &path, Exposure::Ev(-2.0)).unwrap();
+        let back = read_image(&path).unwrap();
+        let code = |v: f64| srgb_encode(v) as f32 / 255.0;
+        assert_eq!(back.get(0, 0), [code(0.125), code(0.25), 1.0, 1.0]);
+        assert_eq!(back.get(1, 0), [0.0, 0.0, 0.0, 0.0]);
+        std::fs::remove_file(path).unwrap();
+    }
+
+    #[test]
+    fn truncated_pfm_is_an_error_naming_the_file() {
+        let path = tmp("short.pfm");
+        std::fs::write(&path, b"PF\n4 4\n-1.0\n\0\0\0\0").unwrap();
+        let err = read_image(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("short.pfm") && err.contains("shorter"),
+            "{err}"
+        );
+        std::fs::remove_file(path).unwrap();
+    }
+
+    #[test]
+    fn unknown_extension_is_refused() {
+        let err = write_image(&sample(), Path::new("x.tiff"), Exposure::Auto)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("x.tiff"), "{err}");
+    }
+}

@@ -1,0 +1,204 @@
+//! What sunshade needs to know about a physical device, and which device to use.
+
+use ash::vk;
+
+use super::error::GpuError;
+
+/// A physical device and the properties that matter to sunshade.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceInfo {
+    /// Position in Vulkan's enumeration (what `--device N` names).
+    pub index: usize,
+    pub name: String,
+    pub device_type: vk::PhysicalDeviceType,
+    /// Vulkan version the device supports (major, minor, patch).
+    pub api_version: (u32, u32, u32),
+    pub driver_name: String,
+    pub driver_info: String,
+    /// Bits of sub-pixel precision in window coordinates (the reference rasterizer snaps to these).
+    pub sub_pixel_precision_bits: u32,
+    pub viewport_sub_pixel_bits: u32,
+    pub max_image_dimension_2d: u32,
+    pub max_viewport_dimensions: [u32; 2],
+    /// Largest single allocation [bytes] (`maxMemoryAllocationSize`).
+    pub max_memory_allocation_size: u64,
+    /// Size of the largest device-local heap [bytes].
+    pub device_local_heap_bytes: u64,
+    pub max_push_constants_size: u32,
+    pub framebuffer_color_sample_counts: vk::SampleCountFlags,
+    /// A queue family with graphics (and so transfer) support.
+    pub graphics_queue_family: Option<u32>,
+    /// Why sunshade cannot use this device, if it cannot.
+    pub unusable: Option<String>,
+}
+
+impl DeviceInfo {
+    pub fn type_name(&self) -> &'static str {
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
+            vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
+            vk::PhysicalDeviceType::VIRTUAL_GPU => "virtual GPU",
+            vk::PhysicalDeviceType::CPU => "CPU",
+            _ => "other",
+        }
+    }
+
+    /// Preference when no `--device` is given: lower is better.
+    fn rank(&self) -> u32 {
+        match self.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        }
+    }
+}
+
+pub(crate) fn describe(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    index: usize,
+) -> DeviceInfo {
+    // SAFETY: valid instance and physical device; the chained structs outlive the call.
+    unsafe {
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut maint3 = vk::PhysicalDeviceMaintenance3Properties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut driver)
+            .push_next(&mut maint3);
+        instance.get_physical_device_properties2(physical, &mut props2);
+        let props = props2.properties;
+        let limits = props.limits;
+        let memory = instance.get_physical_device_memory_properties(physical);
+        let heaps = &memory.memory_heaps[..memory.memory_heap_count as usize];
+        let device_local_heap_bytes = heaps
+            .iter()
+            .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+            .map(|h| h.size)
+            .max()
+            .unwrap_or(0);
+        let families = instance.get_physical_device_queue_family_properties(physical);
+        let graphics_queue_family = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
+            .map(|i| i as u32);
+        let v = props.api_version;
+        let api_version = (
+            vk::api_version_major(v),
+            vk::api_version_minor(v),
+            vk::api_version_patch(v),
+        );
+        let mut features13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut features13);
+        let mut unusable = None;
+        if v < vk::API_VERSION_1_3 {
+            unusable = Some(format!(
+                "supports Vulkan {}.{} only (1.3 needed)",
+                api_version.0, api_version.1
+            ));
+        } else {
+            instance.get_physical_device_features2(physical, &mut features2);
+            if features13.dynamic_rendering == vk::FALSE || features13.synchronization2 == vk::FALSE
+            {
+                unusable = Some("lacks dynamicRendering or synchronization2".into());
+            }
+        }
+        if graphics_queue_family.is_none() {
+            unusable = Some("has no graphics queue".into());
+        }
+        let text = |s: Result<&std::ffi::CStr, _>| {
+            s.map(|c: &std::ffi::CStr| c.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        DeviceInfo {
+            index,
+            name: text(props.device_name_as_c_str()),
+            device_type: props.device_type,
+            api_version,
+            driver_name: text(driver.driver_name_as_c_str()),
+            driver_info: text(driver.driver_info_as_c_str()),
+            sub_pixel_precision_bits: limits.sub_pixel_precision_bits,
+            viewport_sub_pixel_bits: limits.viewport_sub_pixel_bits,
+            max_image_dimension_2d: limits.max_image_dimension2_d,
+            max_viewport_dimensions: limits.max_viewport_dimensions,
+            max_memory_allocation_size: maint3.max_memory_allocation_size,
+            device_local_heap_bytes,
+            max_push_constants_size: limits.max_push_constants_size,
+            framebuffer_color_sample_counts: limits.framebuffer_color_sample_counts,
+            graphics_queue_family,
+            unusable,
+        }
+    }
+}
+
+/// Picks a device: `selector` is an index or a case-insensitive name substring; without one, the best-ranked
+/// usable device (discrete GPU, then integrated, virtual, CPU).
+pub(crate) fn choose<'a>(
+    devices: &'a [(vk::PhysicalDevice, DeviceInfo)],
+    selector: Option<&str>,
+) -> Result<(vk::PhysicalDevice, DeviceInfo), GpuError> {
+    let list = || {
+        devices
+            .iter()
+            .map(|(_, d)| format!("{}: {}", d.index, d.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if devices.is_empty() {
+        return Err(GpuError::NoDevice(
+            "Vulkan reports no physical device".into(),
+        ));
+    }
+    let pick = |d: &'a (vk::PhysicalDevice, DeviceInfo)| -> Result<(vk::PhysicalDevice, DeviceInfo), GpuError> {
+        match &d.1.unusable {
+            Some(why) => Err(GpuError::DeviceNotFound(format!("selects '{}', which {why}", d.1.name))),
+            None => Ok((d.0, d.1.clone())),
+        }
+    };
+    match selector {
+        Some(s) => {
+            if let Ok(i) = s.trim().parse::<usize>() {
+                let d = devices.get(i).ok_or_else(|| {
+                    GpuError::DeviceNotFound(format!(
+                        "{s}: no device with that index (devices: {})",
+                        list()
+                    ))
+                })?;
+                return pick(d);
+            }
+            let needle = s.to_lowercase();
+            let d = devices
+                .iter()
+                .find(|(_, d)| d.name.to_lowercase().contains(&needle))
+                .ok_or_else(|| {
+                    GpuError::DeviceNotFound(format!(
+                        "'{s}': no device name contains it (devices: {})",
+                        list()
+                    ))
+                })?;
+            pick(d)
+        }
+        None => {
+            let best = devices
+                .iter()
+                .filter(|(_, d)| d.unusable.is_none())
+                .min_by_key(|(_, d)| d.rank());
+            match best {
+                Some(d) => pick(d),
+                None => Err(GpuError::NoDevice(format!(
+                    "none of the devices is usable ({})",
+                    devices
+                        .iter()
+                        .map(|(_, d)| format!(
+                            "{}: {}",
+                            d.name,
+                            d.unusable.as_deref().unwrap_or("?")
+                        ))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ))),
+            }
+        }
+    }
+}

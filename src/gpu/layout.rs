@@ -1,0 +1,126 @@
+//! Byte layouts shared with the shaders (std430), mirrored by `shaders/bindings.glsl`: change both together.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::scene::{Brdf, Lights, Material};
+use crate::settings::RenderSettings;
+
+pub const BRDF_LAMBERT: u32 = 0;
+
+/// One vertex: world position [m] and unit normal, interleaved.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MaterialGpu {
+    pub kd: [f32; 4],
+    pub ks: [f32; 4],
+    pub params: [f32; 4],
+    pub kind: [u32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SunGpu {
+    pub direction: [f32; 4],
+    pub irradiance: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DiskGpu {
+    pub center_radius: [f32; 4],
+    pub direction: [f32; 4],
+    pub radiance: [f32; 4],
+}
+
+/// The fixed head of the light buffer; `DiskGpu` records follow it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightsHeader {
+    pub sun: SunGpu,
+    pub sky: [f32; 4],
+    pub counts: [u32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PushConstants {
+    pub clip_from_world: [f32; 16],
+    pub viewer: [f32; 4],
+    pub material: u32,
+    pub _pad: [u32; 3],
+}
+
+pub fn material_gpu(m: &Material) -> MaterialGpu {
+    let Brdf::Lambert { albedo } = m.brdf;
+    MaterialGpu {
+        kd: [albedo[0], albedo[1], albedo[2], 0.0],
+        ks: [0.0; 4],
+        params: [0.0; 4],
+        kind: [BRDF_LAMBERT, m.double_sided as u32, 0, 0],
+    }
+}
+
+/// The light buffer's bytes.
+pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
+    let sun = match &lights.sun {
+        Some(s) => SunGpu {
+            direction: [
+                s.direction.x,
+                s.direction.y,
+                s.direction.z,
+                s.angular_diameter,
+            ],
+            irradiance: [s.irradiance[0], s.irradiance[1], s.irradiance[2], 1.0],
+        },
+        None => SunGpu::zeroed(),
+    };
+    let sky = match lights.sky {
+        Some(l) => [l[0], l[1], l[2], 1.0],
+        None => [0.0; 4],
+    };
+    let header = LightsHeader {
+        sun,
+        sky,
+        counts: [lights.disks.len() as u32, 0, 0, 0],
+    };
+    let mut bytes = bytemuck::bytes_of(&header).to_vec();
+    for d in &lights.disks {
+        let disk = DiskGpu {
+            center_radius: [d.center.x, d.center.y, d.center.z, d.radius],
+            direction: [d.direction.x, d.direction.y, d.direction.z, 0.0],
+            radiance: [d.radiance[0], d.radiance[1], d.radiance[2], 0.0],
+        };
+        bytes.extend_from_slice(bytemuck::bytes_of(&disk));
+    }
+    bytes
+}
+
+pub fn push_constants(settings: &RenderSettings, material: u32) -> PushConstants {
+    PushConstants {
+        clip_from_world: settings.clip_from_world().to_cols_array(),
+        viewer: settings.viewer().to_array(),
+        material,
+        _pad: [0; 3],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_match_std430() {
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
+        assert_eq!(std::mem::size_of::<LightsHeader>(), 64);
+        assert_eq!(std::mem::size_of::<DiskGpu>(), 48);
+        assert_eq!(std::mem::size_of::<PushConstants>(), 96);
+        assert_eq!(std::mem::size_of::<Vertex>(), 24);
+    }
+}

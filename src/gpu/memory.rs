@@ -1,0 +1,228 @@
+//! Buffers and images with their memory (through gpu-allocator), destroyed on drop.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::context::Device;
+use super::error::{GpuError, VkContext};
+
+/// A buffer and its memory.
+pub(crate) struct Buffer {
+    dev: Arc<Device>,
+    pub buffer: vk::Buffer,
+    allocation: Option<Allocation>,
+    pub size: u64,
+}
+
+impl Buffer {
+    pub fn new(
+        dev: &Arc<Device>,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+        name: &str,
+    ) -> Result<Self, GpuError> {
+        // SAFETY: valid device; the buffer is bound to memory allocated for its own requirements.
+        unsafe {
+            let info = vk::BufferCreateInfo::default()
+                .size(size.max(4))
+                .usage(usage)
+                .sharing_mode(vk::SharingMode::EXCLUSIVE);
+            let buffer = dev.device.create_buffer(&info, None).vk("vkCreateBuffer")?;
+            let requirements = dev.device.get_buffer_memory_requirements(buffer);
+            let allocation = allocate(dev, name, requirements, location, true);
+            let allocation = match allocation {
+                Ok(a) => a,
+                Err(e) => {
+                    dev.device.destroy_buffer(buffer, None);
+                    return Err(e);
+                }
+            };
+            let mut out = Self {
+                dev: dev.clone(),
+                buffer,
+                allocation: None,
+                size,
+            };
+            let bind =
+                dev.device
+                    .bind_buffer_memory(buffer, allocation.memory(), allocation.offset());
+            out.allocation = Some(allocation);
+            bind.vk("vkBindBufferMemory")?;
+            Ok(out)
+        }
+    }
+
+    /// A host-visible buffer holding `bytes`.
+    pub fn with_data(
+        dev: &Arc<Device>,
+        bytes: &[u8],
+        usage: vk::BufferUsageFlags,
+        name: &str,
+    ) -> Result<Self, GpuError> {
+        let mut b = Self::new(
+            dev,
+            bytes.len() as u64,
+            usage,
+            MemoryLocation::CpuToGpu,
+            name,
+        )?;
+        b.mapped_mut()[..bytes.len()].copy_from_slice(bytes);
+        Ok(b)
+    }
+
+    /// The mapped memory (host-visible and coherent: gpu-allocator requires coherence for CPU locations).
+    pub fn mapped(&self) -> &[u8] {
+        let a = self.allocation.as_ref().expect("allocated");
+        &a.mapped_slice().expect("host-visible buffer")[..self.size as usize]
+    }
+
+    pub fn mapped_mut(&mut self) -> &mut [u8] {
+        let size = self.size as usize;
+        let a = self.allocation.as_mut().expect("allocated");
+        &mut a.mapped_slice_mut().expect("host-visible buffer")[..size]
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: the caller waited for the GPU to finish with this buffer (renders wait on a fence).
+        unsafe {
+            self.dev.device.destroy_buffer(self.buffer, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            if let Ok(mut allocator) = self.dev.allocator.lock() {
+                let _ = allocator.free(a);
+            }
+        }
+    }
+}
+
+/// A 2D image with one view.
+pub(crate) struct Image2d {
+    dev: Arc<Device>,
+    pub image: vk::Image,
+    pub view: vk::ImageView,
+    allocation: Option<Allocation>,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Image2d {
+    pub fn new(
+        dev: &Arc<Device>,
+        width: u32,
+        height: u32,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+        name: &str,
+    ) -> Result<Self, GpuError> {
+        // SAFETY: valid device and create infos; partial failures destroy what was made.
+        unsafe {
+            let info = vk::ImageCreateInfo::default()
+                .image_type(vk::ImageType::TYPE_2D)
+                .format(format)
+                .extent(vk::Extent3D {
+                    width,
+                    height,
+                    depth: 1,
+                })
+                .mip_levels(1)
+                .array_layers(1)
+                .samples(vk::SampleCountFlags::TYPE_1)
+                .tiling(vk::ImageTiling::OPTIMAL)
+                .usage(usage)
+                .sharing_mode(vk::SharingMode::EXCLUSIVE)
+                .initial_layout(vk::ImageLayout::UNDEFINED);
+            let image = dev.device.create_image(&info, None).vk("vkCreateImage")?;
+            let requirements = dev.device.get_image_memory_requirements(image);
+            let allocation = match allocate(dev, name, requirements, MemoryLocation::GpuOnly, false)
+            {
+                Ok(a) => a,
+                Err(e) => {
+                    dev.device.destroy_image(image, None);
+                    return Err(e);
+                }
+            };
+            let mut out = Self {
+                dev: dev.clone(),
+                image,
+                view: vk::ImageView::null(),
+                allocation: None,
+                width,
+                height,
+            };
+            let bind =
+                dev.device
+                    .bind_image_memory(image, allocation.memory(), allocation.offset());
+            out.allocation = Some(allocation);
+            bind.vk("vkBindImageMemory")?;
+            let view_info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(vk::ImageViewType::TYPE_2D)
+                .format(format)
+                .subresource_range(subresource_range(aspect));
+            out.view = dev
+                .device
+                .create_image_view(&view_info, None)
+                .vk("vkCreateImageView")?;
+            Ok(out)
+        }
+    }
+}
+
+impl Drop for Image2d {
+    fn drop(&mut self) {
+        // SAFETY: the GPU is done with the image (renders wait on a fence).
+        unsafe {
+            if self.view != vk::ImageView::null() {
+                self.dev.device.destroy_image_view(self.view, None);
+            }
+            self.dev.device.destroy_image(self.image, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            if let Ok(mut allocator) = self.dev.allocator.lock() {
+                let _ = allocator.free(a);
+            }
+        }
+    }
+}
+
+pub(crate) fn subresource_range(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange {
+        aspect_mask: aspect,
+        base_mip_level: 0,
+        level_count: 1,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+fn allocate(
+    dev: &Arc<Device>,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation, GpuError> {
+    let mut allocator = dev.allocator.lock().map_err(|_| GpuError::Allocation {
+        what: name.into(),
+        message: "allocator lock poisoned".into(),
+    })?;
+    allocator
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|e| GpuError::Allocation {
+            what: name.into(),
+            message: e.to_string(),
+        })
+}

@@ -1,0 +1,24 @@
+//! The Vulkan renderer (ash). It knows nothing of glTF: it takes a [`Scene`](crate::scene::Scene) and
+//! [`RenderSettings`](crate::settings::RenderSettings) and returns an [`Image`](crate::film::Image).
+//!
+//! - `context`: instance (no surface), validation messages, device choice, queue, allocator;
+//! - `device_info`: the properties and limits that matter, and the `--device` choice;
+//! - `memory`: buffers and images with their memory;
+//! - `shaders`: the embedded GLSL and its run-time compilation;
+//! - `layout`: the byte layouts shared with the shaders;
+//! - `pipeline`: the graphics pipeline (dynamic rendering, RGBA32F + D32);
+//! - `renderer`: upload, draw, readback.
+
+mod context;
+mod device_info;
+mod error;
+pub mod layout;
+mod memory;
+mod pipeline;
+mod renderer;
+pub mod shaders;
+
+pub use context::{list_devices, ContextOptions, ValidationLog};
+pub use device_info::DeviceInfo;
+pub use error::{GpuError, VULKAN_PACKAGES};
+pub use renderer::{FrameTimings, GpuScene, Renderer, SetupTimings};

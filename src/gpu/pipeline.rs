@@ -1,0 +1,221 @@
+//! The scene pipeline: descriptor layout (materials, lights), push constants, and the graphics pipeline for
+//! dynamic rendering into RGBA32F colour + D32 depth.
+//!
+//! Fixed state: triangle lists, fill, counter-clockwise front faces, depth test LESS with writes, no blending,
+//! one sample. Dynamic state: viewport, scissor and cull mode (back for single-sided materials, none for
+//! double-sided ones).
+
+use std::sync::Arc;
+
+use ash::vk;
+
+use super::context::Device;
+use super::error::{GpuError, VkContext};
+use super::layout::{PushConstants, Vertex};
+
+pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+pub(crate) struct ScenePipeline {
+    dev: Arc<Device>,
+    pub set_layout: vk::DescriptorSetLayout,
+    pub layout: vk::PipelineLayout,
+    pub pipeline: vk::Pipeline,
+    pub descriptor_pool: vk::DescriptorPool,
+    pub descriptor_set: vk::DescriptorSet,
+}
+
+impl ScenePipeline {
+    pub fn new(
+        dev: &Arc<Device>,
+        vertex_spirv: &[u32],
+        fragment_spirv: &[u32],
+    ) -> Result<Self, GpuError> {
+        let d = &dev.device;
+        let mut out = Self {
+            dev: dev.clone(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            descriptor_pool: vk::DescriptorPool::null(),
+            descriptor_set: vk::DescriptorSet::null(),
+        };
+        // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
+        unsafe {
+            let bindings = [0, 1].map(|b| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+            });
+            out.set_layout = d
+                .create_descriptor_set_layout(
+                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                    None,
+                )
+                .vk("vkCreateDescriptorSetLayout")?;
+            let ranges = [vk::PushConstantRange::default()
+                .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
+                .offset(0)
+                .size(std::mem::size_of::<PushConstants>() as u32)];
+            let set_layouts = [out.set_layout];
+            out.layout = d
+                .create_pipeline_layout(
+                    &vk::PipelineLayoutCreateInfo::default()
+                        .set_layouts(&set_layouts)
+                        .push_constant_ranges(&ranges),
+                    None,
+                )
+                .vk("vkCreatePipelineLayout")?;
+            let pool_sizes = [vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: 2,
+            }];
+            out.descriptor_pool = d
+                .create_descriptor_pool(
+                    &vk::DescriptorPoolCreateInfo::default()
+                        .max_sets(1)
+                        .pool_sizes(&pool_sizes),
+                    None,
+                )
+                .vk("vkCreateDescriptorPool")?;
+            out.descriptor_set = d
+                .allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(out.descriptor_pool)
+                        .set_layouts(&set_layouts),
+                )
+                .vk("vkAllocateDescriptorSets")?[0];
+            out.pipeline = create_pipeline(d, out.layout, vertex_spirv, fragment_spirv)?;
+        }
+        Ok(out)
+    }
+}
+
+unsafe fn create_pipeline(
+    d: &ash::Device,
+    layout: vk::PipelineLayout,
+    vertex_spirv: &[u32],
+    fragment_spirv: &[u32],
+) -> Result<vk::Pipeline, GpuError> {
+    // SAFETY (whole function): valid device; shader modules are destroyed before returning.
+    unsafe {
+        let vs = d
+            .create_shader_module(
+                &vk::ShaderModuleCreateInfo::default().code(vertex_spirv),
+                None,
+            )
+            .vk("vkCreateShaderModule")?;
+        let fs = match d.create_shader_module(
+            &vk::ShaderModuleCreateInfo::default().code(fragment_spirv),
+            None,
+        ) {
+            Ok(m) => m,
+            Err(result) => {
+                d.destroy_shader_module(vs, None);
+                return Err(GpuError::Vulkan {
+                    what: "vkCreateShaderModule",
+                    result,
+                });
+            }
+        };
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vs)
+                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fs)
+                .name(c"main"),
+        ];
+        let vertex_bindings = [vk::VertexInputBindingDescription {
+            binding: 0,
+            stride: std::mem::size_of::<Vertex>() as u32,
+            input_rate: vk::VertexInputRate::VERTEX,
+        }];
+        let vertex_attributes = [
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 12,
+            },
+        ];
+        let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&vertex_bindings)
+            .vertex_attribute_descriptions(&vertex_attributes);
+        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
+            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default()
+            .viewport_count(1)
+            .scissor_count(1);
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::BACK)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
+            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(true)
+            .depth_write_enable(true)
+            .depth_compare_op(vk::CompareOp::LESS);
+        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend =
+            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [
+            vk::DynamicState::VIEWPORT,
+            vk::DynamicState::SCISSOR,
+            vk::DynamicState::CULL_MODE,
+        ];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        let color_formats = [COLOR_FORMAT];
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(&color_formats)
+            .depth_attachment_format(DEPTH_FORMAT);
+        let info = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&input_assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend)
+            .dynamic_state(&dynamic)
+            .layout(layout)
+            .push_next(&mut rendering);
+        let result = d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None);
+        d.destroy_shader_module(vs, None);
+        d.destroy_shader_module(fs, None);
+        result
+            .map(|p| p[0])
+            .map_err(|(_, result)| GpuError::Vulkan {
+                what: "vkCreateGraphicsPipelines",
+                result,
+            })
+    }
+}
+
+impl Drop for ScenePipeline {
+    fn drop(&mut self) {
+        let d = &self.dev.device;
+        // SAFETY: the device is idle with respect to these objects (renders wait on a fence); null handles are
+        // ignored by the destroy calls.
+        unsafe {
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_descriptor_pool(self.descriptor_pool, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}

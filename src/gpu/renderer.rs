@@ -1,0 +1,612 @@
+//! The GPU renderer: upload a scene, draw it offscreen, read the radiance back into an [`Image`].
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use super::context::{ContextOptions, Device, ValidationLog};
+use super::device_info::DeviceInfo;
+use super::error::{GpuError, VkContext};
+use super::layout::{lights_bytes, material_gpu, push_constants, Vertex};
+use super::memory::{subresource_range, Buffer, Image2d};
+use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
+use super::shaders;
+use crate::film::{rgba32f_bytes, Image};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+
+/// Wall-clock time of the set-up phases [s].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SetupTimings {
+    /// Loader, instance, device and allocator creation.
+    pub instance: Duration,
+    /// GLSL → SPIR-V (shaderc) and pipeline creation.
+    pub shader_compile: Duration,
+}
+
+/// Wall-clock time of the phases of one frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameTimings {
+    /// Recording, submitting and waiting for the draw (the frame time).
+    pub render: Duration,
+    /// Copying the colour target to host memory and into the [`Image`].
+    pub readback: Duration,
+}
+
+/// A scene's geometry and materials on the device.
+pub struct GpuScene {
+    vertices: Option<Buffer>,
+    indices: Option<Buffer>,
+    materials: Buffer,
+    draws: Vec<Draw>,
+}
+
+struct Draw {
+    first_index: u32,
+    index_count: u32,
+    vertex_offset: i32,
+    material: u32,
+    double_sided: bool,
+}
+
+struct Target {
+    color: Image2d,
+    depth: Image2d,
+    readback: Buffer,
+}
+
+/// Renders scenes through Vulkan. Owns its device; everything is released when it is dropped.
+pub struct Renderer {
+    // Field order is drop order: everything that uses the device goes before `dev`.
+    target: Option<Target>,
+    lights: Option<Buffer>,
+    pipeline: ScenePipeline,
+    commands: Commands,
+    setup: SetupTimings,
+    dev: Arc<Device>,
+}
+
+impl Renderer {
+    /// Creates the device and compiles the shaders.
+    pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
+        let t0 = Instant::now();
+        let dev = Device::new(options)?;
+        let instance = t0.elapsed();
+        let t1 = Instant::now();
+        let vs =
+            shaders::compile("scene.vert", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
+        let fs =
+            shaders::compile("scene.frag", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
+        let pipeline = ScenePipeline::new(&dev, &vs, &fs)?;
+        let shader_compile = t1.elapsed();
+        let commands = Commands::new(&dev)?;
+        let renderer = Self {
+            target: None,
+            lights: None,
+            pipeline,
+            commands,
+            setup: SetupTimings {
+                instance,
+                shader_compile,
+            },
+            dev,
+        };
+        renderer.check_validation()?;
+        Ok(renderer)
+    }
+
+    pub fn device_info(&self) -> &DeviceInfo {
+        &self.dev.info
+    }
+
+    pub fn setup_timings(&self) -> SetupTimings {
+        self.setup
+    }
+
+    /// The validation layer's messages (empty without validation). Outlives the renderer.
+    pub fn validation_log(&self) -> Arc<ValidationLog> {
+        self.dev.validation_log()
+    }
+
+    /// Refuses image sizes the device cannot hold: over `maxImageDimension2D`, over the largest single
+    /// allocation, or over the device-local heap.
+    pub fn check_size(&self, width: u32, height: u32) -> Result<(), GpuError> {
+        let info = &self.dev.info;
+        let max = info
+            .max_image_dimension_2d
+            .min(info.max_viewport_dimensions[0])
+            .min(info.max_viewport_dimensions[1]);
+        if width > max || height > max {
+            return Err(GpuError::TooLarge(format!(
+                "a {width}x{height} image exceeds the largest image {} supports ({max} pixels per side)",
+                info.name
+            )));
+        }
+        let color = rgba32f_bytes(width, height).unwrap_or(u64::MAX);
+        let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+        if color > info.max_memory_allocation_size {
+            return Err(GpuError::TooLarge(format!(
+                "a {width}x{height} RGBA32F image needs {:.2} GiB in one allocation; {} allows {:.2} GiB",
+                gib(color),
+                info.name,
+                gib(info.max_memory_allocation_size)
+            )));
+        }
+        // Colour target + depth (4 bytes/pixel) + host readback buffer.
+        let total = color.saturating_mul(2).saturating_add(color / 4);
+        if info.device_local_heap_bytes > 0 && total > info.device_local_heap_bytes {
+            return Err(GpuError::TooLarge(format!(
+                "a {width}x{height} render needs {:.2} GiB of memory; {} has {:.2} GiB",
+                gib(total),
+                info.name,
+                gib(info.device_local_heap_bytes)
+            )));
+        }
+        Ok(())
+    }
+
+    /// Copies a scene's triangles and materials to the device.
+    pub fn upload(&self, scene: &Scene) -> Result<GpuScene, GpuError> {
+        let mut vertices = Vec::new();
+        let mut indices = Vec::new();
+        let mut draws = Vec::new();
+        for mesh in &scene.meshes {
+            let vertex_offset = i32::try_from(vertices.len())
+                .map_err(|_| GpuError::TooLarge("the scene has more than 2^31 vertices".into()))?;
+            draws.push(Draw {
+                first_index: indices.len() as u32,
+                index_count: mesh.indices.len() as u32,
+                vertex_offset,
+                material: mesh.material as u32,
+                double_sided: scene.materials[mesh.material].double_sided,
+            });
+            vertices.extend(
+                mesh.positions
+                    .iter()
+                    .zip(&mesh.normals)
+                    .map(|(p, n)| Vertex {
+                        position: p.to_array(),
+                        normal: n.to_array(),
+                    }),
+            );
+            indices.extend_from_slice(&mesh.indices);
+        }
+        let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
+        let materials_bytes: &[u8] = if materials.is_empty() {
+            &[0; 64]
+        } else {
+            bytemuck::cast_slice(&materials)
+        };
+        Ok(GpuScene {
+            vertices: (!vertices.is_empty())
+                .then(|| {
+                    Buffer::with_data(
+                        &self.dev,
+                        bytemuck::cast_slice(&vertices),
+                        vk::BufferUsageFlags::VERTEX_BUFFER,
+                        "vertices",
+                    )
+                })
+                .transpose()?,
+            indices: (!indices.is_empty())
+                .then(|| {
+                    Buffer::with_data(
+                        &self.dev,
+                        bytemuck::cast_slice(&indices),
+                        vk::BufferUsageFlags::INDEX_BUFFER,
+                        "indices",
+                    )
+                })
+                .transpose()?,
+            materials: Buffer::with_data(
+                &self.dev,
+                materials_bytes,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+                "materials",
+            )?,
+            draws,
+        })
+    }
+
+    /// Uploads and renders in one go.
+    pub fn render_scene(
+        &mut self,
+        scene: &Scene,
+        settings: &RenderSettings,
+    ) -> Result<(Image, FrameTimings), GpuError> {
+        let gpu_scene = self.upload(scene)?;
+        self.render(&gpu_scene, settings)
+    }
+
+    /// Draws an uploaded scene and reads the radiance back.
+    pub fn render(
+        &mut self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+    ) -> Result<(Image, FrameTimings), GpuError> {
+        let (width, height) = (settings.width, settings.height);
+        self.check_size(width, height)?;
+        if self
+            .target
+            .as_ref()
+            .is_none_or(|t| t.color.width != width || t.color.height != height)
+        {
+            self.target = None;
+            self.target = Some(Target {
+                color: Image2d::new(
+                    &self.dev,
+                    width,
+                    height,
+                    COLOR_FORMAT,
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                    vk::ImageAspectFlags::COLOR,
+                    "colour target",
+                )?,
+                depth: Image2d::new(
+                    &self.dev,
+                    width,
+                    height,
+                    DEPTH_FORMAT,
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                    vk::ImageAspectFlags::DEPTH,
+                    "depth target",
+                )?,
+                readback: Buffer::new(
+                    &self.dev,
+                    rgba32f_bytes(width, height).expect("checked"),
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                    "readback",
+                )?,
+            });
+        }
+        self.lights = None;
+        let lights = Buffer::with_data(
+            &self.dev,
+            &lights_bytes(&settings.lights),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            "lights",
+        )?;
+        let target = self.target.as_ref().expect("created above");
+        let d = &self.dev.device;
+
+        let t_render = Instant::now();
+        // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
+        // for), so the descriptor set may be updated and the command buffer re-recorded.
+        unsafe {
+            let infos = [
+                [vk::DescriptorBufferInfo {
+                    buffer: scene.materials.buffer,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }],
+                [vk::DescriptorBufferInfo {
+                    buffer: lights.buffer,
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                }],
+            ];
+            let writes = [0usize, 1].map(|b| {
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(b as u32)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(&infos[b])
+            });
+            d.update_descriptor_sets(&writes, &[]);
+
+            let cb = self.commands.begin(&self.dev)?;
+            let to_attachment = [
+                image_barrier(
+                    target.color.image,
+                    vk::ImageAspectFlags::COLOR,
+                    (
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        vk::AccessFlags2::MEMORY_WRITE,
+                    ),
+                    (
+                        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                    ),
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                ),
+                image_barrier(
+                    target.depth.image,
+                    vk::ImageAspectFlags::DEPTH,
+                    (
+                        vk::PipelineStageFlags2::ALL_COMMANDS,
+                        vk::AccessFlags2::MEMORY_WRITE,
+                    ),
+                    (
+                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                        vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                    ),
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+                ),
+            ];
+            d.cmd_pipeline_barrier2(
+                cb,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_attachment),
+            );
+            let area = vk::Rect2D {
+                offset: vk::Offset2D { x: 0, y: 0 },
+                extent: vk::Extent2D { width, height },
+            };
+            let color_attachments = [vk::RenderingAttachmentInfo::default()
+                .image_view(target.color.view)
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [0.0; 4] },
+                })];
+            let depth_attachment = vk::RenderingAttachmentInfo::default()
+                .image_view(target.depth.view)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::DONT_CARE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: 1.0,
+                        stencil: 0,
+                    },
+                });
+            d.cmd_begin_rendering(
+                cb,
+                &vk::RenderingInfo::default()
+                    .render_area(area)
+                    .layer_count(1)
+                    .color_attachments(&color_attachments)
+                    .depth_attachment(&depth_attachment),
+            );
+            let viewport = vk::Viewport {
+                x: 0.0,
+                y: 0.0,
+                width: width as f32,
+                height: height as f32,
+                min_depth: 0.0,
+                max_depth: 1.0,
+            };
+            d.cmd_set_viewport(cb, 0, &[viewport]);
+            d.cmd_set_scissor(cb, 0, &[area]);
+            if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cb,
+                    vk::PipelineBindPoint::GRAPHICS,
+                    self.pipeline.layout,
+                    0,
+                    &[self.pipeline.descriptor_set],
+                    &[],
+                );
+                d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
+                d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
+                for draw in &scene.draws {
+                    let pc = push_constants(settings, draw.material);
+                    d.cmd_push_constants(
+                        cb,
+                        self.pipeline.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&pc),
+                    );
+                    d.cmd_set_cull_mode(
+                        cb,
+                        if draw.double_sided {
+                            vk::CullModeFlags::NONE
+                        } else {
+                            vk::CullModeFlags::BACK
+                        },
+                    );
+                    d.cmd_draw_indexed(
+                        cb,
+                        draw.index_count,
+                        1,
+                        draw.first_index,
+                        draw.vertex_offset,
+                        0,
+                    );
+                }
+            }
+            d.cmd_end_rendering(cb);
+            self.commands.submit_and_wait(&self.dev, cb)?;
+        }
+        let render = t_render.elapsed();
+
+        let t_readback = Instant::now();
+        // SAFETY: as above; the colour image is in COLOR_ATTACHMENT_OPTIMAL after the render submission.
+        unsafe {
+            let cb = self.commands.begin(&self.dev)?;
+            let to_transfer = [image_barrier(
+                target.color.image,
+                vk::ImageAspectFlags::COLOR,
+                (
+                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            )];
+            d.cmd_pipeline_barrier2(
+                cb,
+                &vk::DependencyInfo::default().image_memory_barriers(&to_transfer),
+            );
+            let region = vk::BufferImageCopy {
+                buffer_offset: 0,
+                buffer_row_length: 0,
+                buffer_image_height: 0,
+                image_subresource: vk::ImageSubresourceLayers {
+                    aspect_mask: vk::ImageAspectFlags::COLOR,
+                    mip_level: 0,
+                    base_array_layer: 0,
+                    layer_count: 1,
+                },
+                image_offset: vk::Offset3D { x: 0, y: 0, z: 0 },
+                image_extent: vk::Extent3D {
+                    width,
+                    height,
+                    depth: 1,
+                },
+            };
+            d.cmd_copy_image_to_buffer(
+                cb,
+                target.color.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                target.readback.buffer,
+                &[region],
+            );
+            let to_host = [vk::BufferMemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .buffer(target.readback.buffer)
+                .offset(0)
+                .size(vk::WHOLE_SIZE)];
+            d.cmd_pipeline_barrier2(
+                cb,
+                &vk::DependencyInfo::default().buffer_memory_barriers(&to_host),
+            );
+            self.commands.submit_and_wait(&self.dev, cb)?;
+        }
+        let pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(target.readback.mapped());
+        let image =
+            Image::from_pixels(width, height, pixels).expect("readback buffer sized for the image");
+        let readback = t_readback.elapsed();
+        self.lights = Some(lights);
+        self.check_validation()?;
+        Ok((image, FrameTimings { render, readback }))
+    }
+
+    fn check_validation(&self) -> Result<(), GpuError> {
+        let messages = self.validation_log().messages();
+        if messages.is_empty() {
+            Ok(())
+        } else {
+            Err(GpuError::Validation(messages))
+        }
+    }
+}
+
+fn image_barrier(
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    old_layout: vk::ImageLayout,
+    new_layout: vk::ImageLayout,
+) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)
+        .old_layout(old_layout)
+        .new_layout(new_layout)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(subresource_range(aspect))
+}
+
+/// One command pool with one reusable primary command buffer and a fence.
+struct Commands {
+    dev: Arc<Device>,
+    pool: vk::CommandPool,
+    buffer: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+impl Commands {
+    fn new(dev: &Arc<Device>) -> Result<Self, GpuError> {
+        // SAFETY: valid device and create infos.
+        unsafe {
+            let pool = dev
+                .device
+                .create_command_pool(
+                    &vk::CommandPoolCreateInfo::default()
+                        .queue_family_index(dev.queue_family)
+                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                    None,
+                )
+                .vk("vkCreateCommandPool")?;
+            let mut out = Self {
+                dev: dev.clone(),
+                pool,
+                buffer: vk::CommandBuffer::null(),
+                fence: vk::Fence::null(),
+            };
+            out.buffer = dev
+                .device
+                .allocate_command_buffers(
+                    &vk::CommandBufferAllocateInfo::default()
+                        .command_pool(pool)
+                        .level(vk::CommandBufferLevel::PRIMARY)
+                        .command_buffer_count(1),
+                )
+                .vk("vkAllocateCommandBuffers")?[0];
+            out.fence = dev
+                .device
+                .create_fence(&vk::FenceCreateInfo::default(), None)
+                .vk("vkCreateFence")?;
+            Ok(out)
+        }
+    }
+
+    /// Resets and begins the command buffer (the previous submission has been waited for).
+    unsafe fn begin(&self, dev: &Device) -> Result<vk::CommandBuffer, GpuError> {
+        // SAFETY: the buffer is not pending (submit_and_wait waits for completion).
+        unsafe {
+            dev.device
+                .reset_command_buffer(self.buffer, vk::CommandBufferResetFlags::empty())
+                .vk("vkResetCommandBuffer")?;
+            dev.device
+                .begin_command_buffer(
+                    self.buffer,
+                    &vk::CommandBufferBeginInfo::default()
+                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                )
+                .vk("vkBeginCommandBuffer")?;
+        }
+        Ok(self.buffer)
+    }
+
+    unsafe fn submit_and_wait(&self, dev: &Device, cb: vk::CommandBuffer) -> Result<(), GpuError> {
+        // SAFETY: `cb` was begun by `begin`; the fence is unsignalled (reset after every wait).
+        unsafe {
+            dev.device.end_command_buffer(cb).vk("vkEndCommandBuffer")?;
+            let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cb)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&buffers)];
+            dev.device
+                .queue_submit2(dev.queue, &submit, self.fence)
+                .vk("vkQueueSubmit2")?;
+            dev.device
+                .wait_for_fences(&[self.fence], true, u64::MAX)
+                .vk("vkWaitForFences")?;
+            dev.device.reset_fences(&[self.fence]).vk("vkResetFences")?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Commands {
+    fn drop(&mut self) {
+        // SAFETY: nothing is pending (every submission is waited for).
+        unsafe {
+            self.dev.device.destroy_fence(self.fence, None);
+            self.dev.device.destroy_command_pool(self.pool, None);
+        }
+    }
+}

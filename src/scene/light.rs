@@ -1,0 +1,49 @@
+//! Light sources in world units: the sun, disk skylights and a uniform sky.
+//!
+//! Radiometric quantities are in W/m² (irradiance) and W/(m²·sr) (radiance), per linear RGB channel.
+//! The formulas that turn these into irradiance at a surface live in `shading::radiometry`.
+
+use glam::Vec3;
+
+/// The sun: a disk of uniform radiance `L_sun` and angular diameter `δ` in the direction `direction`.
+///
+/// It is specified by `E⊥`, the irradiance on a surface facing the sun, per channel:
+/// `E⊥ = L_sun · π sin²(δ/2)` exactly (the projected solid angle of the sun's cone), which is `L_sun · Ω_sun` to
+/// within 5.3·10⁻⁶ relative for the real sun (see `shading::radiometry`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sun {
+    /// Unit vector from the scene towards the sun, world axes.
+    pub direction: Vec3,
+    /// `E⊥` [W/m²] per channel.
+    pub irradiance: [f32; 3],
+    /// Angular diameter `δ` [rad] (0.53° by default).
+    pub angular_diameter: f32,
+}
+
+/// A disk skylight: radius `R` [m], uniform radiance `L0` [W/(m²·sr)], emitting from one face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskLight {
+    /// Centre [m], world space.
+    pub center: Vec3,
+    /// Unit vector in the direction the disk emits (its lit side faces this way).
+    pub direction: Vec3,
+    /// Radius `R` [m].
+    pub radius: f32,
+    /// Radiance `L0` [W/(m²·sr)] per channel.
+    pub radiance: [f32; 3],
+}
+
+/// All the lights of a render; their contributions add up.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Lights {
+    pub sun: Option<Sun>,
+    pub disks: Vec<DiskLight>,
+    /// Overcast sky: uniform radiance [W/(m²·sr)] over the whole sphere of directions, per channel.
+    pub sky: Option<[f32; 3]>,
+}
+
+impl Lights {
+    pub fn is_empty(&self) -> bool {
+        self.sun.is_none() && self.disks.is_empty() && self.sky.is_none()
+    }
+}

@@ -1,0 +1,104 @@
+//! The scene in world units: triangle meshes in metres, materials, cameras and lights in radiometric units.
+//!
+//! This is the only module that knows glTF ([`load`]). Geometry is flattened once while loading: node transforms
+//! are applied (in f64, rounded once to f32), normals are carried by the inverse transpose, triangles of mirrored
+//! nodes are re-wound so that counter-clockwise is the front face everywhere, and flat normals are generated where
+//! the file has none. Both renderers therefore consume exactly the same `f32` triangles.
+//!
+//! Axes are glTF's: right-handed, +Y up, metres.
+
+mod accessor;
+pub mod camera;
+pub mod light;
+mod load;
+pub mod material;
+mod uri;
+
+use glam::{DVec3, Vec3};
+
+pub use camera::{Camera, Projection};
+pub use light::{DiskLight, Lights, Sun};
+pub use load::{load, load_with_options, LoadError, LoadOptions};
+pub use material::{Brdf, Material};
+
+/// A loaded scene: everything both renderers need apart from the per-render settings.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Triangle meshes in world space.
+    pub meshes: Vec<Mesh>,
+    /// Materials; `Mesh::material` indexes this list.
+    pub materials: Vec<Material>,
+    /// Cameras placed by the scene's nodes, in node order, each with the index of its glTF camera.
+    pub cameras: Vec<(usize, Camera)>,
+    /// Lights the scene defines (the CLI may override or add to them).
+    pub lights: Lights,
+    /// Things the loader skipped or changed, each one line (skipped primitive modes, ignored lights...).
+    pub warnings: Vec<String>,
+}
+
+/// One triangle list in world space, all of one material.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// A name for messages: the glTF mesh name (or index) and primitive index.
+    pub name: String,
+    /// Vertex positions in world space [m].
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals in world space (a zero vector where the file's normal was zero).
+    pub normals: Vec<Vec3>,
+    /// Triangle list; counter-clockwise (seen from the front) in world space.
+    pub indices: Vec<u32>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+impl Mesh {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+/// An axis-aligned box in world space [m].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+/// A sphere enclosing the scene [m].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundingSphere {
+    pub center: DVec3,
+    pub radius: f64,
+}
+
+impl Scene {
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(Mesh::triangle_count).sum()
+    }
+
+    /// The box around every vertex that a triangle uses, or `None` for a scene without triangles.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let mut used = self
+            .meshes
+            .iter()
+            .flat_map(|m| m.indices.iter().map(move |&i| m.positions[i as usize]));
+        let first = used.next()?.as_dvec3();
+        let (min, max) = used.fold((first, first), |(lo, hi), p| {
+            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+        });
+        Some(Aabb { min, max })
+    }
+
+    /// A sphere around every used vertex: centred on the box centre, radius the farthest vertex from it.
+    pub fn bounding_sphere(&self) -> Option<BoundingSphere> {
+        let b = self.bounds()?;
+        let center = (b.min + b.max) * 0.5;
+        let radius = self
+            .meshes
+            .iter()
+            .flat_map(|m| m.indices.iter().map(move |&i| m.positions[i as usize]))
+            .map(|p| p.as_dvec3().distance(center))
+            .fold(0.0, f64::max);
+        Some(BoundingSphere { center, radius })
+    }
+}
