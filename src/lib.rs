@@ -5,6 +5,7 @@
 //! `shaders/` mirrors it) → two renderers, [`gpu`] (Vulkan) and `cpu` (the reference), both producing a
 //! [`film::Image`] of radiance in W/(m²·sr) → `compare` → the command line.
 
+pub mod authoring;
 pub mod cli;
 pub mod film;
 pub mod gpu;

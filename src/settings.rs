@@ -7,8 +7,7 @@ use glam::{DVec3, Mat4, Vec4};
 use crate::scene::camera::{near_far_around, AUTO_FOV_DEGREES};
 use crate::scene::{BoundingSphere, Camera, Lights, Projection, Scene, Sun};
 use crate::shading::radiometry::{
-    degrees_to_radians, sun_irradiance_from_radiance, DEFAULT_SUN_IRRADIANCE,
-    SUN_ANGULAR_DIAMETER_DEGREES,
+    degrees_to_radians, sun_irradiance_from_radiance, DEFAULT_SUN_IRRADIANCE, SUN_ANGULAR_DIAMETER_DEGREES,
 };
 
 /// Default image size [pixels].
@@ -102,10 +101,7 @@ fn usage(msg: impl Into<String>) -> SettingsError {
 
 /// Unit direction towards the sun from elevation and azimuth [degrees]: `(cos e sin a, sin e, cos e cos a)`.
 pub fn sun_direction_from_angles(elevation_degrees: f64, azimuth_degrees: f64) -> DVec3 {
-    let (e, a) = (
-        degrees_to_radians(elevation_degrees),
-        degrees_to_radians(azimuth_degrees),
-    );
+    let (e, a) = (degrees_to_radians(elevation_degrees), degrees_to_radians(azimuth_degrees));
     DVec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos())
 }
 
@@ -125,36 +121,15 @@ pub fn resolve(
     let mut lights = scene.lights.clone();
     let sun = resolve_sun(scene.lights.sun, scene.lights.is_empty(), sun)?;
     lights.sun = sun;
-    Ok(RenderSettings {
-        width,
-        height,
-        camera,
-        lights,
-    })
+    Ok(RenderSettings { width, height, camera, lights })
 }
 
-fn resolve_camera(
-    scene: &Scene,
-    aspect: f64,
-    opts: &CameraOptions,
-) -> Result<Camera, SettingsError> {
-    let sphere = scene.bounding_sphere().unwrap_or(BoundingSphere {
-        center: DVec3::ZERO,
-        radius: 1.0,
-    });
-    let sphere = BoundingSphere {
-        radius: if sphere.radius > 0.0 {
-            sphere.radius
-        } else {
-            1.0
-        },
-        ..sphere
-    };
+fn resolve_camera(scene: &Scene, aspect: f64, opts: &CameraOptions) -> Result<Camera, SettingsError> {
+    let sphere = scene.bounding_sphere().unwrap_or(BoundingSphere { center: DVec3::ZERO, radius: 1.0 });
+    let sphere = BoundingSphere { radius: if sphere.radius > 0.0 { sphere.radius } else { 1.0 }, ..sphere };
     if let Some(fov) = opts.fov_degrees {
         if !(fov > 0.0 && fov < 180.0) {
-            return Err(usage(format!(
-                "--fov {fov} must be between 0 and 180 degrees"
-            )));
+            return Err(usage(format!("--fov {fov} must be between 0 and 180 degrees")));
         }
     }
     let scene_camera = match opts.camera {
@@ -174,21 +149,14 @@ fn resolve_camera(
         let eye = opts.eye.unwrap_or(auto.eye);
         let target = opts.target.unwrap_or(sphere.center);
         let (znear, zfar) = near_far_around(eye, sphere);
-        let projection = Projection::Perspective {
-            yfov,
-            znear,
-            zfar: Some(zfar),
-        };
-        return Camera::look_at(eye, target, opts.up.unwrap_or(DVec3::Y), projection).ok_or_else(
-            || usage("--eye equals the target, or --up is parallel to the view direction"),
-        );
+        let projection = Projection::Perspective { yfov, znear, zfar: Some(zfar) };
+        return Camera::look_at(eye, target, opts.up.unwrap_or(DVec3::Y), projection)
+            .ok_or_else(|| usage("--eye equals the target, or --up is parallel to the view direction"));
     };
     if let Some(fov) = opts.fov_degrees {
         match &mut cam.projection {
             Projection::Perspective { yfov, .. } => *yfov = degrees_to_radians(fov),
-            Projection::Orthographic { .. } => {
-                return Err(usage("--fov applies to perspective cameras only"))
-            }
+            Projection::Orthographic { .. } => return Err(usage("--fov applies to perspective cameras only")),
         }
     }
     let eye = opts.eye.unwrap_or(cam.eye);
@@ -200,41 +168,25 @@ fn resolve_camera(
         .ok_or_else(|| usage("--eye equals the target, or --up is parallel to the view direction"))
 }
 
-fn resolve_sun(
-    scene_sun: Option<Sun>,
-    scene_unlit: bool,
-    opts: &SunOptions,
-) -> Result<Option<Sun>, SettingsError> {
+fn resolve_sun(scene_sun: Option<Sun>, scene_unlit: bool, opts: &SunOptions) -> Result<Option<Sun>, SettingsError> {
     if scene_sun.is_none() && !scene_unlit && !opts.any() {
         // The scene has its own (non-sun) lights and the flags add no sun.
         return Ok(None);
     }
-    let diameter_degrees = opts
-        .diameter_degrees
-        .unwrap_or(SUN_ANGULAR_DIAMETER_DEGREES);
+    let diameter_degrees = opts.diameter_degrees.unwrap_or(SUN_ANGULAR_DIAMETER_DEGREES);
     if !(diameter_degrees > 0.0 && diameter_degrees < 180.0) {
-        return Err(usage(format!(
-            "--sun-diameter {diameter_degrees} must be between 0 and 180 degrees"
-        )));
+        return Err(usage(format!("--sun-diameter {diameter_degrees} must be between 0 and 180 degrees")));
     }
     let diameter = degrees_to_radians(diameter_degrees);
     let direction = if let Some(d) = opts.direction {
         if opts.elevation_degrees.is_some() || opts.azimuth_degrees.is_some() {
-            return Err(usage(
-                "give either --sun-dir or --sun-elevation/--sun-azimuth, not both",
-            ));
+            return Err(usage("give either --sun-dir or --sun-elevation/--sun-azimuth, not both"));
         }
-        d.try_normalize()
-            .ok_or_else(|| usage("--sun-dir must be a non-zero finite vector"))?
+        d.try_normalize().ok_or_else(|| usage("--sun-dir must be a non-zero finite vector"))?
     } else if opts.elevation_degrees.is_some() || opts.azimuth_degrees.is_some() {
-        let (e, a) = (
-            opts.elevation_degrees.unwrap_or(45.0),
-            opts.azimuth_degrees.unwrap_or(0.0),
-        );
+        let (e, a) = (opts.elevation_degrees.unwrap_or(45.0), opts.azimuth_degrees.unwrap_or(0.0));
         if !(-90.0..=90.0).contains(&e) || !a.is_finite() {
-            return Err(usage(format!(
-                "--sun-elevation {e} must be within [-90, 90] degrees"
-            )));
+            return Err(usage(format!("--sun-elevation {e} must be within [-90, 90] degrees")));
         }
         sun_direction_from_angles(e, a)
     } else if let Some(s) = scene_sun {
@@ -247,11 +199,7 @@ fn resolve_sun(
         return Err(usage("--sun-color factors must be finite and non-negative"));
     }
     let irradiance: [f64; 3] = match (opts.irradiance, opts.radiance) {
-        (Some(_), Some(_)) => {
-            return Err(usage(
-                "give either --sun-irradiance or --sun-radiance, not both",
-            ))
-        }
+        (Some(_), Some(_)) => return Err(usage("give either --sun-irradiance or --sun-radiance, not both")),
         (Some(e), None) => color.map(|c| c * e),
         (None, Some(l)) => color.map(|c| c * sun_irradiance_from_radiance(l, diameter)),
         (None, None) => match scene_sun {
@@ -264,13 +212,8 @@ fn resolve_sun(
             None => color.map(|c| c * DEFAULT_SUN_IRRADIANCE),
         },
     };
-    if irradiance
-        .iter()
-        .any(|e| !(e.is_finite() && *e >= 0.0 && *e <= f32::MAX as f64))
-    {
-        return Err(usage(
-            "the sun's irradiance must be finite, non-negative and within f32 range",
-        ));
+    if irradiance.iter().any(|e| !(e.is_finite() && *e >= 0.0 && *e <= f32::MAX as f64)) {
+        return Err(usage("the sun's irradiance must be finite, non-negative and within f32 range"));
     }
     Ok(Some(Sun {
         direction: direction.as_vec3(),
@@ -296,74 +239,28 @@ mod tests {
     #[test]
     fn default_sun_and_overrides() {
         let scene = Scene::default();
-        let s = resolve(
-            &scene,
-            4,
-            2,
-            &CameraOptions::default(),
-            &SunOptions::default(),
-        )
-        .unwrap();
+        let s = resolve(&scene, 4, 2, &CameraOptions::default(), &SunOptions::default()).unwrap();
         let sun = s.lights.sun.unwrap();
         assert_eq!(sun.irradiance, [1000.0; 3]);
-        assert!(
-            (sun.direction.as_dvec3() - DVec3::from_array(DEFAULT_SUN_DIRECTION).normalize())
-                .length()
-                < 1e-7
-        );
-        let opts = SunOptions {
-            radiance: Some(1.0),
-            irradiance: Some(1.0),
-            ..Default::default()
-        };
+        assert!((sun.direction.as_dvec3() - DVec3::from_array(DEFAULT_SUN_DIRECTION).normalize()).length() < 1e-7);
+        let opts = SunOptions { radiance: Some(1.0), irradiance: Some(1.0), ..Default::default() };
         assert!(resolve(&scene, 4, 2, &CameraOptions::default(), &opts).is_err());
-        let opts = SunOptions {
-            direction: Some(DVec3::ZERO),
-            ..Default::default()
-        };
+        let opts = SunOptions { direction: Some(DVec3::ZERO), ..Default::default() };
         assert!(resolve(&scene, 4, 2, &CameraOptions::default(), &opts).is_err());
-        let opts = SunOptions {
-            irradiance: Some(10.0),
-            color: Some([1.0, 0.5, 0.0]),
-            ..Default::default()
-        };
-        let sun = resolve(&scene, 4, 2, &CameraOptions::default(), &opts)
-            .unwrap()
-            .lights
-            .sun
-            .unwrap();
+        let opts = SunOptions { irradiance: Some(10.0), color: Some([1.0, 0.5, 0.0]), ..Default::default() };
+        let sun = resolve(&scene, 4, 2, &CameraOptions::default(), &opts).unwrap().lights.sun.unwrap();
         assert_eq!(sun.irradiance, [10.0, 5.0, 0.0]);
     }
 
     #[test]
     fn bad_camera_options_are_usage_errors() {
         let scene = Scene::default();
-        let same = CameraOptions {
-            eye: Some(DVec3::ONE),
-            target: Some(DVec3::ONE),
-            ..Default::default()
-        };
+        let same = CameraOptions { eye: Some(DVec3::ONE), target: Some(DVec3::ONE), ..Default::default() };
         assert!(resolve(&scene, 4, 4, &same, &SunOptions::default()).is_err());
-        let fov = CameraOptions {
-            fov_degrees: Some(180.0),
-            ..Default::default()
-        };
+        let fov = CameraOptions { fov_degrees: Some(180.0), ..Default::default() };
         assert!(resolve(&scene, 4, 4, &fov, &SunOptions::default()).is_err());
-        let missing = CameraOptions {
-            camera: Some(3),
-            ..Default::default()
-        };
-        assert!(resolve(&scene, 4, 4, &missing, &SunOptions::default())
-            .unwrap_err()
-            .0
-            .contains("camera 3"));
-        assert!(resolve(
-            &scene,
-            0,
-            4,
-            &CameraOptions::default(),
-            &SunOptions::default()
-        )
-        .is_err());
+        let missing = CameraOptions { camera: Some(3), ..Default::default() };
+        assert!(resolve(&scene, 4, 4, &missing, &SunOptions::default()).unwrap_err().0.contains("camera 3"));
+        assert!(resolve(&scene, 0, 4, &CameraOptions::default(), &SunOptions::default()).is_err());
     }
 }

@@ -12,15 +12,11 @@ use crate::settings::{CameraOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
     let parts: Vec<&str> = s.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        return Err(format!(
-            "expected three comma-separated numbers x,y,z, got '{s}'"
-        ));
+        return Err(format!("expected three comma-separated numbers x,y,z, got '{s}'"));
     }
     let mut v = [0.0; 3];
     for (slot, p) in v.iter_mut().zip(&parts) {
-        *slot = p
-            .parse::<f64>()
-            .map_err(|_| format!("'{p}' is not a number"))?;
+        *slot = p.parse::<f64>().map_err(|_| format!("'{p}' is not a number"))?;
         if !slot.is_finite() {
             return Err(format!("'{p}' is not finite"));
         }
@@ -125,13 +121,7 @@ pub struct SceneArgs {
 
 impl SceneArgs {
     pub fn camera_options(&self) -> CameraOptions {
-        CameraOptions {
-            camera: self.camera,
-            eye: self.eye,
-            target: self.target,
-            up: self.up,
-            fov_degrees: self.fov,
-        }
+        CameraOptions { camera: self.camera, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
     }
 
     pub fn sun_options(&self) -> SunOptions {
@@ -155,12 +145,7 @@ pub struct OutputArgs {
     pub output: PathBuf,
 
     /// PNG exposure: EV stops (display value = radiance × 2^EV) or 'auto'.
-    #[arg(
-        long,
-        default_value = "auto",
-        allow_hyphen_values = true,
-        value_name = "EV|auto"
-    )]
+    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_name = "EV|auto")]
     pub exposure: Exposure,
 }
 
@@ -170,14 +155,8 @@ mod tests {
 
     #[test]
     fn vectors_parse_strictly() {
-        assert_eq!(
-            parse_vec3("0.3,1,-0.5").unwrap(),
-            DVec3::new(0.3, 1.0, -0.5)
-        );
-        assert_eq!(
-            parse_vec3(" 1 , 2 , 3 ").unwrap(),
-            DVec3::new(1.0, 2.0, 3.0)
-        );
+        assert_eq!(parse_vec3("0.3,1,-0.5").unwrap(), DVec3::new(0.3, 1.0, -0.5));
+        assert_eq!(parse_vec3(" 1 , 2 , 3 ").unwrap(), DVec3::new(1.0, 2.0, 3.0));
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,2,3,4").is_err());
         assert!(parse_vec3("1,x,3").is_err());

@@ -13,18 +13,11 @@ pub struct InfoArgs {
 }
 
 pub fn run(a: &InfoArgs) -> Result<(), CliError> {
-    let options = ContextOptions {
-        device: a.device.clone(),
-        ..ContextOptions::from_env()
-    };
+    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
     let (devices, chosen) = list_devices(&options)?;
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     for d in &devices {
-        let mark = if chosen.as_ref().is_ok_and(|c| *c == d.index) {
-            "*"
-        } else {
-            " "
-        };
+        let mark = if chosen.as_ref().is_ok_and(|c| *c == d.index) { "*" } else { " " };
         println!(
             "{mark} {}: {} [{}], Vulkan {}.{}.{}",
             d.index,

@@ -29,7 +29,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a glTF scene on the GPU (Vulkan) to an image of radiance.
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
 }
@@ -49,7 +49,18 @@ impl<E: Into<anyhow::Error>> From<E> for CliError {
 
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("sunshade: error: {} (see --help)", clap_error_line(&e));
+            return ExitCode::from(2);
+        }
+    };
     let result = match cli.command {
         Command::Render(a) => render::run(&a),
         Command::Info(a) => info::run(&a),
@@ -67,6 +78,22 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// clap's usage error on one line: its text without the "Usage:" block and the "--help" hint.
+fn clap_error_line(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let mut parts = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line.strip_prefix("error: ").unwrap_or(line));
+        }
+    }
+    parts.join(" ")
+}
+
 /// The error and its causes on one line.
 fn one_line(e: &anyhow::Error) -> String {
     format!("{e:#}").replace('\n', "; ")
@@ -75,24 +102,13 @@ fn one_line(e: &anyhow::Error) -> String {
 /// Loads the scene and resolves the render settings; prints the loader's warnings.
 fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
     let t = Instant::now();
-    let scene = scene::load_with_options(
-        &a.scene,
-        &LoadOptions {
-            scene: a.scene_index,
-        },
-    )?;
+    let scene = scene::load_with_options(&a.scene, &LoadOptions { scene: a.scene_index })?;
     let load_time = t.elapsed();
     for w in &scene.warnings {
         eprintln!("sunshade: warning: {}: {w}", a.scene.display());
     }
-    let settings = settings::resolve(
-        &scene,
-        a.width,
-        a.height,
-        &a.camera_options(),
-        &a.sun_options(),
-    )
-    .map_err(|e| CliError::Usage(e.to_string()))?;
+    let settings = settings::resolve(&scene, a.width, a.height, &a.camera_options(), &a.sun_options())
+        .map_err(|e| CliError::Usage(e.to_string()))?;
     Ok((scene, settings, load_time))
 }
 

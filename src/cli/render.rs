@@ -26,10 +26,7 @@ pub struct RenderArgs {
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     check_output_path(&a.output.output)?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
-    let options = ContextOptions {
-        device: a.device.clone(),
-        ..ContextOptions::from_env()
-    };
+    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
     let mut renderer = Renderer::new(&options)?;
     renderer.check_size(settings.width, settings.height)?;
     let t_upload = Instant::now();

@@ -30,9 +30,8 @@ where
 
 /// `dir/.name.sunshade-tmp-PID`: same directory (so the rename cannot cross file systems), hidden, unique per process.
 fn temporary_path(path: &Path) -> io::Result<PathBuf> {
-    let name = path.file_name().ok_or_else(|| {
-        io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name")
-    })?;
+    let name =
+        path.file_name().ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no file name"))?;
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(name);
     tmp_name.push(format!(".sunshade-tmp-{}", std::process::id()));
@@ -54,11 +53,7 @@ mod tests {
         });
         assert!(err.is_err());
         assert!(!target.exists());
-        assert_eq!(
-            fs::read_dir(&dir).unwrap().count(),
-            0,
-            "temporary file left behind"
-        );
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 0, "temporary file left behind");
 
         write_atomically(&target, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"whole");

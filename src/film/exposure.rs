@@ -33,9 +33,7 @@ impl std::str::FromStr for Exposure {
         }
         match s.parse::<f64>() {
             Ok(ev) if ev.is_finite() => Ok(Exposure::Ev(ev)),
-            _ => Err(format!(
-                "exposure must be a number of stops or 'auto', got '{s}'"
-            )),
+            _ => Err(format!("exposure must be a number of stops or 'auto', got '{s}'")),
         }
     }
 }
@@ -61,16 +59,8 @@ pub fn auto_exposure_ev(image: &Image) -> f64 {
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1], to an 8-bit code.
 pub fn srgb_encode(linear: f64) -> u8 {
     // NaN fails both comparisons of clamp's argument check only if we let it through: map it to 0 explicitly.
-    let v = if linear.is_nan() {
-        0.0
-    } else {
-        linear.clamp(0.0, 1.0)
-    };
-    let encoded = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
+    let v = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) };
+    let encoded = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
     (encoded * 255.0).round() as u8
 }
 

@@ -47,30 +47,20 @@ pub enum ImageIoError {
 
 impl ImageIoError {
     fn invalid(path: &Path, message: impl Into<String>) -> Self {
-        Self::Invalid {
-            path: path.to_path_buf(),
-            message: message.into(),
-        }
+        Self::Invalid { path: path.to_path_buf(), message: message.into() }
     }
 }
 
 /// Writes `image` to `path` in the format its extension names. `exposure` applies to PNG only.
 pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(), ImageIoError> {
     let format =
-        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension {
-            path: path.to_path_buf(),
-        })?;
-    let io_err = |source| ImageIoError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_path_buf() })?;
+    let io_err = |source| ImageIoError::Io { path: path.to_path_buf(), source };
     match format {
         ImageFormat::Exr => {
             let data: Vec<f32> = image.pixels().iter().flatten().copied().collect();
             let buf = ::image::Rgba32FImage::from_raw(image.width(), image.height(), data)
-                .ok_or_else(|| {
-                    ImageIoError::invalid(path, "pixel buffer does not match the image size")
-                })?;
+                .ok_or_else(|| ImageIoError::invalid(path, "pixel buffer does not match the image size"))?;
             write_atomically(path, |w| {
                 ::image::DynamicImage::ImageRgba32F(buf)
                     .write_to(w, ::image::ImageFormat::OpenExr)
@@ -89,13 +79,9 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(),
                 data.push((p[3].clamp(0.0, 1.0) * 255.0).round() as u8);
             }
             let buf = ::image::RgbaImage::from_raw(image.width(), image.height(), data)
-                .ok_or_else(|| {
-                    ImageIoError::invalid(path, "pixel buffer does not match the image size")
-                })?;
+                .ok_or_else(|| ImageIoError::invalid(path, "pixel buffer does not match the image size"))?;
             write_atomically(path, |w| {
-                ::image::DynamicImage::ImageRgba8(buf)
-                    .write_to(w, ::image::ImageFormat::Png)
-                    .map_err(io::Error::other)
+                ::image::DynamicImage::ImageRgba8(buf).write_to(w, ::image::ImageFormat::Png).map_err(io::Error::other)
             })
             .map_err(io_err)
         }
@@ -105,24 +91,14 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(),
 /// Reads an image in the format its extension names.
 pub fn read_image(path: &Path) -> Result<Image, ImageIoError> {
     let format =
-        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension {
-            path: path.to_path_buf(),
-        })?;
-    let io_err = |source| ImageIoError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
+        ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_path_buf() })?;
+    let io_err = |source| ImageIoError::Io { path: path.to_path_buf(), source };
     match format {
         ImageFormat::Pfm => {
             let file = std::fs::File::open(path).map_err(io_err)?;
             read_pfm(&mut io::BufReader::new(file)).map_err(|e| match e.kind() {
-                io::ErrorKind::InvalidData | io::ErrorKind::UnexpectedEof => {
-                    ImageIoError::invalid(path, e.to_string())
-                }
-                _ => ImageIoError::Io {
-                    path: path.to_path_buf(),
-                    source: e,
-                },
+                io::ErrorKind::InvalidData | io::ErrorKind::UnexpectedEof => ImageIoError::invalid(path, e.to_string()),
+                _ => ImageIoError::Io { path: path.to_path_buf(), source: e },
             })
         }
         ImageFormat::Exr | ImageFormat::Png => {
@@ -134,16 +110,11 @@ pub fn read_image(path: &Path) -> Result<Image, ImageIoError> {
                 .map_err(|e| ImageIoError::invalid(path, e.to_string()))?;
             let (w, h) = (decoded.width(), decoded.height());
             let pixels: Vec<[f32; 4]> = if format == ImageFormat::Png {
-                decoded
-                    .into_rgba8()
-                    .pixels()
-                    .map(|p| p.0.map(|c| c as f32 / 255.0))
-                    .collect()
+                decoded.into_rgba8().pixels().map(|p| p.0.map(|c| c as f32 / 255.0)).collect()
             } else {
                 decoded.into_rgba32f().pixels().map(|p| p.0).collect()
             };
-            Image::from_pixels(w, h, pixels)
-                .ok_or_else(|| ImageIoError::invalid(path, "decoded size mismatch"))
+            Image::from_pixels(w, h, pixels).ok_or_else(|| ImageIoError::invalid(path, "decoded size mismatch"))
         }
     }
 }
@@ -185,20 +156,13 @@ fn read_pfm(r: &mut impl BufRead) -> io::Result<Image> {
         .and_then(|n| n.checked_mul(channels * 4))
         .ok_or_else(|| bad("PFM size overflows"))?;
     let mut data = vec![0u8; count];
-    r.read_exact(&mut data)
-        .map_err(|_| bad("PFM file is shorter than its header says"))?;
+    r.read_exact(&mut data).map_err(|_| bad("PFM file is shorter than its header says"))?;
     let mut pixels = vec![[0.0f32; 4]; width as usize * height as usize];
     for (i, chunk) in data.chunks_exact(channels * 4).enumerate() {
         let mut px = [0.0f32, 0.0, 0.0, 1.0];
         for c in 0..channels {
-            let b: [u8; 4] = chunk[c * 4..c * 4 + 4]
-                .try_into()
-                .expect("chunk of 4 bytes");
-            px[c] = if little_endian {
-                f32::from_le_bytes(b)
-            } else {
-                f32::from_be_bytes(b)
-            };
+            let b: [u8; 4] = chunk[c * 4..c * 4 + 4].try_into().expect("chunk of 4 bytes");
+            px[c] = if little_endian { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) };
         }
         if channels == 1 {
             px[1] = px[0];
@@ -216,10 +180,7 @@ fn read_token(r: &mut impl BufRead) -> io::Result<String> {
     let mut byte = [0u8; 1];
     loop {
         if r.read(&mut byte)? == 0 {
-            return Err(io::Error::new(
-                io::ErrorKind::UnexpectedEof,
-                "PFM header ends early",
-            ));
+            return Err(io::Error::new(io::ErrorKind::UnexpectedEof, "PFM header ends early"));
         }
         if byte[0].is_ascii_whitespace() {
             if token.is_empty() {
@@ -229,14 +190,10 @@ fn read_token(r: &mut impl BufRead) -> io::Result<String> {
         }
         token.push(byte[0]);
         if token.len() > 32 {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                "PFM header token too long",
-            ));
+            return Err(io::Error::new(io::ErrorKind::InvalidData, "PFM header token too long"));
         }
     }
-    String::from_utf8(token)
-        .map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "PFM header is not ASCII"))
+    String::from_utf8(token).map_err(|_| io::Error::new(io::ErrorKind::InvalidData, "PFM header is not ASCII"))
 }
 
 #[cfg(test)]
@@ -259,13 +216,7 @@ mod tests {
         let path = tmp("a.exr");
         write_image(&sample(), &path, Exposure::Ev(0.0)).unwrap();
         let back = read_image(&path).unwrap();
-        let bits = |i: &Image| {
-            i.pixels()
-                .iter()
-                .flatten()
-                .map(|v| v.to_bits())
-                .collect::<Vec<_>>()
-        };
+        let bits = |i: &Image| i.pixels().iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&back), bits(&sample()));
         std::fs::remove_file(path).unwrap();
     }
@@ -299,18 +250,13 @@ mod tests {
         let path = tmp("short.pfm");
         std::fs::write(&path, b"PF\n4 4\n-1.0\n\0\0\0\0").unwrap();
         let err = read_image(&path).unwrap_err().to_string();
-        assert!(
-            err.contains("short.pfm") && err.contains("shorter"),
-            "{err}"
-        );
+        assert!(err.contains("short.pfm") && err.contains("shorter"), "{err}");
         std::fs::remove_file(path).unwrap();
     }
 
     #[test]
     fn unknown_extension_is_refused() {
-        let err = write_image(&sample(), Path::new("x.tiff"), Exposure::Auto)
-            .unwrap_err()
-            .to_string();
+        let err = write_image(&sample(), Path::new("x.tiff"), Exposure::Auto).unwrap_err().to_string();
         assert!(err.contains("x.tiff"), "{err}");
     }
 }

@@ -22,20 +22,12 @@ pub struct Image {
 impl Image {
     /// A `width × height` image with every pixel uncovered (radiance 0, alpha 0).
     pub fn new(width: u32, height: u32) -> Self {
-        Self {
-            width,
-            height,
-            pixels: vec![[0.0; 4]; width as usize * height as usize],
-        }
+        Self { width, height, pixels: vec![[0.0; 4]; width as usize * height as usize] }
     }
 
     /// Wraps pixels given row-major, top row first. Returns `None` when the count does not match the size.
     pub fn from_pixels(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> Option<Self> {
-        (pixels.len() == width as usize * height as usize).then_some(Self {
-            width,
-            height,
-            pixels,
-        })
+        (pixels.len() == width as usize * height as usize).then_some(Self { width, height, pixels })
     }
 
     pub fn width(&self) -> u32 {
@@ -76,12 +68,7 @@ impl Image {
     }
 
     fn index(&self, x: u32, y: u32) -> usize {
-        assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) outside a {}x{} image",
-            self.width,
-            self.height
-        );
+        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside a {}x{} image", self.width, self.height);
         y as usize * self.width as usize + x as usize
     }
 }

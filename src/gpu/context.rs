@@ -27,10 +27,7 @@ pub struct ContextOptions {
 impl ContextOptions {
     /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`.
     pub fn from_env() -> Self {
-        Self {
-            validation: std::env::var("SUNSHADE_VALIDATION").is_ok_and(|v| v == "1"),
-            device: None,
-        }
+        Self { validation: std::env::var("SUNSHADE_VALIDATION").is_ok_and(|v| v == "1"), device: None }
     }
 }
 
@@ -102,10 +99,8 @@ impl Instance {
         let entry = unsafe { ash::Entry::load() }.map_err(|e| GpuError::NoLoader(e.to_string()))?;
         // SAFETY: plain queries and object creation with valid create infos.
         unsafe {
-            let version = entry
-                .try_enumerate_instance_version()
-                .vk("vkEnumerateInstanceVersion")?
-                .unwrap_or(vk::API_VERSION_1_0);
+            let version =
+                entry.try_enumerate_instance_version().vk("vkEnumerateInstanceVersion")?.unwrap_or(vk::API_VERSION_1_0);
             if version < vk::API_VERSION_1_3 {
                 return Err(GpuError::NoDevice(format!(
                     "the Vulkan loader supports Vulkan {}.{} only",
@@ -116,13 +111,8 @@ impl Instance {
             let mut layers = Vec::new();
             let mut extensions = Vec::new();
             if validation {
-                let available = entry
-                    .enumerate_instance_layer_properties()
-                    .vk("vkEnumerateInstanceLayerProperties")?;
-                if !available
-                    .iter()
-                    .any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER))
-                {
+                let available = entry.enumerate_instance_layer_properties().vk("vkEnumerateInstanceLayerProperties")?;
+                if !available.iter().any(|l| l.layer_name_as_c_str() == Ok(VALIDATION_LAYER)) {
                     return Err(GpuError::NoValidationLayer);
                 }
                 layers.push(VALIDATION_LAYER.as_ptr());
@@ -137,8 +127,7 @@ impl Instance {
             let log = Arc::new(ValidationLog::default());
             let mut debug_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
                 .message_severity(
-                    vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
-                        | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+                    vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
                 )
                 .message_type(
                     vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
@@ -155,43 +144,28 @@ impl Instance {
                 // Also catches messages from vkCreateInstance and vkDestroyInstance themselves.
                 create_info = create_info.push_next(&mut debug_info);
             }
-            let instance = entry
-                .create_instance(&create_info, None)
-                .vk("vkCreateInstance")?;
+            let instance = entry.create_instance(&create_info, None).vk("vkCreateInstance")?;
             let debug = if validation {
                 let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
                 match loader.create_debug_utils_messenger(&debug_info, None) {
                     Ok(m) => Some((loader, m)),
                     Err(result) => {
                         instance.destroy_instance(None);
-                        return Err(GpuError::Vulkan {
-                            what: "vkCreateDebugUtilsMessengerEXT",
-                            result,
-                        });
+                        return Err(GpuError::Vulkan { what: "vkCreateDebugUtilsMessengerEXT", result });
                     }
                 }
             } else {
                 None
             };
-            Ok(Arc::new(Self {
-                _entry: entry,
-                instance,
-                debug,
-                log,
-            }))
+            Ok(Arc::new(Self { _entry: entry, instance, debug, log }))
         }
     }
 
     /// Every physical device, described.
     pub fn devices(&self) -> Result<Vec<(vk::PhysicalDevice, DeviceInfo)>, GpuError> {
         // SAFETY: valid instance.
-        let physicals = unsafe { self.instance.enumerate_physical_devices() }
-            .vk("vkEnumeratePhysicalDevices")?;
-        Ok(physicals
-            .into_iter()
-            .enumerate()
-            .map(|(i, p)| (p, device_info::describe(&self.instance, p, i)))
-            .collect())
+        let physicals = unsafe { self.instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+        Ok(physicals.into_iter().enumerate().map(|(i, p)| (p, device_info::describe(&self.instance, p, i))).collect())
     }
 }
 
@@ -207,10 +181,7 @@ unsafe extern "system" fn debug_callback(
         if data.is_null() || user_data.is_null() {
             return vk::FALSE;
         }
-        let message = (*data)
-            .message_as_c_str()
-            .map(|m| m.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let message = (*data).message_as_c_str().map(|m| m.to_string_lossy().into_owned()).unwrap_or_default();
         let log = &*(user_data as *const ValidationLog);
         log.push(format!("[{severity:?} {kind:?}] {message}"));
     }
@@ -224,25 +195,17 @@ impl Device {
         let instance = Instance::new(options.validation)?;
         let devices = instance.devices()?;
         let (physical, info) = device_info::choose(&devices, options.device.as_deref())?;
-        let queue_family = info
-            .graphics_queue_family
-            .expect("chosen devices have a graphics queue");
+        let queue_family = info.graphics_queue_family.expect("chosen devices have a graphics queue");
         // SAFETY: valid physical device; the create info only enables features the device reported.
         unsafe {
             let priorities = [1.0f32];
-            let queue_info = [vk::DeviceQueueCreateInfo::default()
-                .queue_family_index(queue_family)
-                .queue_priorities(&priorities)];
-            let mut features13 = vk::PhysicalDeviceVulkan13Features::default()
-                .dynamic_rendering(true)
-                .synchronization2(true);
-            let create_info = vk::DeviceCreateInfo::default()
-                .queue_create_infos(&queue_info)
-                .push_next(&mut features13);
-            let device = instance
-                .instance
-                .create_device(physical, &create_info, None)
-                .vk("vkCreateDevice")?;
+            let queue_info =
+                [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+            let mut features13 =
+                vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+            let create_info =
+                vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).push_next(&mut features13);
+            let device = instance.instance.create_device(physical, &create_info, None).vk("vkCreateDevice")?;
             let queue = device.get_device_queue(queue_family, 0);
             let allocator = Allocator::new(&AllocatorCreateDesc {
                 instance: instance.instance.clone(),
@@ -256,10 +219,7 @@ impl Device {
                 Ok(a) => a,
                 Err(e) => {
                     device.destroy_device(None);
-                    return Err(GpuError::Allocation {
-                        what: "the allocator".into(),
-                        message: e.to_string(),
-                    });
+                    return Err(GpuError::Allocation { what: "the allocator".into(), message: e.to_string() });
                 }
             };
             Ok(Arc::new(Self {
@@ -279,13 +239,10 @@ impl Device {
 }
 
 /// Lists the devices Vulkan reports, for `sunshade info`, without creating a logical device.
-pub fn list_devices(
-    options: &ContextOptions,
-) -> Result<(Vec<DeviceInfo>, Result<usize, String>), GpuError> {
+pub fn list_devices(options: &ContextOptions) -> Result<(Vec<DeviceInfo>, Result<usize, String>), GpuError> {
     let instance = Instance::new(options.validation)?;
     let devices = instance.devices()?;
-    let chosen = device_info::choose(&devices, options.device.as_deref())
-        .map(|(_, i)| i.index)
-        .map_err(|e| e.to_string());
+    let chosen =
+        device_info::choose(&devices, options.device.as_deref()).map(|(_, i)| i.index).map_err(|e| e.to_string());
     Ok((devices.into_iter().map(|(_, i)| i).collect(), chosen))
 }

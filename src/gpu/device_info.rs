@@ -55,18 +55,12 @@ impl DeviceInfo {
     }
 }
 
-pub(crate) fn describe(
-    instance: &ash::Instance,
-    physical: vk::PhysicalDevice,
-    index: usize,
-) -> DeviceInfo {
+pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, index: usize) -> DeviceInfo {
     // SAFETY: valid instance and physical device; the chained structs outlive the call.
     unsafe {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut maint3 = vk::PhysicalDeviceMaintenance3Properties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default()
-            .push_next(&mut driver)
-            .push_next(&mut maint3);
+        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut maint3);
         instance.get_physical_device_properties2(physical, &mut props2);
         let props = props2.properties;
         let limits = props.limits;
@@ -79,28 +73,18 @@ pub(crate) fn describe(
             .max()
             .unwrap_or(0);
         let families = instance.get_physical_device_queue_family_properties(physical);
-        let graphics_queue_family = families
-            .iter()
-            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS))
-            .map(|i| i as u32);
+        let graphics_queue_family =
+            families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)).map(|i| i as u32);
         let v = props.api_version;
-        let api_version = (
-            vk::api_version_major(v),
-            vk::api_version_minor(v),
-            vk::api_version_patch(v),
-        );
+        let api_version = (vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v));
         let mut features13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut features13);
         let mut unusable = None;
         if v < vk::API_VERSION_1_3 {
-            unusable = Some(format!(
-                "supports Vulkan {}.{} only (1.3 needed)",
-                api_version.0, api_version.1
-            ));
+            unusable = Some(format!("supports Vulkan {}.{} only (1.3 needed)", api_version.0, api_version.1));
         } else {
             instance.get_physical_device_features2(physical, &mut features2);
-            if features13.dynamic_rendering == vk::FALSE || features13.synchronization2 == vk::FALSE
-            {
+            if features13.dynamic_rendering == vk::FALSE || features13.synchronization2 == vk::FALSE {
                 unusable = Some("lacks dynamicRendering or synchronization2".into());
             }
         }
@@ -108,8 +92,7 @@ pub(crate) fn describe(
             unusable = Some("has no graphics queue".into());
         }
         let text = |s: Result<&std::ffi::CStr, _>| {
-            s.map(|c: &std::ffi::CStr| c.to_string_lossy().into_owned())
-                .unwrap_or_default()
+            s.map(|c: &std::ffi::CStr| c.to_string_lossy().into_owned()).unwrap_or_default()
         };
         DeviceInfo {
             index,
@@ -138,17 +121,9 @@ pub(crate) fn choose<'a>(
     devices: &'a [(vk::PhysicalDevice, DeviceInfo)],
     selector: Option<&str>,
 ) -> Result<(vk::PhysicalDevice, DeviceInfo), GpuError> {
-    let list = || {
-        devices
-            .iter()
-            .map(|(_, d)| format!("{}: {}", d.index, d.name))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
+    let list = || devices.iter().map(|(_, d)| format!("{}: {}", d.index, d.name)).collect::<Vec<_>>().join(", ");
     if devices.is_empty() {
-        return Err(GpuError::NoDevice(
-            "Vulkan reports no physical device".into(),
-        ));
+        return Err(GpuError::NoDevice("Vulkan reports no physical device".into()));
     }
     let pick = |d: &'a (vk::PhysicalDevice, DeviceInfo)| -> Result<(vk::PhysicalDevice, DeviceInfo), GpuError> {
         match &d.1.unusable {
@@ -160,41 +135,25 @@ pub(crate) fn choose<'a>(
         Some(s) => {
             if let Ok(i) = s.trim().parse::<usize>() {
                 let d = devices.get(i).ok_or_else(|| {
-                    GpuError::DeviceNotFound(format!(
-                        "{s}: no device with that index (devices: {})",
-                        list()
-                    ))
+                    GpuError::DeviceNotFound(format!("{s}: no device with that index (devices: {})", list()))
                 })?;
                 return pick(d);
             }
             let needle = s.to_lowercase();
-            let d = devices
-                .iter()
-                .find(|(_, d)| d.name.to_lowercase().contains(&needle))
-                .ok_or_else(|| {
-                    GpuError::DeviceNotFound(format!(
-                        "'{s}': no device name contains it (devices: {})",
-                        list()
-                    ))
-                })?;
+            let d = devices.iter().find(|(_, d)| d.name.to_lowercase().contains(&needle)).ok_or_else(|| {
+                GpuError::DeviceNotFound(format!("'{s}': no device name contains it (devices: {})", list()))
+            })?;
             pick(d)
         }
         None => {
-            let best = devices
-                .iter()
-                .filter(|(_, d)| d.unusable.is_none())
-                .min_by_key(|(_, d)| d.rank());
+            let best = devices.iter().filter(|(_, d)| d.unusable.is_none()).min_by_key(|(_, d)| d.rank());
             match best {
                 Some(d) => pick(d),
                 None => Err(GpuError::NoDevice(format!(
                     "none of the devices is usable ({})",
                     devices
                         .iter()
-                        .map(|(_, d)| format!(
-                            "{}: {}",
-                            d.name,
-                            d.unusable.as_deref().unwrap_or("?")
-                        ))
+                        .map(|(_, d)| format!("{}: {}", d.name, d.unusable.as_deref().unwrap_or("?")))
                         .collect::<Vec<_>>()
                         .join("; ")
                 ))),

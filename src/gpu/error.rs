@@ -9,17 +9,18 @@ pub const VULKAN_PACKAGES: &str = "libvulkan1 mesa-vulkan-drivers";
 pub enum GpuError {
     #[error("cannot load the Vulkan loader (libvulkan.so.1): {0}; install the packages {VULKAN_PACKAGES} (or run `make setup`)")]
     NoLoader(String),
-    #[error("no usable Vulkan 1.3 device: {0}; install the packages {VULKAN_PACKAGES} for lavapipe (or run `make setup`)")]
+    #[error(
+        "no usable Vulkan 1.3 device: {0}; install the packages {VULKAN_PACKAGES} for lavapipe (or run `make setup`)"
+    )]
     NoDevice(String),
     #[error("--device {0}")]
     DeviceNotFound(String),
-    #[error("validation was requested but VK_LAYER_KHRONOS_validation is not installed (install vulkan-validationlayers)")]
+    #[error(
+        "validation was requested but VK_LAYER_KHRONOS_validation is not installed (install vulkan-validationlayers)"
+    )]
     NoValidationLayer,
     #[error("Vulkan call {what} failed: {result}")]
-    Vulkan {
-        what: &'static str,
-        result: vk::Result,
-    },
+    Vulkan { what: &'static str, result: vk::Result },
     #[error("GPU memory allocation for {what} failed: {message}")]
     Allocation { what: String, message: String },
     #[error("shader compilation failed: {0}")]

@@ -71,12 +71,7 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
 pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
     let sun = match &lights.sun {
         Some(s) => SunGpu {
-            direction: [
-                s.direction.x,
-                s.direction.y,
-                s.direction.z,
-                s.angular_diameter,
-            ],
+            direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
             irradiance: [s.irradiance[0], s.irradiance[1], s.irradiance[2], 1.0],
         },
         None => SunGpu::zeroed(),
@@ -85,11 +80,7 @@ pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
         Some(l) => [l[0], l[1], l[2], 1.0],
         None => [0.0; 4],
     };
-    let header = LightsHeader {
-        sun,
-        sky,
-        counts: [lights.disks.len() as u32, 0, 0, 0],
-    };
+    let header = LightsHeader { sun, sky, counts: [lights.disks.len() as u32, 0, 0, 0] };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
         let disk = DiskGpu {

@@ -27,10 +27,8 @@ impl Buffer {
     ) -> Result<Self, GpuError> {
         // SAFETY: valid device; the buffer is bound to memory allocated for its own requirements.
         unsafe {
-            let info = vk::BufferCreateInfo::default()
-                .size(size.max(4))
-                .usage(usage)
-                .sharing_mode(vk::SharingMode::EXCLUSIVE);
+            let info =
+                vk::BufferCreateInfo::default().size(size.max(4)).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
             let buffer = dev.device.create_buffer(&info, None).vk("vkCreateBuffer")?;
             let requirements = dev.device.get_buffer_memory_requirements(buffer);
             let allocation = allocate(dev, name, requirements, location, true);
@@ -41,15 +39,8 @@ impl Buffer {
                     return Err(e);
                 }
             };
-            let mut out = Self {
-                dev: dev.clone(),
-                buffer,
-                allocation: None,
-                size,
-            };
-            let bind =
-                dev.device
-                    .bind_buffer_memory(buffer, allocation.memory(), allocation.offset());
+            let mut out = Self { dev: dev.clone(), buffer, allocation: None, size };
+            let bind = dev.device.bind_buffer_memory(buffer, allocation.memory(), allocation.offset());
             out.allocation = Some(allocation);
             bind.vk("vkBindBufferMemory")?;
             Ok(out)
@@ -63,13 +54,7 @@ impl Buffer {
         usage: vk::BufferUsageFlags,
         name: &str,
     ) -> Result<Self, GpuError> {
-        let mut b = Self::new(
-            dev,
-            bytes.len() as u64,
-            usage,
-            MemoryLocation::CpuToGpu,
-            name,
-        )?;
+        let mut b = Self::new(dev, bytes.len() as u64, usage, MemoryLocation::CpuToGpu, name)?;
         b.mapped_mut()[..bytes.len()].copy_from_slice(bytes);
         Ok(b)
     }
@@ -126,11 +111,7 @@ impl Image2d {
             let info = vk::ImageCreateInfo::default()
                 .image_type(vk::ImageType::TYPE_2D)
                 .format(format)
-                .extent(vk::Extent3D {
-                    width,
-                    height,
-                    depth: 1,
-                })
+                .extent(vk::Extent3D { width, height, depth: 1 })
                 .mip_levels(1)
                 .array_layers(1)
                 .samples(vk::SampleCountFlags::TYPE_1)
@@ -140,25 +121,16 @@ impl Image2d {
                 .initial_layout(vk::ImageLayout::UNDEFINED);
             let image = dev.device.create_image(&info, None).vk("vkCreateImage")?;
             let requirements = dev.device.get_image_memory_requirements(image);
-            let allocation = match allocate(dev, name, requirements, MemoryLocation::GpuOnly, false)
-            {
+            let allocation = match allocate(dev, name, requirements, MemoryLocation::GpuOnly, false) {
                 Ok(a) => a,
                 Err(e) => {
                     dev.device.destroy_image(image, None);
                     return Err(e);
                 }
             };
-            let mut out = Self {
-                dev: dev.clone(),
-                image,
-                view: vk::ImageView::null(),
-                allocation: None,
-                width,
-                height,
-            };
-            let bind =
-                dev.device
-                    .bind_image_memory(image, allocation.memory(), allocation.offset());
+            let mut out =
+                Self { dev: dev.clone(), image, view: vk::ImageView::null(), allocation: None, width, height };
+            let bind = dev.device.bind_image_memory(image, allocation.memory(), allocation.offset());
             out.allocation = Some(allocation);
             bind.vk("vkBindImageMemory")?;
             let view_info = vk::ImageViewCreateInfo::default()
@@ -166,10 +138,7 @@ impl Image2d {
                 .view_type(vk::ImageViewType::TYPE_2D)
                 .format(format)
                 .subresource_range(subresource_range(aspect));
-            out.view = dev
-                .device
-                .create_image_view(&view_info, None)
-                .vk("vkCreateImageView")?;
+            out.view = dev.device.create_image_view(&view_info, None).vk("vkCreateImageView")?;
             Ok(out)
         }
     }
@@ -209,10 +178,10 @@ fn allocate(
     location: MemoryLocation,
     linear: bool,
 ) -> Result<Allocation, GpuError> {
-    let mut allocator = dev.allocator.lock().map_err(|_| GpuError::Allocation {
-        what: name.into(),
-        message: "allocator lock poisoned".into(),
-    })?;
+    let mut allocator = dev
+        .allocator
+        .lock()
+        .map_err(|_| GpuError::Allocation { what: name.into(), message: "allocator lock poisoned".into() })?;
     allocator
         .allocate(&AllocationCreateDesc {
             name,
@@ -221,8 +190,5 @@ fn allocate(
             linear,
             allocation_scheme: AllocationScheme::GpuAllocatorManaged,
         })
-        .map_err(|e| GpuError::Allocation {
-            what: name.into(),
-            message: e.to_string(),
-        })
+        .map_err(|e| GpuError::Allocation { what: name.into(), message: e.to_string() })
 }

@@ -26,11 +26,7 @@ pub(crate) struct ScenePipeline {
 }
 
 impl ScenePipeline {
-    pub fn new(
-        dev: &Arc<Device>,
-        vertex_spirv: &[u32],
-        fragment_spirv: &[u32],
-    ) -> Result<Self, GpuError> {
+    pub fn new(dev: &Arc<Device>, vertex_spirv: &[u32], fragment_spirv: &[u32]) -> Result<Self, GpuError> {
         let d = &dev.device;
         let mut out = Self {
             dev: dev.clone(),
@@ -50,10 +46,7 @@ impl ScenePipeline {
                     .stage_flags(vk::ShaderStageFlags::FRAGMENT)
             });
             out.set_layout = d
-                .create_descriptor_set_layout(
-                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                    None,
-                )
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
                 .vk("vkCreateDescriptorSetLayout")?;
             let ranges = [vk::PushConstantRange::default()
                 .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
@@ -62,21 +55,14 @@ impl ScenePipeline {
             let set_layouts = [out.set_layout];
             out.layout = d
                 .create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default()
-                        .set_layouts(&set_layouts)
-                        .push_constant_ranges(&ranges),
+                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges),
                     None,
                 )
                 .vk("vkCreatePipelineLayout")?;
-            let pool_sizes = [vk::DescriptorPoolSize {
-                ty: vk::DescriptorType::STORAGE_BUFFER,
-                descriptor_count: 2,
-            }];
+            let pool_sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 2 }];
             out.descriptor_pool = d
                 .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default()
-                        .max_sets(1)
-                        .pool_sizes(&pool_sizes),
+                    &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&pool_sizes),
                     None,
                 )
                 .vk("vkCreateDescriptorPool")?;
@@ -102,33 +88,18 @@ unsafe fn create_pipeline(
     // SAFETY (whole function): valid device; shader modules are destroyed before returning.
     unsafe {
         let vs = d
-            .create_shader_module(
-                &vk::ShaderModuleCreateInfo::default().code(vertex_spirv),
-                None,
-            )
+            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(vertex_spirv), None)
             .vk("vkCreateShaderModule")?;
-        let fs = match d.create_shader_module(
-            &vk::ShaderModuleCreateInfo::default().code(fragment_spirv),
-            None,
-        ) {
+        let fs = match d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None) {
             Ok(m) => m,
             Err(result) => {
                 d.destroy_shader_module(vs, None);
-                return Err(GpuError::Vulkan {
-                    what: "vkCreateShaderModule",
-                    result,
-                });
+                return Err(GpuError::Vulkan { what: "vkCreateShaderModule", result });
             }
         };
         let stages = [
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vs)
-                .name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(fs)
-                .name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"),
         ];
         let vertex_bindings = [vk::VertexInputBindingDescription {
             binding: 0,
@@ -152,31 +123,24 @@ unsafe fn create_pipeline(
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
             .vertex_attribute_descriptions(&vertex_attributes);
-        let input_assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
+        let input_assembly =
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(vk::CullModeFlags::BACK)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample =
+            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(true)
             .depth_write_enable(true)
             .depth_compare_op(vk::CompareOp::LESS);
-        let blend_attachments = [vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend =
-            vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
-        let dynamic_states = [
-            vk::DynamicState::VIEWPORT,
-            vk::DynamicState::SCISSOR,
-            vk::DynamicState::CULL_MODE,
-        ];
+        let blend_attachments =
+            [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR, vk::DynamicState::CULL_MODE];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let color_formats = [COLOR_FORMAT];
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
@@ -197,12 +161,7 @@ unsafe fn create_pipeline(
         let result = d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None);
         d.destroy_shader_module(vs, None);
         d.destroy_shader_module(fs, None);
-        result
-            .map(|p| p[0])
-            .map_err(|(_, result)| GpuError::Vulkan {
-                what: "vkCreateGraphicsPipelines",
-                result,
-            })
+        result.map(|p| p[0]).map_err(|(_, result)| GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result })
     }
 }
 

@@ -75,10 +75,8 @@ impl Renderer {
         let dev = Device::new(options)?;
         let instance = t0.elapsed();
         let t1 = Instant::now();
-        let vs =
-            shaders::compile("scene.vert", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
-        let fs =
-            shaders::compile("scene.frag", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
+        let vs = shaders::compile("scene.vert", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
+        let fs = shaders::compile("scene.frag", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
         let pipeline = ScenePipeline::new(&dev, &vs, &fs)?;
         let shader_compile = t1.elapsed();
         let commands = Commands::new(&dev)?;
@@ -87,10 +85,7 @@ impl Renderer {
             lights: None,
             pipeline,
             commands,
-            setup: SetupTimings {
-                instance,
-                shader_compile,
-            },
+            setup: SetupTimings { instance, shader_compile },
             dev,
         };
         renderer.check_validation()?;
@@ -114,10 +109,7 @@ impl Renderer {
     /// allocation, or over the device-local heap.
     pub fn check_size(&self, width: u32, height: u32) -> Result<(), GpuError> {
         let info = &self.dev.info;
-        let max = info
-            .max_image_dimension_2d
-            .min(info.max_viewport_dimensions[0])
-            .min(info.max_viewport_dimensions[1]);
+        let max = info.max_image_dimension_2d.min(info.max_viewport_dimensions[0]).min(info.max_viewport_dimensions[1]);
         if width > max || height > max {
             return Err(GpuError::TooLarge(format!(
                 "a {width}x{height} image exceeds the largest image {} supports ({max} pixels per side)",
@@ -166,19 +158,12 @@ impl Renderer {
                 mesh.positions
                     .iter()
                     .zip(&mesh.normals)
-                    .map(|(p, n)| Vertex {
-                        position: p.to_array(),
-                        normal: n.to_array(),
-                    }),
+                    .map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
             );
             indices.extend_from_slice(&mesh.indices);
         }
         let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
-        let materials_bytes: &[u8] = if materials.is_empty() {
-            &[0; 64]
-        } else {
-            bytemuck::cast_slice(&materials)
-        };
+        let materials_bytes: &[u8] = if materials.is_empty() { &[0; 64] } else { bytemuck::cast_slice(&materials) };
         Ok(GpuScene {
             vertices: (!vertices.is_empty())
                 .then(|| {
@@ -221,18 +206,10 @@ impl Renderer {
     }
 
     /// Draws an uploaded scene and reads the radiance back.
-    pub fn render(
-        &mut self,
-        scene: &GpuScene,
-        settings: &RenderSettings,
-    ) -> Result<(Image, FrameTimings), GpuError> {
+    pub fn render(&mut self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Image, FrameTimings), GpuError> {
         let (width, height) = (settings.width, settings.height);
         self.check_size(width, height)?;
-        if self
-            .target
-            .as_ref()
-            .is_none_or(|t| t.color.width != width || t.color.height != height)
-        {
+        if self.target.as_ref().is_none_or(|t| t.color.width != width || t.color.height != height) {
             self.target = None;
             self.target = Some(Target {
                 color: Image2d::new(
@@ -277,16 +254,8 @@ impl Renderer {
         // for), so the descriptor set may be updated and the command buffer re-recorded.
         unsafe {
             let infos = [
-                [vk::DescriptorBufferInfo {
-                    buffer: scene.materials.buffer,
-                    offset: 0,
-                    range: vk::WHOLE_SIZE,
-                }],
-                [vk::DescriptorBufferInfo {
-                    buffer: lights.buffer,
-                    offset: 0,
-                    range: vk::WHOLE_SIZE,
-                }],
+                [vk::DescriptorBufferInfo { buffer: scene.materials.buffer, offset: 0, range: vk::WHOLE_SIZE }],
+                [vk::DescriptorBufferInfo { buffer: lights.buffer, offset: 0, range: vk::WHOLE_SIZE }],
             ];
             let writes = [0usize, 1].map(|b| {
                 vk::WriteDescriptorSet::default()
@@ -302,27 +271,17 @@ impl Renderer {
                 image_barrier(
                     target.color.image,
                     vk::ImageAspectFlags::COLOR,
-                    (
-                        vk::PipelineStageFlags2::ALL_COMMANDS,
-                        vk::AccessFlags2::MEMORY_WRITE,
-                    ),
-                    (
-                        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                    ),
+                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
+                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
                     vk::ImageLayout::UNDEFINED,
                     vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                 ),
                 image_barrier(
                     target.depth.image,
                     vk::ImageAspectFlags::DEPTH,
+                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
                     (
-                        vk::PipelineStageFlags2::ALL_COMMANDS,
-                        vk::AccessFlags2::MEMORY_WRITE,
-                    ),
-                    (
-                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-                            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
                         vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
                             | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
                     ),
@@ -330,33 +289,20 @@ impl Renderer {
                     vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
                 ),
             ];
-            d.cmd_pipeline_barrier2(
-                cb,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_attachment),
-            );
-            let area = vk::Rect2D {
-                offset: vk::Offset2D { x: 0, y: 0 },
-                extent: vk::Extent2D { width, height },
-            };
+            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+            let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width, height } };
             let color_attachments = [vk::RenderingAttachmentInfo::default()
                 .image_view(target.color.view)
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue { float32: [0.0; 4] },
-                })];
+                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
             let depth_attachment = vk::RenderingAttachmentInfo::default()
                 .image_view(target.depth.view)
                 .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: 1.0,
-                        stencil: 0,
-                    },
-                });
+                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
             d.cmd_begin_rendering(
                 cb,
                 &vk::RenderingInfo::default()
@@ -398,20 +344,9 @@ impl Renderer {
                     );
                     d.cmd_set_cull_mode(
                         cb,
-                        if draw.double_sided {
-                            vk::CullModeFlags::NONE
-                        } else {
-                            vk::CullModeFlags::BACK
-                        },
+                        if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK },
                     );
-                    d.cmd_draw_indexed(
-                        cb,
-                        draw.index_count,
-                        1,
-                        draw.first_index,
-                        draw.vertex_offset,
-                        0,
-                    );
+                    d.cmd_draw_indexed(cb, draw.index_count, 1, draw.first_index, draw.vertex_offset, 0);
                 }
             }
             d.cmd_end_rendering(cb);
@@ -426,21 +361,12 @@ impl Renderer {
             let to_transfer = [image_barrier(
                 target.color.image,
                 vk::ImageAspectFlags::COLOR,
-                (
-                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ),
                 vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             )];
-            d.cmd_pipeline_barrier2(
-                cb,
-                &vk::DependencyInfo::default().image_memory_barriers(&to_transfer),
-            );
+            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_transfer));
             let region = vk::BufferImageCopy {
                 buffer_offset: 0,
                 buffer_row_length: 0,
@@ -452,11 +378,7 @@ impl Renderer {
                     layer_count: 1,
                 },
                 image_offset: vk::Offset3D { x: 0, y: 0, z: 0 },
-                image_extent: vk::Extent3D {
-                    width,
-                    height,
-                    depth: 1,
-                },
+                image_extent: vk::Extent3D { width, height, depth: 1 },
             };
             d.cmd_copy_image_to_buffer(
                 cb,
@@ -475,15 +397,11 @@ impl Renderer {
                 .buffer(target.readback.buffer)
                 .offset(0)
                 .size(vk::WHOLE_SIZE)];
-            d.cmd_pipeline_barrier2(
-                cb,
-                &vk::DependencyInfo::default().buffer_memory_barriers(&to_host),
-            );
+            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().buffer_memory_barriers(&to_host));
             self.commands.submit_and_wait(&self.dev, cb)?;
         }
         let pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(target.readback.mapped());
-        let image =
-            Image::from_pixels(width, height, pixels).expect("readback buffer sized for the image");
+        let image = Image::from_pixels(width, height, pixels).expect("readback buffer sized for the image");
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.check_validation()?;
@@ -542,12 +460,7 @@ impl Commands {
                     None,
                 )
                 .vk("vkCreateCommandPool")?;
-            let mut out = Self {
-                dev: dev.clone(),
-                pool,
-                buffer: vk::CommandBuffer::null(),
-                fence: vk::Fence::null(),
-            };
+            let mut out = Self { dev: dev.clone(), pool, buffer: vk::CommandBuffer::null(), fence: vk::Fence::null() };
             out.buffer = dev
                 .device
                 .allocate_command_buffers(
@@ -557,10 +470,7 @@ impl Commands {
                         .command_buffer_count(1),
                 )
                 .vk("vkAllocateCommandBuffers")?[0];
-            out.fence = dev
-                .device
-                .create_fence(&vk::FenceCreateInfo::default(), None)
-                .vk("vkCreateFence")?;
+            out.fence = dev.device.create_fence(&vk::FenceCreateInfo::default(), None).vk("vkCreateFence")?;
             Ok(out)
         }
     }
@@ -575,8 +485,7 @@ impl Commands {
             dev.device
                 .begin_command_buffer(
                     self.buffer,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
                 )
                 .vk("vkBeginCommandBuffer")?;
         }
@@ -589,12 +498,8 @@ impl Commands {
             dev.device.end_command_buffer(cb).vk("vkEndCommandBuffer")?;
             let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cb)];
             let submit = [vk::SubmitInfo2::default().command_buffer_infos(&buffers)];
-            dev.device
-                .queue_submit2(dev.queue, &submit, self.fence)
-                .vk("vkQueueSubmit2")?;
-            dev.device
-                .wait_for_fences(&[self.fence], true, u64::MAX)
-                .vk("vkWaitForFences")?;
+            dev.device.queue_submit2(dev.queue, &submit, self.fence).vk("vkQueueSubmit2")?;
+            dev.device.wait_for_fences(&[self.fence], true, u64::MAX).vk("vkWaitForFences")?;
             dev.device.reset_fences(&[self.fence]).vk("vkResetFences")?;
         }
         Ok(())

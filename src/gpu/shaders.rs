@@ -6,10 +6,7 @@
 /// Every file in `shaders/`, by name.
 pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../shaders/bindings.glsl")),
-    (
-        "radiometry.glsl",
-        include_str!("../../shaders/radiometry.glsl"),
-    ),
+    ("radiometry.glsl", include_str!("../../shaders/radiometry.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
@@ -27,18 +24,11 @@ pub fn compile(name: &str, sources: &[(&str, &str)]) -> Result<Vec<u32>, String>
     } else if name.ends_with(".comp") {
         shaderc::ShaderKind::Compute
     } else {
-        return Err(format!(
-            "{name}: unknown shader stage (expected .vert, .frag or .comp)"
-        ));
+        return Err(format!("{name}: unknown shader stage (expected .vert, .frag or .comp)"));
     };
-    let compiler =
-        shaderc::Compiler::new().map_err(|e| format!("cannot initialise shaderc: {e}"))?;
-    let mut options = shaderc::CompileOptions::new()
-        .map_err(|e| format!("cannot create shaderc options: {e}"))?;
-    options.set_target_env(
-        shaderc::TargetEnv::Vulkan,
-        shaderc::EnvVersion::Vulkan1_3 as u32,
-    );
+    let compiler = shaderc::Compiler::new().map_err(|e| format!("cannot initialise shaderc: {e}"))?;
+    let mut options = shaderc::CompileOptions::new().map_err(|e| format!("cannot create shaderc options: {e}"))?;
+    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
     // No SPIR-V optimisation: the device compiles anyway, and the arithmetic stays exactly as written.
     options.set_optimization_level(shaderc::OptimizationLevel::Zero);
     options.set_warnings_as_errors();
@@ -72,15 +62,15 @@ mod tests {
     fn errors_name_file_and_line() {
         let sources = [
             ("inc.glsl", "float f() {\n  return 1.0;\n}\nfloat g() { return undefined_name; }\n"),
-            ("broken.frag", "#version 450\n#include \"inc.glsl\"\nlayout(location=0) out vec4 o;\nvoid main() { o = vec4(f()); }\n"),
+            (
+                "broken.frag",
+                "#version 450\n#include \"inc.glsl\"\nlayout(location=0) out vec4 o;\nvoid main() { o = vec4(f()); }\n",
+            ),
             ("missing.frag", "#version 450\n#include \"nowhere.glsl\"\nvoid main() {}\n"),
         ];
         let err = compile("broken.frag", &sources).unwrap_err();
         assert!(err.contains("inc.glsl:4"), "{err}");
         let err = compile("missing.frag", &sources).unwrap_err();
-        assert!(
-            err.contains("missing.frag:2") && err.contains("nowhere.glsl"),
-            "{err}"
-        );
+        assert!(err.contains("missing.frag:2") && err.contains("nowhere.glsl"), "{err}");
     }
 }

@@ -16,30 +16,16 @@ impl AccessorReader<'_> {
     pub fn read_vec3_f32(&self, accessor: &gltf::Accessor) -> Result<Vec<[f32; 3]>, String> {
         expect_layout(accessor, Dimensions::Vec3, &[DataType::F32])?;
         let raw = self.read_components(accessor)?;
-        Ok(raw
-            .chunks_exact(3)
-            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
-            .collect())
+        Ok(raw.chunks_exact(3).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32]).collect())
     }
 
     /// Reads `SCALAR` unsigned-integer data of any width (indices).
     pub fn read_indices(&self, accessor: &gltf::Accessor) -> Result<Vec<u32>, String> {
-        expect_layout(
-            accessor,
-            Dimensions::Scalar,
-            &[DataType::U8, DataType::U16, DataType::U32],
-        )?;
+        expect_layout(accessor, Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32])?;
         if accessor.normalized() {
-            return Err(format!(
-                "accessor {}: indices must not be normalized",
-                accessor.index()
-            ));
+            return Err(format!("accessor {}: indices must not be normalized", accessor.index()));
         }
-        Ok(self
-            .read_components(accessor)?
-            .into_iter()
-            .map(|v| v as u32)
-            .collect())
+        Ok(self.read_components(accessor)?.into_iter().map(|v| v as u32).collect())
     }
 
     /// All components of an accessor, as f64 (every glTF component type converts to f64 exactly), sparse
@@ -47,9 +33,7 @@ impl AccessorReader<'_> {
     fn read_components(&self, accessor: &gltf::Accessor) -> Result<Vec<f64>, String> {
         let n = accessor.dimensions().multiplicity();
         let count = accessor.count();
-        let total = count
-            .checked_mul(n)
-            .ok_or_else(|| format!("accessor {}: count overflows", accessor.index()))?;
+        let total = count.checked_mul(n).ok_or_else(|| format!("accessor {}: count overflows", accessor.index()))?;
         let mut out = match accessor.view() {
             Some(view) => self.read_strided(
                 &view,
@@ -91,9 +75,7 @@ impl AccessorReader<'_> {
             for (j, &i) in indices.iter().enumerate() {
                 let i = i as usize;
                 if i >= count {
-                    return Err(format!(
-                        "{what}: index {i} is past the accessor's {count} elements"
-                    ));
+                    return Err(format!("{what}: index {i} is past the accessor's {count} elements"));
                 }
                 out[i * n..(i + 1) * n].copy_from_slice(&values[j * n..(j + 1) * n]);
             }
@@ -137,10 +119,8 @@ impl AccessorReader<'_> {
         }
         let data = &buffer[view.offset()..view.offset() + view.length()];
         if count > 0 {
-            let needed = (count - 1)
-                .checked_mul(stride)
-                .and_then(|b| b.checked_add(offset))
-                .and_then(|b| b.checked_add(elem));
+            let needed =
+                (count - 1).checked_mul(stride).and_then(|b| b.checked_add(offset)).and_then(|b| b.checked_add(elem));
             if needed.is_none_or(|needed| needed > data.len()) {
                 return Err(format!(
                     "{what}: {count} elements at offset {offset} with stride {stride} run past the end of buffer view {} ({} bytes)",
@@ -168,11 +148,7 @@ impl AccessorReader<'_> {
     }
 }
 
-fn expect_layout(
-    accessor: &gltf::Accessor,
-    dims: Dimensions,
-    types: &[DataType],
-) -> Result<(), String> {
+fn expect_layout(accessor: &gltf::Accessor, dims: Dimensions, types: &[DataType]) -> Result<(), String> {
     if accessor.dimensions() != dims || !types.contains(&accessor.data_type()) {
         return Err(format!(
             "accessor {} is {:?} {:?}, expected {:?} of {:?}",

@@ -13,11 +13,7 @@ use super::BoundingSphere;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
     /// Perspective with vertical field of view `yfov`; `zfar = None` is an infinite far plane.
-    Perspective {
-        yfov: f64,
-        znear: f64,
-        zfar: Option<f64>,
-    },
+    Perspective { yfov: f64, znear: f64, zfar: Option<f64> },
     /// Orthographic with half-height `ymag` [m].
     Orthographic { ymag: f64, znear: f64, zfar: f64 },
 }
@@ -48,58 +44,26 @@ impl Camera {
     }
 
     /// A camera at `eye` looking along `direction`, `up` made orthogonal to it.
-    pub fn looking(
-        eye: DVec3,
-        direction: DVec3,
-        up: DVec3,
-        projection: Projection,
-    ) -> Option<Self> {
+    pub fn looking(eye: DVec3, direction: DVec3, up: DVec3, projection: Projection) -> Option<Self> {
         let forward = direction.try_normalize()?;
         let right = forward.cross(up).try_normalize()?;
         let up = right.cross(forward);
-        Some(Self {
-            eye,
-            forward,
-            up,
-            projection,
-        })
+        Some(Self { eye, forward, up, projection })
     }
 
     /// A perspective camera that sees the whole sphere, from the default direction.
     pub fn frame_sphere(sphere: BoundingSphere, aspect: f64, yfov: f64) -> Self {
-        let (el, az) = (
-            AUTO_ELEVATION_DEGREES.to_radians(),
-            AUTO_AZIMUTH_DEGREES.to_radians(),
-        );
+        let (el, az) = (AUTO_ELEVATION_DEGREES.to_radians(), AUTO_AZIMUTH_DEGREES.to_radians());
         let towards_eye = DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
-        let radius = if sphere.radius > 0.0 {
-            sphere.radius
-        } else {
-            1.0
-        };
+        let radius = if sphere.radius > 0.0 { sphere.radius } else { 1.0 };
         // The sphere fits in the narrower of the two view cones: distance = r / sin(half-angle).
         let half_y = 0.5 * yfov;
         let half_x = (aspect * half_y.tan()).atan();
         let distance = radius / half_y.min(half_x).sin();
         let eye = sphere.center + towards_eye * distance;
-        let (znear, zfar) = near_far_around(
-            eye,
-            BoundingSphere {
-                center: sphere.center,
-                radius,
-            },
-        );
-        Self::look_at(
-            eye,
-            sphere.center,
-            DVec3::Y,
-            Projection::Perspective {
-                yfov,
-                znear,
-                zfar: Some(zfar),
-            },
-        )
-        .expect("default direction is not vertical")
+        let (znear, zfar) = near_far_around(eye, BoundingSphere { center: sphere.center, radius });
+        Self::look_at(eye, sphere.center, DVec3::Y, Projection::Perspective { yfov, znear, zfar: Some(zfar) })
+            .expect("default direction is not vertical")
     }
 
     /// World → view: view space has the camera at the origin looking down −Z, +Y up (right-handed).
@@ -110,12 +74,7 @@ impl Camera {
             DVec4::new(right.x, self.up.x, back.x, 0.0),
             DVec4::new(right.y, self.up.y, back.y, 0.0),
             DVec4::new(right.z, self.up.z, back.z, 0.0),
-            DVec4::new(
-                -right.dot(self.eye),
-                -self.up.dot(self.eye),
-                -back.dot(self.eye),
-                1.0,
-            ),
+            DVec4::new(-right.dot(self.eye), -self.up.dot(self.eye), -back.dot(self.eye), 1.0),
         )
     }
 
@@ -183,11 +142,7 @@ mod tests {
             DVec3::new(0.0, 0.0, 5.0),
             DVec3::ZERO,
             DVec3::Y,
-            Projection::Perspective {
-                yfov: 90f64.to_radians(),
-                znear: 1.0,
-                zfar: Some(9.0),
-            },
+            Projection::Perspective { yfov: 90f64.to_radians(), znear: 1.0, zfar: Some(9.0) },
         )
         .unwrap();
         let m = cam.clip_from_world(2.0);
@@ -207,11 +162,7 @@ mod tests {
             DVec3::ZERO,
             -DVec3::Z,
             DVec3::Y,
-            Projection::Perspective {
-                yfov: 1.0,
-                znear: 0.5,
-                zfar: None,
-            },
+            Projection::Perspective { yfov: 1.0, znear: 0.5, zfar: None },
         )
         .unwrap();
         let m = cam.clip_from_world(1.0);
@@ -226,55 +177,31 @@ mod tests {
             DVec3::new(0.0, 10.0, 0.0),
             -DVec3::Y,
             -DVec3::Z,
-            Projection::Orthographic {
-                ymag: 2.0,
-                znear: 1.0,
-                zfar: 11.0,
-            },
+            Projection::Orthographic { ymag: 2.0, znear: 1.0, zfar: 11.0 },
         )
         .unwrap();
         let m = cam.clip_from_world(1.5);
         let p = project(m, DVec3::new(3.0, 0.0, -2.0));
         // Looking down with up = −Z: +X is image-right, −Z is image-up.
-        assert!(
-            (p.x - 1.0).abs() < 1e-12 && (p.y + 1.0).abs() < 1e-12 && (p.z - 0.9).abs() < 1e-12,
-            "{p}"
-        );
+        assert!((p.x - 1.0).abs() < 1e-12 && (p.y + 1.0).abs() < 1e-12 && (p.z - 0.9).abs() < 1e-12, "{p}");
     }
 
     #[test]
     fn framing_keeps_sphere_inside_the_view() {
-        let sphere = BoundingSphere {
-            center: DVec3::new(1.0, 2.0, 3.0),
-            radius: 2.0,
-        };
+        let sphere = BoundingSphere { center: DVec3::new(1.0, 2.0, 3.0), radius: 2.0 };
         for aspect in [0.5, 1.0, 2.0] {
             let cam = Camera::frame_sphere(sphere, aspect, 45f64.to_radians());
             let m = cam.clip_from_world(aspect);
-            for dir in [
-                DVec3::X,
-                -DVec3::X,
-                DVec3::Y,
-                -DVec3::Y,
-                DVec3::Z,
-                -DVec3::Z,
-            ] {
+            for dir in [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z] {
                 let p = project(m, sphere.center + dir * sphere.radius);
-                assert!(
-                    p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z),
-                    "{aspect} {dir} {p}"
-                );
+                assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z), "{aspect} {dir} {p}");
             }
         }
     }
 
     #[test]
     fn degenerate_look_at_is_refused() {
-        let proj = Projection::Perspective {
-            yfov: 1.0,
-            znear: 0.1,
-            zfar: None,
-        };
+        let proj = Projection::Perspective { yfov: 1.0, znear: 0.1, zfar: None };
         assert!(Camera::look_at(DVec3::ONE, DVec3::ONE, DVec3::Y, proj).is_none());
         assert!(Camera::look_at(DVec3::ZERO, DVec3::Y, DVec3::Y, proj).is_none());
     }

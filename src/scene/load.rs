@@ -40,16 +40,11 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 
 /// Loads a glTF file.
 pub fn load_with_options(path: &Path, options: &LoadOptions) -> Result<Scene, LoadError> {
-    let fail = |message: String| LoadError {
-        path: path.to_path_buf(),
-        message,
-    };
+    let fail = |message: String| LoadError { path: path.to_path_buf(), message };
     let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
     let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(describe_gltf_error(&e)))?;
     let buffers = load_buffers(path, &gltf).map_err(fail)?;
-    Loader::new(&gltf.document, &buffers)
-        .load(options)
-        .map_err(fail)
+    Loader::new(&gltf.document, &buffers).load(options).map_err(fail)
 }
 
 fn describe_gltf_error(e: &gltf::Error) -> String {
@@ -57,16 +52,8 @@ fn describe_gltf_error(e: &gltf::Error) -> String {
         gltf::Error::Deserialize(e) => format!("invalid glTF JSON: {e}"),
         gltf::Error::Binary(e) => format!("invalid GLB container: {e}"),
         gltf::Error::Validation(errors) => {
-            let list: Vec<String> = errors
-                .iter()
-                .take(3)
-                .map(|(path, err)| format!("{path}: {err}"))
-                .collect();
-            let more = if errors.len() > 3 {
-                format!(" (and {} more)", errors.len() - 3)
-            } else {
-                String::new()
-            };
+            let list: Vec<String> = errors.iter().take(3).map(|(path, err)| format!("{path}: {err}")).collect();
+            let more = if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() };
             format!("invalid glTF: {}{more}", list.join("; "))
         }
         other => format!("invalid glTF: {other}"),
@@ -80,26 +67,20 @@ fn load_buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<Vec<u8>>, String> 
     for buffer in gltf.document.buffers() {
         let i = buffer.index();
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
-                format!("buffer {i} refers to the GLB binary chunk, which the file does not have")
-            })?,
-            gltf::buffer::Source::Uri(u) => match uri::resolve(u)
-                .map_err(|e| format!("buffer {i}: {e}"))?
-            {
+            gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| format!("buffer {i} refers to the GLB binary chunk, which the file does not have"))?,
+            gltf::buffer::Source::Uri(u) => match uri::resolve(u).map_err(|e| format!("buffer {i}: {e}"))? {
                 UriTarget::Data(bytes) => bytes,
                 UriTarget::File(rel) => {
                     let file = dir.join(&rel);
-                    std::fs::read(&file)
-                        .map_err(|e| format!("buffer {i}: cannot read '{}': {e}", file.display()))?
+                    std::fs::read(&file).map_err(|e| format!("buffer {i}: cannot read '{}': {e}", file.display()))?
                 }
             },
         };
         if data.len() < buffer.length() {
-            return Err(format!(
-                "buffer {i} holds {} bytes but declares byteLength {}",
-                data.len(),
-                buffer.length()
-            ));
+            return Err(format!("buffer {i} holds {} bytes but declares byteLength {}", data.len(), buffer.length()));
         }
         out.push(data);
     }
@@ -116,27 +97,23 @@ struct Loader<'a> {
 
 impl<'a> Loader<'a> {
     fn new(doc: &'a gltf::Document, buffers: &'a [Vec<u8>]) -> Self {
-        Self {
-            doc,
-            reader: AccessorReader { buffers },
-            scene: Scene::default(),
-            default_material: None,
-        }
+        Self { doc, reader: AccessorReader { buffers }, scene: Scene::default(), default_material: None }
     }
 
     fn load(mut self, options: &LoadOptions) -> Result<Scene, String> {
         let scene_count = self.doc.scenes().len();
-        let gscene =
-            match options.scene {
-                Some(n) => self.doc.scenes().nth(n).ok_or_else(|| {
-                    format!("scene {n} does not exist (the file has {scene_count})")
-                })?,
-                None => self
-                    .doc
-                    .default_scene()
-                    .or_else(|| self.doc.scenes().next())
-                    .ok_or("the file has no scene to render")?,
-            };
+        let gscene = match options.scene {
+            Some(n) => self
+                .doc
+                .scenes()
+                .nth(n)
+                .ok_or_else(|| format!("scene {n} does not exist (the file has {scene_count})"))?,
+            None => self
+                .doc
+                .default_scene()
+                .or_else(|| self.doc.scenes().next())
+                .ok_or("the file has no scene to render")?,
+        };
         for material in self.doc.materials() {
             let m = read_material(&material)?;
             self.scene.materials.push(m);
@@ -148,17 +125,9 @@ impl<'a> Loader<'a> {
         Ok(self.scene)
     }
 
-    fn visit(
-        &mut self,
-        node: &gltf::Node,
-        parent: DMat4,
-        path: &mut Vec<usize>,
-    ) -> Result<(), String> {
+    fn visit(&mut self, node: &gltf::Node, parent: DMat4, path: &mut Vec<usize>) -> Result<(), String> {
         if path.contains(&node.index()) {
-            return Err(format!(
-                "node {} is its own ancestor (the node hierarchy has a cycle)",
-                node.index()
-            ));
+            return Err(format!("node {} is its own ancestor (the node hierarchy has a cycle)", node.index()));
         }
         let world = parent * local_transform(node)?;
         if let Some(mesh) = node.mesh() {
@@ -167,8 +136,7 @@ impl<'a> Loader<'a> {
             }
         }
         if let Some(camera) = node.camera() {
-            let c =
-                read_camera(&camera, &world).map_err(|e| format!("node {}: {e}", node.index()))?;
+            let c = read_camera(&camera, &world).map_err(|e| format!("node {}: {e}", node.index()))?;
             self.scene.cameras.push((camera.index(), c));
         }
         if let Some(light) = node.light() {
@@ -194,32 +162,20 @@ impl<'a> Loader<'a> {
             None => format!("mesh {} primitive {}", mesh.index(), primitive.index()),
         };
         if primitive.mode() != gltf::mesh::Mode::Triangles {
-            self.scene.warnings.push(format!(
-                "{name}: mode {:?} skipped (only TRIANGLES is rendered)",
-                primitive.mode()
-            ));
+            self.scene
+                .warnings
+                .push(format!("{name}: mode {:?} skipped (only TRIANGLES is rendered)", primitive.mode()));
             return Ok(());
         }
         let linear = DMat3::from_mat4(*world);
         let det = linear.determinant();
         if !det.is_finite() || det == 0.0 {
-            self.scene.warnings.push(format!(
-                "{name}: node {} has a singular transform; skipped",
-                node.index()
-            ));
+            self.scene.warnings.push(format!("{name}: node {} has a singular transform; skipped", node.index()));
             return Ok(());
         }
-        let pos_acc = primitive
-            .get(&gltf::Semantic::Positions)
-            .ok_or_else(|| format!("{name}: no POSITION"))?;
-        let local_positions = self
-            .reader
-            .read_vec3_f32(&pos_acc)
-            .map_err(|e| format!("{name}: POSITION: {e}"))?;
-        if let Some(i) = local_positions
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
+        let pos_acc = primitive.get(&gltf::Semantic::Positions).ok_or_else(|| format!("{name}: no POSITION"))?;
+        let local_positions = self.reader.read_vec3_f32(&pos_acc).map_err(|e| format!("{name}: POSITION: {e}"))?;
+        if let Some(i) = local_positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(format!(
                 "{name}: POSITION accessor {} holds a non-finite value at vertex {i}",
                 pos_acc.index()
@@ -227,22 +183,14 @@ impl<'a> Loader<'a> {
         }
         let vertex_count = local_positions.len();
         let mut indices = match primitive.indices() {
-            Some(acc) => self
-                .reader
-                .read_indices(&acc)
-                .map_err(|e| format!("{name}: indices: {e}"))?,
+            Some(acc) => self.reader.read_indices(&acc).map_err(|e| format!("{name}: indices: {e}"))?,
             None => (0..vertex_count as u32).collect(),
         };
         if indices.len() % 3 != 0 {
-            return Err(format!(
-                "{name}: {} indices is not a whole number of triangles",
-                indices.len()
-            ));
+            return Err(format!("{name}: {} indices is not a whole number of triangles", indices.len()));
         }
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
-            return Err(format!(
-                "{name}: index {bad} is out of range ({vertex_count} vertices)"
-            ));
+            return Err(format!("{name}: index {bad} is out of range ({vertex_count} vertices)"));
         }
         // Mirrored node: the winding flips with the determinant's sign; swap two corners to keep CCW = front.
         if det < 0.0 {
@@ -252,29 +200,16 @@ impl<'a> Loader<'a> {
         }
         let positions: Vec<Vec3> = local_positions
             .iter()
-            .map(|p| {
-                world
-                    .transform_point3(DVec3::from_array(p.map(f64::from)))
-                    .as_vec3()
-            })
+            .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))).as_vec3())
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "{name}: vertex {i} is not finite after the node transform"
-            ));
+            return Err(format!("{name}: vertex {i} is not finite after the node transform"));
         }
 
-        let mut out = Mesh {
-            name,
-            material: self.material_index(primitive),
-            ..Default::default()
-        };
+        let mut out = Mesh { name, material: self.material_index(primitive), ..Default::default() };
         match primitive.get(&gltf::Semantic::Normals) {
             Some(acc) => {
-                let normals = self
-                    .reader
-                    .read_vec3_f32(&acc)
-                    .map_err(|e| format!("{}: NORMAL: {e}", out.name))?;
+                let normals = self.reader.read_vec3_f32(&acc).map_err(|e| format!("{}: NORMAL: {e}", out.name))?;
                 if normals.len() != vertex_count {
                     return Err(format!(
                         "{}: NORMAL has {} elements, POSITION {vertex_count}",
@@ -324,30 +259,17 @@ impl<'a> Loader<'a> {
         }
     }
 
-    fn add_light(
-        &mut self,
-        node: &gltf::Node,
-        light: &gltf::khr_lights_punctual::Light,
-        world: &DMat4,
-    ) {
-        let label = light.name().map_or_else(
-            || format!("light {}", light.index()),
-            |n| format!("light '{n}'"),
-        );
+    fn add_light(&mut self, node: &gltf::Node, light: &gltf::khr_lights_punctual::Light, world: &DMat4) {
+        let label = light.name().map_or_else(|| format!("light {}", light.index()), |n| format!("light '{n}'"));
         match light.kind() {
             gltf::khr_lights_punctual::Kind::Directional => {
                 if self.scene.lights.sun.is_some() {
-                    self.scene.warnings.push(format!(
-                        "{label}: a second directional light is ignored (one sun)"
-                    ));
+                    self.scene.warnings.push(format!("{label}: a second directional light is ignored (one sun)"));
                     return;
                 }
                 // The light shines along its node's −Z, so the direction towards the sun is the node's +Z.
                 let Some(direction) = world.transform_vector3(DVec3::Z).try_normalize() else {
-                    self.scene.warnings.push(format!(
-                        "{label}: node {} has no direction; ignored",
-                        node.index()
-                    ));
+                    self.scene.warnings.push(format!("{label}: node {} has no direction; ignored", node.index()));
                     return;
                 };
                 let e = light.intensity();
@@ -370,20 +292,10 @@ impl<'a> Loader<'a> {
 
 fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {
     let m = match node.transform() {
-        gltf::scene::Transform::Matrix { matrix } => {
-            DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)))
-        }
-        gltf::scene::Transform::Decomposed {
-            translation,
-            rotation,
-            scale,
-        } => {
+        gltf::scene::Transform::Matrix { matrix } => DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))),
+        gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
             let q = DQuat::from_array(rotation.map(f64::from));
-            let q = if q.length_squared() > 0.0 {
-                q.normalize()
-            } else {
-                DQuat::NAN
-            };
+            let q = if q.length_squared() > 0.0 { q.normalize() } else { DQuat::NAN };
             DMat4::from_scale_rotation_translation(
                 DVec3::from_array(scale.map(f64::from)),
                 q,
@@ -392,55 +304,41 @@ fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {
         }
     };
     if !m.is_finite() {
-        return Err(format!(
-            "node {} has a non-finite or zero-length transform",
-            node.index()
-        ));
+        return Err(format!("node {} has a non-finite or zero-length transform", node.index()));
     }
     Ok(m)
 }
 
 fn read_material(material: &gltf::Material) -> Result<Material, String> {
     let index = material.index().unwrap_or(0);
-    let name = material.name().map_or_else(
-        || format!("material {index}"),
-        |n| format!("material '{n}'"),
-    );
+    let name = material.name().map_or_else(|| format!("material {index}"), |n| format!("material '{n}'"));
     let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
     let albedo = [r, g, b];
     if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
-        return Err(format!(
-            "{name}: baseColorFactor {albedo:?} is outside [0, 1]"
-        ));
+        return Err(format!("{name}: baseColorFactor {albedo:?} is outside [0, 1]"));
     }
-    Ok(Material {
-        name,
-        double_sided: material.double_sided(),
-        brdf: Brdf::Lambert { albedo },
-    })
+    Ok(Material { name, double_sided: material.double_sided(), brdf: Brdf::Lambert { albedo } })
 }
 
 fn read_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
-    let label = camera.name().map_or_else(
-        || format!("camera {}", camera.index()),
-        |n| format!("camera '{n}'"),
-    );
+    let label = camera.name().map_or_else(|| format!("camera {}", camera.index()), |n| format!("camera '{n}'"));
     let projection = match camera.projection() {
         gltf::camera::Projection::Perspective(p) => {
             let (yfov, znear, zfar) = (p.yfov() as f64, p.znear() as f64, p.zfar().map(f64::from));
             if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
                 return Err(format!("{label}: yfov {yfov} rad is not in (0, π)"));
             }
-            if !(znear > 0.0) || zfar.is_some_and(|f| !(f > znear)) {
-                return Err(format!(
-                    "{label}: needs 0 < znear < zfar (znear {znear}, zfar {zfar:?})"
-                ));
+            // Written so that NaN fails the check.
+            let valid = znear > 0.0 && zfar.is_none_or(|f| f > znear);
+            if !valid {
+                return Err(format!("{label}: needs 0 < znear < zfar (znear {znear}, zfar {zfar:?})"));
             }
             Projection::Perspective { yfov, znear, zfar }
         }
         gltf::camera::Projection::Orthographic(o) => {
             let (ymag, znear, zfar) = (o.ymag().abs() as f64, o.znear() as f64, o.zfar() as f64);
-            if !(ymag > 0.0) || !(znear >= 0.0) || !(zfar > znear) {
+            let valid = ymag > 0.0 && znear >= 0.0 && zfar > znear;
+            if !valid {
                 return Err(format!("{label}: needs ymag ≠ 0 and 0 ≤ znear < zfar"));
             }
             Projection::Orthographic { ymag, znear, zfar }

@@ -22,10 +22,6 @@ pub struct Material {
 impl Material {
     /// glTF's default material: single-sided, white Lambertian (albedo 1).
     pub fn default_material() -> Self {
-        Self {
-            name: "default material".into(),
-            double_sided: false,
-            brdf: Brdf::Lambert { albedo: [1.0; 3] },
-        }
+        Self { name: "default material".into(), double_sided: false, brdf: Brdf::Lambert { albedo: [1.0; 3] } }
     }
 }

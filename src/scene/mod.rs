@@ -78,14 +78,9 @@ impl Scene {
 
     /// The box around every vertex that a triangle uses, or `None` for a scene without triangles.
     pub fn bounds(&self) -> Option<Aabb> {
-        let mut used = self
-            .meshes
-            .iter()
-            .flat_map(|m| m.indices.iter().map(move |&i| m.positions[i as usize]));
+        let mut used = self.meshes.iter().flat_map(|m| m.indices.iter().map(move |&i| m.positions[i as usize]));
         let first = used.next()?.as_dvec3();
-        let (min, max) = used.fold((first, first), |(lo, hi), p| {
-            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-        });
+        let (min, max) = used.fold((first, first), |(lo, hi), p| (lo.min(p.as_dvec3()), hi.max(p.as_dvec3())));
         Some(Aabb { min, max })
     }
 

@@ -110,38 +110,20 @@ mod tests {
         assert!((e - 1000.0).abs() < 20.0, "{e}");
         // E⊥ = L_sun Ω_sun to within sin²(δ/4) = 5.3e-6 relative.
         let l = 1.47e7;
-        assert!(
-            (rel(l * omega, e) - 5.3e-6).abs() < 0.1e-6,
-            "{}",
-            rel(l * omega, e)
-        );
+        assert!((rel(l * omega, e) - 5.3e-6).abs() < 0.1e-6, "{}", rel(l * omega, e));
         assert!(rel(sun_radiance_from_irradiance(e, delta), l) < 1e-15);
     }
 
     #[test]
     fn small_cone_estimate_error_is_tiny_for_the_sun_and_large_at_60_degrees() {
         // Sphere seen at half-angle a (the sun): base = π r², height = d, r/d = sin a.
-        let sphere = |a: f64| {
-            rel(
-                small_cone_solid_angle(PI * a.sin().powi(2), 1.0),
-                cone_solid_angle(a),
-            )
-        };
+        let sphere = |a: f64| rel(small_cone_solid_angle(PI * a.sin().powi(2), 1.0), cone_solid_angle(a));
         let a_sun = degrees_to_radians(0.265);
-        assert!(
-            (sphere(a_sun) - 5.35e-6).abs() < 0.05e-6,
-            "{}",
-            sphere(a_sun)
-        );
+        assert!((sphere(a_sun) - 5.35e-6).abs() < 0.05e-6, "{}", sphere(a_sun));
         // 60° half-angle: π sin²60° = 3π/4 against π: 25% low.
         assert!((sphere(PI / 3.0) - 0.25).abs() < 1e-12);
         // Flat disk of radius tan a at height 1: π tan² a; at 60°: 3π against π, 200% high.
-        let disk = |a: f64| {
-            rel(
-                small_cone_solid_angle(PI * a.tan().powi(2), 1.0),
-                cone_solid_angle(a),
-            )
-        };
+        let disk = |a: f64| rel(small_cone_solid_angle(PI * a.tan().powi(2), 1.0), cone_solid_angle(a));
         assert!((disk(a_sun) - 0.75 * a_sun * a_sun).abs() < 1e-9);
         assert!((disk(PI / 3.0) - 2.0).abs() < 1e-12);
     }

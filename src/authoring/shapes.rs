@@ -1,0 +1,152 @@
+//! Simple triangle meshes for generated scenes: every triangle counter-clockwise seen from its front side.
+
+use glam::Vec3;
+
+use super::{Indices, Primitive};
+
+/// Positions, unit normals and a triangle list.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshData {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    pub indices: Vec<u32>,
+}
+
+impl MeshData {
+    /// As an indexed primitive with normals, indices in the narrowest type.
+    pub fn primitive(&self, material: Option<usize>) -> Primitive {
+        Primitive {
+            positions: self.positions.clone(),
+            normals: Some(self.normals.clone()),
+            indices: Some(Indices::narrowest(&self.indices)),
+            material,
+            mode: None,
+        }
+    }
+
+    /// The same triangles without an index buffer (vertices repeated).
+    pub fn unindexed(&self) -> MeshData {
+        MeshData {
+            positions: self.indices.iter().map(|&i| self.positions[i as usize]).collect(),
+            normals: self.indices.iter().map(|&i| self.normals[i as usize]).collect(),
+            indices: (0..self.indices.len() as u32).collect(),
+        }
+    }
+
+    /// Appends another mesh.
+    pub fn append(&mut self, other: &MeshData) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+/// A parallelogram with corners `center ± u ± v`, facing `u × v`.
+pub fn quad(center: Vec3, u: Vec3, v: Vec3) -> MeshData {
+    let n = u.cross(v).normalize();
+    let corners = [center - u - v, center + u - v, center + u + v, center - u + v];
+    MeshData {
+        positions: corners.map(|c| c.to_array()).to_vec(),
+        normals: vec![n.to_array(); 4],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    }
+}
+
+/// An axis-aligned cube of half-size `half` around the origin, flat-shaded (24 vertices), faces outwards.
+pub fn cube(half: f32) -> MeshData {
+    let mut m = MeshData::default();
+    for axis in 0..3 {
+        for sign in [1.0f32, -1.0] {
+            let n = Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+            // Two tangents with u × v = n.
+            let u = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { half } else { 0.0 }));
+            let v = n.cross(u);
+            m.append(&quad(n * half, u, v));
+        }
+    }
+    m
+}
+
+/// A UV sphere with smooth normals: `stacks` ≥ 2 rings of latitude, `slices` ≥ 3 of longitude.
+pub fn uv_sphere(center: Vec3, radius: f32, stacks: u32, slices: u32) -> MeshData {
+    let mut m = MeshData::default();
+    for i in 0..=stacks {
+        let theta = std::f64::consts::PI * i as f64 / stacks as f64;
+        for j in 0..=slices {
+            let phi = 2.0 * std::f64::consts::PI * j as f64 / slices as f64;
+            let n = glam::DVec3::new(theta.sin() * phi.sin(), theta.cos(), theta.sin() * phi.cos());
+            m.normals.push(n.as_vec3().to_array());
+            m.positions.push((center + n.as_vec3() * radius).to_array());
+        }
+    }
+    let row = slices + 1;
+    for i in 0..stacks {
+        for j in 0..slices {
+            let (a, b, c, d) = (i * row + j, (i + 1) * row + j, (i + 1) * row + j + 1, i * row + j + 1);
+            // Seen from outside, going down a stack (b) then along the slice (c) is counter-clockwise.
+            if i != 0 {
+                m.indices.extend([a, b, d]);
+            }
+            if i != stacks - 1 {
+                m.indices.extend([d, b, c]);
+            }
+        }
+    }
+    m
+}
+
+/// A `size × size` square in the XZ plane at height `y`, facing +Y, split into `n × n` cells (2 triangles each).
+pub fn grid(center: Vec3, size: f32, n: u32) -> MeshData {
+    let mut m = MeshData::default();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = center.x + size * (j as f32 / n as f32 - 0.5);
+            let z = center.z + size * (i as f32 / n as f32 - 0.5);
+            m.positions.push([x, center.y, z]);
+            m.normals.push([0.0, 1.0, 0.0]);
+        }
+    }
+    let row = n + 1;
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j + 1, (i + 1) * row + j);
+            // +X then +Z is clockwise seen from +Y, so go a → d → c (CCW from above).
+            m.indices.extend([a, d, c, a, c, b]);
+        }
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every triangle's geometric normal agrees with its vertex normals (CCW = front).
+    fn assert_front_faces_agree(m: &MeshData) {
+        for t in m.indices.chunks_exact(3) {
+            let p: [Vec3; 3] = std::array::from_fn(|k| Vec3::from_array(m.positions[t[k] as usize]));
+            let g = (p[1] - p[0]).cross(p[2] - p[0]);
+            if g.length() < 1e-12 {
+                continue;
+            }
+            let n = Vec3::from_array(m.normals[t[0] as usize]);
+            assert!(g.dot(n) > 0.0, "triangle {t:?} winds against its normal");
+        }
+    }
+
+    #[test]
+    fn shapes_wind_counter_clockwise() {
+        assert_front_faces_agree(&quad(Vec3::ZERO, Vec3::X, Vec3::Y));
+        assert_front_faces_agree(&cube(0.5));
+        assert_front_faces_agree(&uv_sphere(Vec3::ONE, 2.0, 8, 12));
+        assert_front_faces_agree(&grid(Vec3::ZERO, 2.0, 4));
+        assert_eq!(cube(1.0).triangle_count(), 12);
+        assert_eq!(grid(Vec3::ZERO, 1.0, 10).triangle_count(), 200);
+        assert_eq!(uv_sphere(Vec3::ZERO, 1.0, 4, 6).triangle_count(), 2 * 6 * 4 - 2 * 6);
+    }
+}

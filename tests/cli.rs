@@ -1,0 +1,135 @@
+//! The command line as a user runs it: exit codes, one-line errors naming the file, no half-written output.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use common::TempDir;
+use glam::Vec3;
+use serde_json::json;
+use sunshade::authoring::shapes::{cube, quad};
+use sunshade::authoring::{GltfBuilder, Node};
+
+fn sunshade(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sunshade"))
+        .args(args)
+        .env("SUNSHADE_VALIDATION", "1")
+        .output()
+        .expect("run sunshade")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn scene() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = b.add_material("m", [0.5; 3], false, None);
+    let mesh =
+        b.add_mesh("cube", &[cube(0.5).primitive(Some(m)), quad(Vec3::ZERO, Vec3::X, Vec3::Z).primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    b
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn renders_every_output_format_atomically() {
+    let dir = TempDir::new("cli-ok");
+    let input = dir.write("scene.glb", &scene());
+    for out in ["out.exr", "out.pfm", "out.png"] {
+        let o = sunshade(&["render", s(&input), "-o", s(&dir.path(out)), "--width", "64", "--height", "48", "-v"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let err = stderr(&o);
+        for phase in ["instance", "shader compile", "upload", "render", "readback", "encode"] {
+            assert!(err.contains(phase), "-v does not print {phase}: {err}");
+        }
+        let img = sunshade::film::read_image(&dir.path(out)).unwrap();
+        assert_eq!((img.width(), img.height()), (64, 48));
+    }
+    // Nothing but the scene, its outputs: no temporary files left behind.
+    assert_eq!(dir.files(), ["out.exr", "out.pfm", "out.png", "scene.glb"]);
+}
+
+/// Runs a render that must fail: exit code, one line naming `names`, and no output file.
+fn assert_refused(dir: &TempDir, input: &Path, extra: &[&str], code: i32, names: &str) {
+    let out = dir.path("refused.exr");
+    let mut args = vec!["render", s(input), "-o", s(&out)];
+    args.extend_from_slice(extra);
+    let o = sunshade(&args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(code), "{err}");
+    assert!(err.contains(names), "message does not name '{names}': {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists(), "output written despite the error");
+    assert!(dir.files().iter().all(|f| !f.contains("sunshade-tmp")), "temporary file left behind");
+}
+
+#[test]
+fn broken_inputs_exit_non_zero_with_a_message_and_no_output() {
+    let dir = TempDir::new("cli-broken");
+    let good = scene();
+    let glb = good.to_glb();
+    let truncated = dir.path("truncated.glb");
+    std::fs::write(&truncated, &glb[..glb.len() - 40]).unwrap();
+    assert_refused(&dir, &truncated, &[], 1, "truncated.glb");
+
+    let bad_json = dir.path("bad.gltf");
+    std::fs::write(&bad_json, "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [").unwrap();
+    assert_refused(&dir, &bad_json, &[], 1, "bad.gltf");
+
+    let mut doc = good.document(Some("index.bin"));
+    std::fs::write(dir.path("index.bin"), good.bin()).unwrap();
+    let last = doc["accessors"].as_array().unwrap().len() - 1;
+    doc["accessors"][last]["count"] = json!(100000);
+    let index = dir.path("index.gltf");
+    std::fs::write(&index, doc.to_string()).unwrap();
+    assert_refused(&dir, &index, &[], 1, "index.gltf");
+
+    let doc = good.document(Some("gone.bin"));
+    let missing = dir.path("missing.gltf");
+    std::fs::write(&missing, doc.to_string()).unwrap();
+    assert_refused(&dir, &missing, &[], 1, "gone.bin");
+
+    assert_refused(&dir, &dir.path("nothing.glb"), &[], 1, "nothing.glb");
+}
+
+#[test]
+fn bad_usage_exits_2() {
+    let dir = TempDir::new("cli-usage");
+    let input = dir.write("scene.glb", &scene());
+    assert_refused(&dir, &input, &["--sun-dir", "0,0,0"], 2, "--sun-dir");
+    assert_refused(&dir, &input, &["--sun-dir", "1,2"], 2, "--sun-dir");
+    assert_refused(&dir, &input, &["--width", "0"], 2, "--width");
+    assert_refused(&dir, &input, &["--camera", "4"], 2, "--camera 4");
+    assert_refused(&dir, &input, &["--eye", "1,1,1", "--target", "1,1,1"], 2, "--eye");
+    let o = sunshade(&["render", s(&input), "-o", s(&dir.path("x.tiff"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("x.tiff"));
+}
+
+#[test]
+fn impossible_sizes_are_refused_clearly() {
+    let dir = TempDir::new("cli-size");
+    let input = dir.write("scene.glb", &scene());
+    assert_refused(&dir, &input, &["--width", "100000", "--height", "8"], 1, "100000x8");
+    // 16384² RGBA32F is 4 GiB: over lavapipe's 2 GiB allocation limit.
+    assert_refused(&dir, &input, &["--width", "16384", "--height", "16384"], 1, "16384x16384");
+}
+
+#[test]
+fn info_lists_the_chosen_device() {
+    let o = sunshade(&["info"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("subPixelPrecisionBits"), "{out}");
+    assert!(out.contains("chosen: device"), "{out}");
+    let o = sunshade(&["info", "--device", "no-such-device"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("no-such-device"));
+}

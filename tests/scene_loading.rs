@@ -1,0 +1,261 @@
+//! glTF import without a GPU: what is read, what is skipped, and how bad files are refused.
+
+mod common;
+
+use common::TempDir;
+use glam::{DVec3, Quat, Vec3};
+use serde_json::json;
+use sunshade::authoring::shapes::{cube, quad};
+use sunshade::authoring::{GltfBuilder, Node, Primitive, Transform};
+use sunshade::scene::{self, Brdf, LoadOptions, Projection};
+use sunshade::settings::{self, CameraOptions, SunOptions};
+
+fn square_scene() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let m = b.add_material("grey", [0.5, 0.4, 0.3], false, None);
+    let mesh = b.add_mesh("square", &[quad(Vec3::ZERO, Vec3::X, Vec3::Y).primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    b
+}
+
+fn load_err(path: &std::path::Path) -> String {
+    match scene::load(path) {
+        Ok(_) => panic!("{} loaded, expected an error", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn reads_materials_and_default_material() {
+    let dir = TempDir::new("materials");
+    let mut b = square_scene();
+    let mesh = b.add_mesh("no-material", &[cube(0.5).primitive(None)]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    let mut doc = b.document(Some("m.bin"));
+    doc["scenes"][0]["nodes"] = json!([0, n]);
+    std::fs::write(dir.path("m.bin"), b.bin()).unwrap();
+    std::fs::write(dir.path("m.gltf"), doc.to_string()).unwrap();
+    let s = scene::load(&dir.path("m.gltf")).unwrap();
+    assert_eq!(s.meshes.len(), 2);
+    assert_eq!(s.materials[s.meshes[0].material].brdf, Brdf::Lambert { albedo: [0.5, 0.4, 0.3] });
+    let default = &s.materials[s.meshes[1].material];
+    assert_eq!(default.brdf, Brdf::Lambert { albedo: [1.0; 3] });
+    assert!(!default.double_sided);
+}
+
+#[test]
+fn skips_non_triangle_modes_and_non_sun_lights_with_warnings() {
+    let dir = TempDir::new("modes");
+    let mut b = GltfBuilder::new();
+    let q = quad(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let lines = Primitive { mode: Some(1), ..q.primitive(None) };
+    let strip = Primitive { mode: Some(5), ..q.primitive(None) };
+    let mesh = b.add_mesh("mixed", &[q.primitive(None), lines, strip]);
+    let point = b.add_point_light(100.0);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    let l = b.add_node(Node { light: Some(point), ..Default::default() });
+    b.add_scene(&[n, l], None);
+    let s = scene::load(&dir.write("modes.glb", &b)).unwrap();
+    assert_eq!(s.meshes.len(), 1, "only the TRIANGLES primitive is kept");
+    assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("Lines") && s.warnings[0].contains("skipped"), "{:?}", s.warnings);
+    assert!(s.warnings[1].contains("TriangleStrip"), "{:?}", s.warnings);
+    assert!(s.warnings[2].contains("point light ignored"), "{:?}", s.warnings);
+    assert!(s.lights.sun.is_none());
+}
+
+#[test]
+fn cameras_are_placed_by_nodes_and_chosen_by_index() {
+    let dir = TempDir::new("cameras");
+    let mut b = square_scene();
+    let persp = b.add_perspective_camera(0.8, 0.1, Some(50.0));
+    let ortho = b.add_orthographic_camera(2.0, 1.5, 0.5, 20.0);
+    let rot = Quat::from_axis_angle(Vec3::Y, 0.5);
+    let c0 = b.add_node(Node {
+        camera: Some(persp),
+        transform: Transform::Trs { translation: [1.0, 2.0, 3.0], rotation: rot.to_array(), scale: [1.0; 3] },
+        ..Default::default()
+    });
+    let c1 = b.add_node(Node {
+        camera: Some(ortho),
+        transform: Transform::Trs {
+            translation: [0.0, 5.0, 0.0],
+            rotation: Quat::from_axis_angle(Vec3::X, -1.0).to_array(),
+            scale: [1.0; 3],
+        },
+        ..Default::default()
+    });
+    let mut doc = b.document(None);
+    doc["scenes"][0]["nodes"] = json!([0, c0, c1]);
+    let path = dir.path("cams.gltf");
+    std::fs::write(dir.path("cams.bin"), b.bin()).unwrap();
+    doc["buffers"][0]["uri"] = json!("cams.bin");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    let s = scene::load(&path).unwrap();
+    assert_eq!(s.cameras.len(), 2);
+    let (idx, cam) = s.cameras[0];
+    assert_eq!(idx, persp);
+    assert!((cam.eye - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-6);
+    let fwd = rot.as_dquat() * -DVec3::Z;
+    assert!((cam.forward - fwd).length() < 1e-6);
+    assert_eq!(cam.projection, Projection::Perspective { yfov: 0.8f32 as f64, znear: 0.1f32 as f64, zfar: Some(50.0) });
+    // Default: the first placed camera; --camera 1 picks the orthographic one.
+    let default = settings::resolve(&s, 64, 32, &CameraOptions::default(), &SunOptions::default()).unwrap();
+    assert_eq!(default.camera, cam);
+    let pick = CameraOptions { camera: Some(ortho), ..Default::default() };
+    let o = settings::resolve(&s, 64, 32, &pick, &SunOptions::default()).unwrap();
+    assert!(matches!(o.camera.projection, Projection::Orthographic { ymag, .. } if ymag == 1.5));
+    // Overrides: --eye/--target replace the placement, --fov the field of view.
+    let moved = CameraOptions {
+        eye: Some(DVec3::new(0.0, 0.0, 9.0)),
+        target: Some(DVec3::ZERO),
+        fov_degrees: Some(30.0),
+        ..Default::default()
+    };
+    let m = settings::resolve(&s, 64, 32, &moved, &SunOptions::default()).unwrap();
+    assert_eq!(m.camera.eye, DVec3::new(0.0, 0.0, 9.0));
+    assert!((m.camera.forward + DVec3::Z).length() < 1e-12);
+    assert!(
+        matches!(m.camera.projection, Projection::Perspective { yfov, .. } if (yfov - 30f64.to_radians()).abs() < 1e-12)
+    );
+    let fov_on_ortho = CameraOptions { camera: Some(ortho), fov_degrees: Some(30.0), ..Default::default() };
+    assert!(settings::resolve(&s, 64, 32, &fov_on_ortho, &SunOptions::default()).is_err());
+}
+
+#[test]
+fn automatic_camera_frames_the_scene() {
+    let dir = TempDir::new("auto");
+    let s = scene::load(&dir.write("sq.glb", &square_scene())).unwrap();
+    assert!(s.cameras.is_empty());
+    let r = settings::resolve(&s, 300, 200, &CameraOptions::default(), &SunOptions::default()).unwrap();
+    let m = r.camera.clip_from_world(r.aspect());
+    for p in s.meshes[0].positions.iter() {
+        let c = m * p.as_dvec3().extend(1.0);
+        let ndc = c.truncate() / c.w;
+        assert!(ndc.x.abs() < 1.0 && ndc.y.abs() < 1.0 && ndc.z > 0.0 && ndc.z < 1.0, "{ndc}");
+    }
+}
+
+#[test]
+fn scene_index_selects_the_scene() {
+    let dir = TempDir::new("scenes");
+    let mut b = square_scene();
+    let mesh = b.add_mesh("cube", &[cube(0.5).primitive(None)]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    let path = dir.write("two.glb", &b);
+    let first = scene::load(&path).unwrap();
+    assert_eq!(first.meshes[0].name, "mesh 'square' primitive 0");
+    let second = scene::load_with_options(&path, &LoadOptions { scene: Some(1) }).unwrap();
+    assert_eq!(second.meshes[0].name, "mesh 'cube' primitive 0");
+    let err = scene::load_with_options(&path, &LoadOptions { scene: Some(5) }).unwrap_err().to_string();
+    assert!(err.contains("scene 5 does not exist"), "{err}");
+}
+
+#[test]
+fn flat_normals_follow_the_front_face_of_mirrored_nodes() {
+    let dir = TempDir::new("flatmirror");
+    let mut b = GltfBuilder::new();
+    let q = quad(Vec3::ZERO, Vec3::X, Vec3::Y);
+    let mesh = b.add_mesh("q", &[Primitive { normals: None, ..q.primitive(None) }]);
+    let n = b.add_node(Node {
+        mesh: Some(mesh),
+        transform: Transform::Trs { translation: [0.0; 3], rotation: [0.0, 0.0, 0.0, 1.0], scale: [1.0, 1.0, -2.0] },
+        ..Default::default()
+    });
+    b.add_scene(&[n], None);
+    let s = scene::load(&dir.write("f.glb", &b)).unwrap();
+    let m = &s.meshes[0];
+    assert_eq!(m.positions.len(), 6, "flat shading gives each triangle its own vertices");
+    for t in m.indices.chunks_exact(3) {
+        let p: Vec<Vec3> = t.iter().map(|&i| m.positions[i as usize]).collect();
+        let geometric = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        assert!((geometric - Vec3::NEG_Z).length() < 1e-6, "mirrored in z the quad faces −Z: {geometric}");
+        assert!((m.normals[t[0] as usize] - Vec3::NEG_Z).length() < 1e-6);
+    }
+}
+
+/// Writes a .gltf whose JSON is modified by `edit`, with its buffer in a .bin beside it.
+fn edited(dir: &TempDir, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> std::path::PathBuf {
+    let b = square_scene();
+    let bin = format!("{name}.bin");
+    let mut doc = b.document(Some(&bin));
+    std::fs::write(dir.path(&bin), b.bin()).unwrap();
+    edit(&mut doc);
+    let path = dir.path(&format!("{name}.gltf"));
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn bad_files_are_refused_with_a_message_naming_file_and_problem() {
+    let dir = TempDir::new("bad");
+    let good = dir.write("good.glb", &square_scene());
+    let bytes = std::fs::read(&good).unwrap();
+
+    let truncated = dir.path("truncated.glb");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let e = load_err(&truncated);
+    assert!(e.starts_with(&truncated.display().to_string()) && e.contains("GLB"), "{e}");
+
+    let bad_json = dir.path("bad.gltf");
+    std::fs::write(&bad_json, "{ \"asset\": { \"version\": \"2.0\" }, ").unwrap();
+    let e = load_err(&bad_json);
+    assert!(e.contains("bad.gltf") && e.contains("invalid glTF JSON"), "{e}");
+
+    let missing_bin = edited(&dir, "missingbin", |d| d["buffers"][0]["uri"] = json!("nowhere.bin"));
+    let e = load_err(&missing_bin);
+    assert!(e.contains("missingbin.gltf") && e.contains("nowhere.bin"), "{e}");
+
+    let index_past_end = edited(&dir, "index", |d| {
+        let last = d["accessors"].as_array().unwrap().len() - 1;
+        d["accessors"][last]["count"] = json!(6000);
+    });
+    let e = load_err(&index_past_end);
+    assert!(e.contains("index.gltf") && e.contains("run past the end"), "{e}");
+
+    let out_of_range = edited(&dir, "range", |d| {
+        // Point the indices at the position data, whose float bits make huge indices.
+        let last = d["accessors"].as_array().unwrap().len() - 1;
+        d["accessors"][last]["bufferView"] = json!(0);
+        d["accessors"][last]["componentType"] = json!(5125);
+    });
+    let e = load_err(&out_of_range);
+    assert!(e.contains("range.gltf") && e.contains("out of range"), "{e}");
+
+    let short_buffer = edited(&dir, "short", |d| d["buffers"][0]["byteLength"] = json!(100000));
+    let e = load_err(&short_buffer);
+    assert!(e.contains("short.gltf") && e.contains("byteLength"), "{e}");
+
+    let dangling = edited(&dir, "dangling", |d| d["meshes"][0]["primitives"][0]["material"] = json!(7));
+    let e = load_err(&dangling);
+    assert!(e.contains("dangling.gltf") && e.contains("invalid glTF"), "{e}");
+
+    let cycle = edited(&dir, "cycle", |d| d["nodes"][0]["children"] = json!([0]));
+    let e = load_err(&cycle);
+    assert!(e.contains("cycle.gltf") && (e.contains("cycle") || e.contains("invalid")), "{e}");
+
+    let albedo = edited(&dir, "albedo", |d| {
+        d["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = json!([1.5, 0, 0, 1])
+    });
+    let e = load_err(&albedo);
+    assert!(e.contains("albedo.gltf") && e.contains("outside [0, 1]"), "{e}");
+
+    let no_file = dir.path("absent.glb");
+    assert!(load_err(&no_file).contains("absent.glb"));
+}
+
+#[test]
+fn non_finite_positions_are_refused() {
+    let dir = TempDir::new("nan");
+    let mut b = GltfBuilder::new();
+    let mut q = quad(Vec3::ZERO, Vec3::X, Vec3::Y).primitive(None);
+    q.positions[2][1] = f32::NAN;
+    let mesh = b.add_mesh("nan", &[q]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    // The writer's POSITION min/max skip the NaN (f32::min ignores it), so the JSON stays valid.
+    let e = load_err(&dir.write("nan.gltf", &b));
+    assert!(e.contains("nan.gltf") && e.contains("non-finite") && e.contains("vertex 2"), "{e}");
+}
