@@ -35,10 +35,24 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     DiskGpu disks[];
 } lights;
 
+// The scene's triangles, for the fragment shader to fetch its triangle's three vertices by gl_PrimitiveID.
+layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
+    uint indices[];
+};
+
+// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz (world space).
+#define FLOATS_PER_VERTEX 6u
+layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
+    float vertex_data[];
+};
+
 layout(push_constant) uniform PushConstants {
-    mat4 clip_from_world; // world -> Vulkan clip space (f32, column-major)
-    vec4 viewer;          // (eye, 1) for perspective; (unit direction towards the viewer, 0) for orthographic
-    uint material;        // index into materials[]
+    mat4 clip_from_world;   // world -> Vulkan clip space (f32, column-major)
+    vec4 viewer;            // (eye, 1) for perspective; (unit direction towards the viewer, 0) for orthographic
+    vec2 framebuffer_size;  // width, height [pixels]
+    uint material;          // index into materials[]
+    uint first_index;       // this draw's first index in indices[]
+    int vertex_offset;      // added to every index of this draw
 } pc;
 
 #endif

@@ -1,21 +1,34 @@
 #version 450
 // Radiance of each covered pixel, linear, in W/(m^2 sr); alpha 1 marks coverage.
+//
+// The fragment fetches its triangle's three vertices (gl_PrimitiveID) and interpolates position and normal with
+// barycentrics it computes itself (transform.glsl), instead of using the device's interpolated varyings.
 #include "bindings.glsl"
+#include "transform.glsl"
 #include "shade.glsl"
-
-layout(location = 0) in vec3 v_position;
-layout(location = 1) in vec3 v_normal;
 
 layout(location = 0) out vec4 out_radiance;
 
+vec3 vertex_vec3(uint index, uint offset) {
+    uint base = index * FLOATS_PER_VERTEX + offset;
+    return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
+}
+
 void main() {
     MaterialGpu material = materials[pc.material];
-    vec3 normal = safe_normalize(v_normal);
+    uint first = pc.first_index + 3u * uint(gl_PrimitiveID);
+    uint i0 = uint(int(indices[first]) + pc.vertex_offset);
+    uint i1 = uint(int(indices[first + 1u]) + pc.vertex_offset);
+    uint i2 = uint(int(indices[first + 2u]) + pc.vertex_offset);
+    vec3 p0 = vertex_vec3(i0, 0u), p1 = vertex_vec3(i1, 0u), p2 = vertex_vec3(i2, 0u);
+    vec3 l = triangle_barycentrics(clip_position(p0), clip_position(p1), clip_position(p2), pixel_ndc(gl_FragCoord.xy));
+    vec3 position = l.x * p0 + l.y * p1 + l.z * p2;
+    vec3 normal = safe_normalize(l.x * vertex_vec3(i0, 3u) + l.y * vertex_vec3(i1, 3u) + l.z * vertex_vec3(i2, 3u));
     // Only double-sided materials reach here with back faces (single-sided ones are culled); glTF reverses
     // their normal.
     if (!gl_FrontFacing) {
         normal = -normal;
     }
-    vec3 to_viewer = pc.viewer.w != 0.0 ? safe_normalize(pc.viewer.xyz - v_position) : pc.viewer.xyz;
-    out_radiance = vec4(radiance_out(material, v_position, normal, to_viewer), 1.0);
+    vec3 to_viewer = pc.viewer.w != 0.0 ? safe_normalize(pc.viewer.xyz - position) : pc.viewer.xyz;
+    out_radiance = vec4(radiance_out(material, position, normal, to_viewer), 1.0);
 }

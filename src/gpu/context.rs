@@ -144,7 +144,12 @@ impl Instance {
                 // Also catches messages from vkCreateInstance and vkDestroyInstance themselves.
                 create_info = create_info.push_next(&mut debug_info);
             }
-            let instance = entry.create_instance(&create_info, None).vk("vkCreateInstance")?;
+            let instance = entry.create_instance(&create_info, None).map_err(|result| match result {
+                vk::Result::ERROR_INCOMPATIBLE_DRIVER => {
+                    GpuError::NoDevice("the Vulkan loader finds no driver (no ICD)".into())
+                }
+                result => GpuError::Vulkan { what: "vkCreateInstance", result },
+            })?;
             let debug = if validation {
                 let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
                 match loader.create_debug_utils_messenger(&debug_info, None) {
@@ -203,8 +208,14 @@ impl Device {
                 [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
             let mut features13 =
                 vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
-            let create_info =
-                vk::DeviceCreateInfo::default().queue_create_infos(&queue_info).push_next(&mut features13);
+            // geometryShader: the fragment shader reads gl_PrimitiveID (SPIR-V's Geometry capability).
+            // shaderFloat64 where present: the fragment shader's barycentrics in f64.
+            let features =
+                vk::PhysicalDeviceFeatures::default().geometry_shader(true).shader_float64(info.shader_float64);
+            let create_info = vk::DeviceCreateInfo::default()
+                .queue_create_infos(&queue_info)
+                .enabled_features(&features)
+                .push_next(&mut features13);
             let device = instance.instance.create_device(physical, &create_info, None).vk("vkCreateDevice")?;
             let queue = device.get_device_queue(queue_family, 0);
             let allocator = Allocator::new(&AllocatorCreateDesc {

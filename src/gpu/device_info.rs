@@ -25,6 +25,8 @@ pub struct DeviceInfo {
     /// Size of the largest device-local heap [bytes].
     pub device_local_heap_bytes: u64,
     pub max_push_constants_size: u32,
+    /// `shaderFloat64`: the fragment shader then computes its barycentrics in f64.
+    pub shader_float64: bool,
     pub framebuffer_color_sample_counts: vk::SampleCountFlags,
     /// A queue family with graphics (and so transfer) support.
     pub graphics_queue_family: Option<u32>,
@@ -80,12 +82,17 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
         let mut features13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut features13);
         let mut unusable = None;
+        let mut shader_float64 = false;
         if v < vk::API_VERSION_1_3 {
             unusable = Some(format!("supports Vulkan {}.{} only (1.3 needed)", api_version.0, api_version.1));
         } else {
             instance.get_physical_device_features2(physical, &mut features2);
+            let geometry_shader = features2.features.geometry_shader;
+            shader_float64 = features2.features.shader_float64 == vk::TRUE;
             if features13.dynamic_rendering == vk::FALSE || features13.synchronization2 == vk::FALSE {
                 unusable = Some("lacks dynamicRendering or synchronization2".into());
+            } else if geometry_shader == vk::FALSE {
+                unusable = Some("lacks geometryShader (needed for gl_PrimitiveID in fragment shaders)".into());
             }
         }
         if graphics_queue_family.is_none() {
@@ -108,6 +115,7 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
             max_memory_allocation_size: maint3.max_memory_allocation_size,
             device_local_heap_bytes,
             max_push_constants_size: limits.max_push_constants_size,
+            shader_float64,
             framebuffer_color_sample_counts: limits.framebuffer_color_sample_counts,
             graphics_queue_family,
             unusable,

@@ -7,7 +7,7 @@ use crate::settings::RenderSettings;
 
 pub const BRDF_LAMBERT: u32 = 0;
 
-/// One vertex: world position [m] and unit normal, interleaved.
+/// One vertex: world position [m] and unit normal, interleaved (`FLOATS_PER_VERTEX` = 6 floats in the shaders).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Vertex {
@@ -53,7 +53,10 @@ pub struct LightsHeader {
 pub struct PushConstants {
     pub clip_from_world: [f32; 16],
     pub viewer: [f32; 4],
+    pub framebuffer_size: [f32; 2],
     pub material: u32,
+    pub first_index: u32,
+    pub vertex_offset: i32,
     pub _pad: [u32; 3],
 }
 
@@ -93,11 +96,15 @@ pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
     bytes
 }
 
-pub fn push_constants(settings: &RenderSettings, material: u32) -> PushConstants {
+/// Push constants of one draw: the view, and where the draw's triangles start in the index and vertex buffers.
+pub fn push_constants(settings: &RenderSettings, material: u32, first_index: u32, vertex_offset: i32) -> PushConstants {
     PushConstants {
         clip_from_world: settings.clip_from_world().to_cols_array(),
         viewer: settings.viewer().to_array(),
+        framebuffer_size: [settings.width as f32, settings.height as f32],
         material,
+        first_index,
+        vertex_offset,
         _pad: [0; 3],
     }
 }
@@ -111,7 +118,9 @@ mod tests {
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
         assert_eq!(std::mem::size_of::<LightsHeader>(), 64);
         assert_eq!(std::mem::size_of::<DiskGpu>(), 48);
-        assert_eq!(std::mem::size_of::<PushConstants>(), 96);
+        assert_eq!(std::mem::size_of::<PushConstants>(), 112);
+        assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
+        assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
         assert_eq!(std::mem::size_of::<Vertex>(), 24);
     }
 }

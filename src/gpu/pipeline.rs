@@ -2,7 +2,8 @@
 //! dynamic rendering into RGBA32F colour + D32 depth.
 //!
 //! Fixed state: triangle lists, fill, counter-clockwise front faces, depth test LESS with writes, no blending,
-//! one sample. Dynamic state: viewport, scissor and cull mode (back for single-sided materials, none for
+//! one sample. The fragment shader reads materials, lights, and the scene's indices and vertices (to interpolate
+//! with its own barycentrics), all as storage buffers. Dynamic state: viewport, scissor and cull mode (back for single-sided materials, none for
 //! double-sided ones).
 
 use std::sync::Arc;
@@ -38,7 +39,8 @@ impl ScenePipeline {
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
-            let bindings = [0, 1].map(|b| {
+            // 0 materials, 1 lights, 2 indices, 3 vertices: all read by the fragment shader.
+            let bindings = [0, 1, 2, 3].map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(b)
                     .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
@@ -59,7 +61,7 @@ impl ScenePipeline {
                     None,
                 )
                 .vk("vkCreatePipelineLayout")?;
-            let pool_sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 2 }];
+            let pool_sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 4 }];
             out.descriptor_pool = d
                 .create_descriptor_pool(
                     &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&pool_sizes),
@@ -106,20 +108,13 @@ unsafe fn create_pipeline(
             stride: std::mem::size_of::<Vertex>() as u32,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        let vertex_attributes = [
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 12,
-            },
-        ];
+        // The vertex shader reads the position only; the fragment shader reads whole vertices from a buffer.
+        let vertex_attributes = [vk::VertexInputAttributeDescription {
+            location: 0,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 0,
+        }];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
             .vertex_attribute_descriptions(&vertex_attributes);

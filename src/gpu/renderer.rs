@@ -75,8 +75,9 @@ impl Renderer {
         let dev = Device::new(options)?;
         let instance = t0.elapsed();
         let t1 = Instant::now();
-        let vs = shaders::compile("scene.vert", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
-        let fs = shaders::compile("scene.frag", shaders::SOURCES).map_err(GpuError::ShaderCompile)?;
+        let defines: &[&str] = if dev.info.shader_float64 { &["SUNSHADE_F64_BARYCENTRICS"] } else { &[] };
+        let vs = shaders::compile("scene.vert", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
+        let fs = shaders::compile("scene.frag", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
         let pipeline = ScenePipeline::new(&dev, &vs, &fs)?;
         let shader_compile = t1.elapsed();
         let commands = Commands::new(&dev)?;
@@ -170,7 +171,7 @@ impl Renderer {
                     Buffer::with_data(
                         &self.dev,
                         bytemuck::cast_slice(&vertices),
-                        vk::BufferUsageFlags::VERTEX_BUFFER,
+                        vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
                         "vertices",
                     )
                 })
@@ -180,7 +181,7 @@ impl Renderer {
                     Buffer::with_data(
                         &self.dev,
                         bytemuck::cast_slice(&indices),
-                        vk::BufferUsageFlags::INDEX_BUFFER,
+                        vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
                         "indices",
                     )
                 })
@@ -253,18 +254,24 @@ impl Renderer {
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
         unsafe {
-            let infos = [
-                [vk::DescriptorBufferInfo { buffer: scene.materials.buffer, offset: 0, range: vk::WHOLE_SIZE }],
-                [vk::DescriptorBufferInfo { buffer: lights.buffer, offset: 0, range: vk::WHOLE_SIZE }],
-            ];
-            let writes = [0usize, 1].map(|b| {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(self.pipeline.descriptor_set)
-                    .dst_binding(b as u32)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(&infos[b])
-            });
-            d.update_descriptor_sets(&writes, &[]);
+            // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
+            if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
+                let buffers = [scene.materials.buffer, lights.buffer, ib.buffer, vb.buffer];
+                let infos =
+                    buffers.map(|buffer| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]);
+                let writes: Vec<_> = infos
+                    .iter()
+                    .enumerate()
+                    .map(|(b, info)| {
+                        vk::WriteDescriptorSet::default()
+                            .dst_set(self.pipeline.descriptor_set)
+                            .dst_binding(b as u32)
+                            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                            .buffer_info(info)
+                    })
+                    .collect();
+                d.update_descriptor_sets(&writes, &[]);
+            }
 
             let cb = self.commands.begin(&self.dev)?;
             let to_attachment = [
@@ -334,7 +341,7 @@ impl Renderer {
                 d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
                 d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
                 for draw in &scene.draws {
-                    let pc = push_constants(settings, draw.material);
+                    let pc = push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
                     d.cmd_push_constants(
                         cb,
                         self.pipeline.layout,

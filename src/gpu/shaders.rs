@@ -9,12 +9,13 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("radiometry.glsl", include_str!("../../shaders/radiometry.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
+    ("transform.glsl", include_str!("../../shaders/transform.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),
 ];
 
-/// Compiles `name` from `sources` (with its includes) to SPIR-V words.
-pub fn compile(name: &str, sources: &[(&str, &str)]) -> Result<Vec<u32>, String> {
+/// Compiles `name` from `sources` (with its includes) to SPIR-V words, with these `#define`s.
+pub fn compile(name: &str, sources: &[(&str, &str)], defines: &[&str]) -> Result<Vec<u32>, String> {
     let lookup = |n: &str| sources.iter().find(|(k, _)| *k == n).map(|(_, s)| *s);
     let source = lookup(name).ok_or_else(|| format!("no shader named '{name}'"))?;
     let kind = if name.ends_with(".vert") {
@@ -32,6 +33,9 @@ pub fn compile(name: &str, sources: &[(&str, &str)]) -> Result<Vec<u32>, String>
     // No SPIR-V optimisation: the device compiles anyway, and the arithmetic stays exactly as written.
     options.set_optimization_level(shaderc::OptimizationLevel::Zero);
     options.set_warnings_as_errors();
+    for d in defines {
+        options.add_macro_definition(d, None);
+    }
     options.set_include_callback(|requested, _kind, requester, _depth| {
         lookup(requested)
             .map(|content| shaderc::ResolvedInclude {
@@ -53,8 +57,10 @@ mod tests {
     #[test]
     fn every_embedded_stage_compiles() {
         for (name, _) in SOURCES.iter().filter(|(n, _)| !n.ends_with(".glsl")) {
-            let words = compile(name, SOURCES).unwrap_or_else(|e| panic!("{e}"));
-            assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+            for defines in [&[][..], &["SUNSHADE_F64_BARYCENTRICS"][..]] {
+                let words = compile(name, SOURCES, defines).unwrap_or_else(|e| panic!("{e}"));
+                assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+            }
         }
     }
 
@@ -68,9 +74,9 @@ mod tests {
             ),
             ("missing.frag", "#version 450\n#include \"nowhere.glsl\"\nvoid main() {}\n"),
         ];
-        let err = compile("broken.frag", &sources).unwrap_err();
+        let err = compile("broken.frag", &sources, &[]).unwrap_err();
         assert!(err.contains("inc.glsl:4"), "{err}");
-        let err = compile("missing.frag", &sources).unwrap_err();
+        let err = compile("missing.frag", &sources, &[]).unwrap_err();
         assert!(err.contains("missing.frag:2") && err.contains("nowhere.glsl"), "{err}");
     }
 }
