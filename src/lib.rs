@@ -7,6 +7,8 @@
 
 pub mod authoring;
 pub mod cli;
+pub mod compare;
+pub mod cpu;
 pub mod film;
 pub mod gpu;
 pub mod scene;

@@ -133,3 +133,73 @@ fn info_lists_the_chosen_device() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("no-such-device"));
 }
+
+/// Runs sunshade with the Vulkan loader pointed at a driver list that does not exist: no device at all.
+fn sunshade_without_vulkan(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sunshade"))
+        .args(args)
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env_remove("SUNSHADE_VALIDATION")
+        .output()
+        .expect("run sunshade")
+}
+
+#[test]
+fn reference_needs_no_vulkan_and_render_says_what_to_install() {
+    let dir = TempDir::new("cli-novulkan");
+    let input = dir.write("scene.glb", &scene());
+    let out = dir.path("cpu.exr");
+    let o = sunshade_without_vulkan(&["reference", s(&input), "-o", s(&out), "--width", "80", "--height", "60"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(sunshade::film::read_image(&out).unwrap().covered_count() > 100);
+    let gpu_out = dir.path("gpu.exr");
+    let o = sunshade_without_vulkan(&["render", s(&input), "-o", s(&gpu_out)]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert!(err.contains("mesa-vulkan-drivers"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!gpu_out.exists());
+}
+
+#[test]
+fn render_check_and_diff_agree_and_report() {
+    let dir = TempDir::new("cli-check");
+    let input = dir.write("scene.glb", &scene());
+    let (gpu, cpu, heat) = (dir.path("gpu.exr"), dir.path("cpu.exr"), dir.path("heat.png"));
+    let o = sunshade(&["render", s(&input), "-o", s(&gpu), "--width", "160", "--height", "120", "--check"]);
+    assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("result: PASS"));
+    let o = sunshade(&["reference", s(&input), "-o", s(&cpu), "--width", "160", "--height", "120"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = sunshade(&["diff", s(&gpu), s(&cpu), "--heatmap", s(&heat), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("diff --json prints JSON");
+    assert_eq!(report["coverage_mismatches"]["total"], 0);
+    assert!(report["max_rel"].as_f64().unwrap() <= 1e-5);
+    assert!(heat.exists());
+    // A changed image fails the diff with exit 1; a size mismatch or unreadable file is exit 2.
+    let other = dir.path("other.exr");
+    let o = sunshade(&[
+        "reference",
+        s(&input),
+        "-o",
+        s(&other),
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--sun-irradiance",
+        "1001",
+    ]);
+    assert!(o.status.success());
+    assert_eq!(sunshade(&["diff", s(&gpu), s(&other)]).status.code(), Some(1));
+    let small = dir.path("small.exr");
+    assert!(sunshade(&["reference", s(&input), "-o", s(&small), "--width", "16", "--height", "12"]).status.success());
+    let o = sunshade(&["diff", s(&gpu), s(&small)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("sizes differ"));
+    let o = sunshade(&["diff", s(&gpu), s(&dir.path("absent.exr"))]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("absent.exr"));
+}

@@ -122,6 +122,33 @@ pub fn grid(center: Vec3, size: f32, n: u32) -> MeshData {
     m
 }
 
+/// `count` random triangles (deterministic for a seed) inside the box `center ± half`, each with edges up to
+/// `max_edge` long and a flat normal; sizes spread over three decades so that slivers and sub-pixel triangles
+/// occur.
+pub fn triangle_soup(center: Vec3, half: Vec3, count: usize, max_edge: f32, seed: u64) -> MeshData {
+    let mut state = seed.max(1);
+    let mut next = move || {
+        // xorshift64*: enough for test geometry.
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        (state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut m = MeshData::default();
+    for _ in 0..count {
+        let a = center + half * Vec3::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0, next() * 2.0 - 1.0);
+        let scale = max_edge * 10f32.powf(-3.0 * next());
+        let mut rnd = || Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 2.0 * scale;
+        let (b, c) = (a + rnd(), a + rnd());
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        let base = m.positions.len() as u32;
+        m.positions.extend([a.to_array(), b.to_array(), c.to_array()]);
+        m.normals.extend([n.to_array(); 3]);
+        m.indices.extend([base, base + 1, base + 2]);
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -42,6 +42,11 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
             gib(d.max_memory_allocation_size),
             d.max_push_constants_size
         );
+        println!(
+            "      shaderFloat64 {} (fragment barycentrics in {})",
+            d.shader_float64,
+            if d.shader_float64 { "f64" } else { "f32" }
+        );
         if let Some(why) = &d.unusable {
             println!("      not usable: {why}");
         }

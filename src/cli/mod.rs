@@ -4,7 +4,9 @@
 //! flag at fault.
 
 mod args;
+mod diff;
 mod info;
+mod reference;
 mod render;
 
 use std::process::ExitCode;
@@ -30,6 +32,10 @@ struct Cli {
 enum Command {
     /// Render a glTF scene on the GPU (Vulkan) to an image of radiance.
     Render(Box<render::RenderArgs>),
+    /// Render the same image on the CPU (f64 shading, no Vulkan needed): the reference to check against.
+    Reference(Box<reference::ReferenceCommand>),
+    /// Compare two images (.exr, .pfm, .png): coverage, errors, worst pixel; exit 1 when outside tolerance.
+    Diff(Box<diff::DiffCommand>),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
 }
@@ -39,6 +45,8 @@ enum Command {
 pub enum CliError {
     Usage(String),
     Failure(anyhow::Error),
+    /// A failure already reported on stdout (a comparison outside tolerance): exit with this code, print nothing.
+    Quiet(u8),
 }
 
 impl<E: Into<anyhow::Error>> From<E> for CliError {
@@ -63,6 +71,8 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(a) => render::run(&a),
+        Command::Reference(a) => reference::run(&a),
+        Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
     };
     match result {
@@ -71,6 +81,7 @@ pub fn main() -> ExitCode {
             eprintln!("sunshade: error: {msg}");
             ExitCode::from(2)
         }
+        Err(CliError::Quiet(code)) => ExitCode::from(code),
         Err(CliError::Failure(e)) => {
             eprintln!("sunshade: error: {}", one_line(&e));
             ExitCode::from(1)

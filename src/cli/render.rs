@@ -5,7 +5,10 @@ use std::time::Instant;
 use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
+use super::diff::{compare_and_report, ToleranceArgs};
+use super::reference::ReferenceArgs;
 use super::{check_output_path, load_scene, print_phases, CliError};
+use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
 use crate::gpu::{ContextOptions, Renderer};
 
@@ -21,6 +24,16 @@ pub struct RenderArgs {
     /// Print the device and the time of each phase (instance, shader compile, upload, render, readback, encode).
     #[arg(short, long)]
     pub verbose: bool,
+    /// Also render the CPU reference (with the device's sub-pixel bits) and compare: exit 1 outside tolerance.
+    #[arg(long)]
+    pub check: bool,
+    /// With --check: write the comparison heatmap here.
+    #[arg(long, value_name = "PNG", requires = "check")]
+    pub heatmap: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub tolerances: ToleranceArgs,
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
 }
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
@@ -63,6 +76,28 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             ("readback", frame.readback),
             ("encode", encode_time),
         ]);
+    }
+    if a.check {
+        let options = ReferenceOptions {
+            sub_pixel_bits: renderer.device_info().sub_pixel_precision_bits,
+            ..a.reference.options()
+        };
+        let t = Instant::now();
+        let reference = cpu::render(&scene, &settings, &options);
+        if a.verbose {
+            eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
+        }
+        let report = compare_and_report(
+            &image,
+            &reference,
+            ("gpu", "cpu reference"),
+            &a.tolerances.options(),
+            a.heatmap.as_deref(),
+            false,
+        )?;
+        if !report.pass {
+            return Err(CliError::Quiet(1));
+        }
     }
     Ok(())
 }

@@ -1,0 +1,66 @@
+//! `sunshade reference`: the CPU reference image (no Vulkan needed).
+
+use std::time::Instant;
+
+use clap::Args;
+
+use super::args::{OutputArgs, SceneArgs};
+use super::{check_output_path, load_scene, print_phases, CliError};
+use crate::cpu::{self, ReferenceOptions};
+use crate::film::write_image;
+
+/// Options of the reference rasterizer that mirror the device.
+#[derive(Args, Clone, Debug)]
+pub struct ReferenceArgs {
+    /// Sub-pixel precision bits of the device to mirror (`subPixelPrecisionBits`; 8 on lavapipe).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub sub_pixel_bits: u32,
+    /// Whether the device fuses the viewport multiply-add for unclipped vertices (default: whether this CPU has
+    /// FMA, which is what lavapipe does).
+    #[arg(long, action = clap::ArgAction::Set, value_name = "true|false")]
+    pub fused_viewport: Option<bool>,
+}
+
+impl ReferenceArgs {
+    pub fn options(&self) -> ReferenceOptions {
+        ReferenceOptions {
+            sub_pixel_bits: self.sub_pixel_bits,
+            fused_viewport: self.fused_viewport.unwrap_or_else(cpu::host_has_fma),
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct ReferenceCommand {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub output: OutputArgs,
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
+    /// Print the time of each phase.
+    #[arg(short, long)]
+    pub verbose: bool,
+}
+
+pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
+    check_output_path(&a.output.output)?;
+    let (scene, settings, load_time) = load_scene(&a.scene)?;
+    let t = Instant::now();
+    let image = cpu::render(&scene, &settings, &a.reference.options());
+    let render_time = t.elapsed();
+    let t = Instant::now();
+    write_image(&image, &a.output.output, a.output.exposure)?;
+    if a.verbose {
+        eprintln!(
+            "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",
+            rayon::current_num_threads(),
+            scene.triangle_count(),
+            settings.width,
+            settings.height,
+            image.covered_count()
+        );
+        print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())]);
+    }
+    Ok(())
+}

@@ -1,0 +1,370 @@
+//! Image comparison metrics, in the spirit of OpenImageIO's `idiff`.
+//!
+//! Over pixels covered in both images (alpha > 0), per RGB channel:
+//! - absolute error `|a − b|` [W/(m²·sr)];
+//! - relative error `|a − b| / max(|a|, |b|, floor)`: the floor keeps values near zero (a surface turning away
+//!   from the light) from dominating; it is `max(--floor, --floor-fraction × peak)`, `peak` the largest channel
+//!   value of either image;
+//! - RMSE over all compared channels, and PSNR `20 log10(peak / RMSE)`.
+//!
+//! Coverage mismatches (alpha differs) are counted apart. A mismatching pixel is an *edge* pixel when its 3×3
+//! neighbourhood holds a coverage boundary in either image, else *interior*.
+//!
+//! A pixel is over tolerance when it exceeds every tolerance given (`--fail-rel`, `--fail-abs`): each grants
+//! leeway, as `numpy.isclose` does. The comparison fails when more than `--fail-count` pixels are over tolerance
+//! or more than `--fail-coverage` pixels differ in coverage.
+
+use serde_json::json;
+
+use crate::film::Image;
+
+/// Thresholds of a comparison.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiffOptions {
+    /// Absolute floor of the relative error's denominator [W/(m²·sr)].
+    pub floor: f64,
+    /// Floor as a fraction of the images' peak value.
+    pub floor_fraction: f64,
+    /// Relative tolerance per pixel.
+    pub fail_rel: Option<f64>,
+    /// Absolute tolerance per pixel [W/(m²·sr)].
+    pub fail_abs: Option<f64>,
+    /// Pixels allowed over tolerance.
+    pub fail_count: usize,
+    /// Pixels allowed to differ in coverage.
+    pub fail_coverage: usize,
+}
+
+impl Default for DiffOptions {
+    fn default() -> Self {
+        Self { floor: 0.0, floor_fraction: 1e-2, fail_rel: Some(1e-5), fail_abs: None, fail_count: 0, fail_coverage: 0 }
+    }
+}
+
+/// The pixel with the largest relative error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorstPixel {
+    pub x: u32,
+    pub y: u32,
+    pub a: [f32; 4],
+    pub b: [f32; 4],
+    pub rel: f64,
+    pub abs: f64,
+}
+
+/// Counts split by where the pixels lie.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Split {
+    pub total: usize,
+    pub edge: usize,
+    pub interior: usize,
+}
+
+impl Split {
+    fn add(&mut self, edge: bool) {
+        self.total += 1;
+        if edge {
+            self.edge += 1;
+        } else {
+            self.interior += 1;
+        }
+    }
+}
+
+/// The result of comparing image A with image B.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiffReport {
+    pub width: u32,
+    pub height: u32,
+    pub covered_a: usize,
+    pub covered_b: usize,
+    pub coverage_mismatches: Split,
+    /// Pixels covered in both.
+    pub compared: usize,
+    pub max_abs: f64,
+    pub max_rel: f64,
+    /// Largest relative error among interior pixels (not next to a coverage boundary).
+    pub max_rel_interior: f64,
+    pub rmse: f64,
+    pub psnr_db: f64,
+    pub peak: f64,
+    /// The floor used in the relative error [W/(m²·sr)].
+    pub floor: f64,
+    pub over_tolerance: Split,
+    pub worst: Option<WorstPixel>,
+    pub options: DiffOptions,
+    pub pass: bool,
+}
+
+/// Per-pixel results, for the heatmap.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PixelDiff {
+    /// Covered in neither image.
+    Empty,
+    /// Covered in one image only.
+    CoverageMismatch,
+    /// Covered in both, with this relative error.
+    Relative(f64),
+}
+
+/// Compares two images of the same size. `Err` names the size mismatch.
+pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, Vec<PixelDiff>), String> {
+    if (a.width(), a.height()) != (b.width(), b.height()) {
+        return Err(format!("sizes differ: {}x{} and {}x{}", a.width(), a.height(), b.width(), b.height()));
+    }
+    let (w, h) = (a.width(), a.height());
+    let covered = |img: &Image, x: i64, y: i64| {
+        x >= 0 && y >= 0 && x < w as i64 && y < h as i64 && img.get(x as u32, y as u32)[3] > 0.0
+    };
+    let boundary = |x: u32, y: u32| {
+        let (x, y) = (x as i64, y as i64);
+        [a, b].iter().any(|img| {
+            let c = covered(img, x, y);
+            (-1..=1).any(|dy| (-1..=1).any(|dx| covered(img, x + dx, y + dy) != c))
+        })
+    };
+    let peak = a
+        .pixels()
+        .iter()
+        .chain(b.pixels())
+        .filter(|p| p[3] > 0.0)
+        .flat_map(|p| p[..3].iter().map(|v| v.abs() as f64))
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let floor = options.floor.max(options.floor_fraction * peak);
+
+    let mut report = DiffReport {
+        width: w,
+        height: h,
+        covered_a: a.covered_count(),
+        covered_b: b.covered_count(),
+        coverage_mismatches: Split::default(),
+        compared: 0,
+        max_abs: 0.0,
+        max_rel: 0.0,
+        max_rel_interior: 0.0,
+        rmse: 0.0,
+        psnr_db: f64::INFINITY,
+        peak,
+        floor,
+        over_tolerance: Split::default(),
+        worst: None,
+        options: *options,
+        pass: true,
+    };
+    let mut per_pixel = Vec::with_capacity((w * h) as usize);
+    let mut sum_sq = 0.0;
+    for y in 0..h {
+        for x in 0..w {
+            let (pa, pb) = (a.get(x, y), b.get(x, y));
+            let (ca, cb) = (pa[3] > 0.0, pb[3] > 0.0);
+            if !ca && !cb {
+                per_pixel.push(PixelDiff::Empty);
+                continue;
+            }
+            if ca != cb {
+                report.coverage_mismatches.add(boundary(x, y));
+                per_pixel.push(PixelDiff::CoverageMismatch);
+                continue;
+            }
+            report.compared += 1;
+            let (mut abs, mut rel) = (0.0f64, 0.0f64);
+            for c in 0..3 {
+                let (va, vb) = (pa[c] as f64, pb[c] as f64);
+                let d = (va - vb).abs();
+                // NaN in either image is an infinite error, never silently zero.
+                let d = if d.is_nan() { f64::INFINITY } else { d };
+                sum_sq += d * d;
+                abs = abs.max(d);
+                let denom = va.abs().max(vb.abs()).max(floor);
+                let r = if d == 0.0 {
+                    0.0
+                } else if denom > 0.0 {
+                    d / denom
+                } else {
+                    f64::INFINITY
+                };
+                rel = rel.max(r);
+            }
+            let edge = boundary(x, y);
+            report.max_abs = report.max_abs.max(abs);
+            if !edge {
+                report.max_rel_interior = report.max_rel_interior.max(rel);
+            }
+            report.max_rel = report.max_rel.max(rel);
+            if report.worst.is_none_or(|wp| rel > wp.rel) {
+                report.worst = Some(WorstPixel { x, y, a: pa, b: pb, rel, abs });
+            }
+            let over_rel = options.fail_rel.map(|t| rel > t);
+            let over_abs = options.fail_abs.map(|t| abs > t);
+            let over = match (over_rel, over_abs) {
+                (Some(r), Some(a)) => r && a,
+                (Some(r), None) => r,
+                (None, Some(a)) => a,
+                (None, None) => false,
+            };
+            if over {
+                report.over_tolerance.add(edge);
+            }
+            per_pixel.push(PixelDiff::Relative(rel));
+        }
+    }
+    if report.compared > 0 {
+        report.rmse = (sum_sq / (3 * report.compared) as f64).sqrt();
+        report.psnr_db = if report.rmse > 0.0 { 20.0 * (peak / report.rmse).log10() } else { f64::INFINITY };
+    }
+    report.pass =
+        report.over_tolerance.total <= options.fail_count && report.coverage_mismatches.total <= options.fail_coverage;
+    Ok((report, per_pixel))
+}
+
+impl DiffReport {
+    /// A short human-readable report.
+    pub fn text(&self, name_a: &str, name_b: &str) -> String {
+        let mut s = String::new();
+        let tol = match (self.options.fail_rel, self.options.fail_abs) {
+            (Some(r), Some(a)) => format!("rel > {r:e} and abs > {a:e}"),
+            (Some(r), None) => format!("rel > {r:e}"),
+            (None, Some(a)) => format!("abs > {a:e}"),
+            (None, None) => "no tolerance".into(),
+        };
+        s += &format!("A: {name_a} ({}x{}, {} covered)\n", self.width, self.height, self.covered_a);
+        s += &format!("B: {name_b} ({}x{}, {} covered)\n", self.width, self.height, self.covered_b);
+        s += &format!(
+            "coverage mismatches: {} (edge {}, interior {}; allowed {})\n",
+            self.coverage_mismatches.total,
+            self.coverage_mismatches.edge,
+            self.coverage_mismatches.interior,
+            self.options.fail_coverage
+        );
+        s += &format!("compared (covered in both): {}\n", self.compared);
+        s += &format!("max abs error: {:.3e} W/(m²·sr)\n", self.max_abs);
+        s += &format!(
+            "max rel error: {:.3e} (interior {:.3e}; floor {:.3e} W/(m²·sr))\n",
+            self.max_rel, self.max_rel_interior, self.floor
+        );
+        s += &format!("RMSE: {:.3e} W/(m²·sr), PSNR: {:.1} dB (peak {:.4e})\n", self.rmse, self.psnr_db, self.peak);
+        s += &format!(
+            "over tolerance ({tol}): {} (edge {}, interior {}; allowed {})\n",
+            self.over_tolerance.total, self.over_tolerance.edge, self.over_tolerance.interior, self.options.fail_count
+        );
+        if let Some(wp) = &self.worst {
+            s += &format!(
+                "worst pixel: ({}, {}) rel {:.3e} abs {:.3e}\n  A = [{:e}, {:e}, {:e}, {}]\n  B = [{:e}, {:e}, {:e}, {}]\n",
+                wp.x, wp.y, wp.rel, wp.abs, wp.a[0], wp.a[1], wp.a[2], wp.a[3], wp.b[0], wp.b[1], wp.b[2], wp.b[3]
+            );
+        }
+        s += if self.pass { "result: PASS\n" } else { "result: FAIL\n" };
+        s
+    }
+
+    /// The metrics as JSON, for scripts.
+    pub fn json(&self, name_a: &str, name_b: &str) -> serde_json::Value {
+        let finite = |v: f64| if v.is_finite() { json!(v) } else { json!(null) };
+        json!({
+            "a": name_a, "b": name_b,
+            "width": self.width, "height": self.height,
+            "covered_a": self.covered_a, "covered_b": self.covered_b,
+            "coverage_mismatches": { "total": self.coverage_mismatches.total, "edge": self.coverage_mismatches.edge, "interior": self.coverage_mismatches.interior },
+            "compared": self.compared,
+            "max_abs": finite(self.max_abs), "max_rel": finite(self.max_rel), "max_rel_interior": finite(self.max_rel_interior),
+            "rmse": finite(self.rmse), "psnr_db": finite(self.psnr_db), "peak": finite(self.peak), "floor": finite(self.floor),
+            "over_tolerance": { "total": self.over_tolerance.total, "edge": self.over_tolerance.edge, "interior": self.over_tolerance.interior },
+            "worst": self.worst.map(|w| json!({ "x": w.x, "y": w.y, "a": w.a, "b": w.b, "rel": finite(w.rel), "abs": finite(w.abs) })),
+            "tolerances": { "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_count": self.options.fail_count, "fail_coverage": self.options.fail_coverage },
+            "pass": self.pass,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn img(w: u32, h: u32, f: impl Fn(u32, u32) -> [f32; 4]) -> Image {
+        let mut i = Image::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                i.set(x, y, f(x, y));
+            }
+        }
+        i
+    }
+
+    #[test]
+    fn identical_images_pass_with_zero_error() {
+        let a = img(8, 8, |x, y| if x > 1 && y > 1 { [x as f32, y as f32, 1.0, 1.0] } else { [0.0; 4] });
+        let (r, _) = diff(&a, &a, &DiffOptions::default()).unwrap();
+        assert!(r.pass);
+        assert_eq!((r.max_abs, r.max_rel, r.rmse, r.coverage_mismatches.total), (0.0, 0.0, 0.0, 0));
+        assert_eq!(r.psnr_db, f64::INFINITY);
+        assert_eq!(r.compared, 36);
+    }
+
+    #[test]
+    fn relative_error_uses_the_floor_and_finds_the_worst_pixel() {
+        let a = img(4, 4, |_, _| [100.0, 100.0, 100.0, 1.0]);
+        let mut b = a.clone();
+        b.set(2, 1, [100.0, 100.5, 100.0, 1.0]);
+        b.set(0, 3, [100.0, 100.0, 100.2, 1.0]);
+        let (r, per) = diff(&a, &b, &DiffOptions { fail_rel: Some(3e-3), ..Default::default() }).unwrap();
+        let wp = r.worst.unwrap();
+        assert_eq!((wp.x, wp.y), (2, 1));
+        assert!((r.max_rel - 0.5 / 100.5).abs() < 1e-12);
+        assert!((r.max_abs - 0.5).abs() < 1e-12);
+        assert_eq!(r.over_tolerance.total, 1);
+        assert!(!r.pass);
+        assert!(matches!(per[4 + 2], PixelDiff::Relative(v) if v > 0.004));
+        // Near zero the floor bounds the relative error.
+        let z = img(2, 1, |_, _| [0.0, 0.0, 0.0, 1.0]);
+        let mut zb = z.clone();
+        zb.set(0, 0, [1e-6, 0.0, 0.0, 1.0]);
+        let (r, _) = diff(&z, &zb, &DiffOptions { floor: 1e-3, floor_fraction: 0.0, ..Default::default() }).unwrap();
+        assert!((r.max_rel - 1e-3).abs() < 1e-9, "{}", r.max_rel); // 1e-6 rounded to f32
+    }
+
+    #[test]
+    fn tolerances_combine_like_isclose() {
+        let a = img(1, 1, |_, _| [1.0, 1.0, 1.0, 1.0]);
+        let b = img(1, 1, |_, _| [1.01, 1.0, 1.0, 1.0]);
+        let run = |rel, abs| {
+            diff(&a, &b, &DiffOptions { fail_rel: rel, fail_abs: abs, ..Default::default() }).unwrap().0.pass
+        };
+        assert!(!run(Some(1e-3), None));
+        assert!(!run(None, Some(1e-3)));
+        assert!(run(Some(1e-3), Some(0.1)), "within the absolute tolerance");
+        assert!(run(Some(0.1), Some(1e-3)), "within the relative tolerance");
+    }
+
+    #[test]
+    fn coverage_mismatches_are_split_into_edge_and_interior() {
+        // A: 6×6 block covered; B: same block minus one boundary pixel and minus one pixel in the middle.
+        let a = img(10, 10, |x, y| if (2..8).contains(&x) && (2..8).contains(&y) { [1.0; 4] } else { [0.0; 4] });
+        let mut b = a.clone();
+        b.set(2, 4, [0.0; 4]); // on the boundary of A's block
+        b.set(5, 5, [0.0; 4]); // a hole: next to B's own boundary, so also an edge
+        let (r, _) = diff(&a, &b, &DiffOptions::default()).unwrap();
+        assert_eq!(r.coverage_mismatches.total, 2);
+        assert_eq!(r.coverage_mismatches.edge, 2);
+        assert!(!r.pass);
+        let (r, _) = diff(&a, &b, &DiffOptions { fail_coverage: 2, ..Default::default() }).unwrap();
+        assert!(r.pass);
+        // An interior value error stays interior.
+        let mut c = a.clone();
+        c.set(5, 5, [1.5, 1.0, 1.0, 1.0]);
+        let (r, _) = diff(&a, &c, &DiffOptions::default()).unwrap();
+        assert_eq!((r.over_tolerance.interior, r.over_tolerance.edge), (1, 0));
+        assert!(r.max_rel_interior > 0.3);
+    }
+
+    #[test]
+    fn nan_is_an_infinite_error_and_size_mismatch_is_refused() {
+        let a = img(2, 2, |_, _| [1.0; 4]);
+        let mut b = a.clone();
+        b.set(1, 1, [f32::NAN, 1.0, 1.0, 1.0]);
+        let (r, _) = diff(&a, &b, &DiffOptions::default()).unwrap();
+        assert_eq!(r.max_rel, f64::INFINITY);
+        assert!(!r.pass);
+        assert!(diff(&a, &Image::new(3, 2), &DiffOptions::default()).unwrap_err().contains("2x2"));
+    }
+}

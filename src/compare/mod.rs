@@ -1,0 +1,16 @@
+//! Comparing two images: metrics ([`diff`]) and a false-colour heatmap ([`heatmap`]).
+
+mod heatmap;
+mod metrics;
+
+pub use heatmap::{colour_scale, heatmap};
+pub use metrics::{diff, DiffOptions, DiffReport, PixelDiff, Split, WorstPixel};
+
+/// Writes a heatmap PNG atomically.
+pub fn write_heatmap(path: &std::path::Path, width: u32, height: u32, diffs: &[PixelDiff]) -> std::io::Result<()> {
+    let (w, h, px) = heatmap(width, height, diffs);
+    let buf = ::image::RgbImage::from_raw(w, h, px).expect("heatmap buffer matches its size");
+    crate::film::write_atomically(path, |out| {
+        ::image::DynamicImage::ImageRgb8(buf).write_to(out, ::image::ImageFormat::Png).map_err(std::io::Error::other)
+    })
+}
