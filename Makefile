@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models accuracy bench clean
+.PHONY: setup build render test lint models bench clean
 
 setup:
 	@./scripts/setup.sh
@@ -21,6 +21,11 @@ test: setup
 lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
+
+# Regenerates the measured figures in README.md and docs/accuracy.md (on this machine; the tables name it).
+bench: build
+	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
+	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 
 # Regenerates the generated scenes in models/.
 models:

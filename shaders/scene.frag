@@ -9,6 +9,11 @@
 
 layout(location = 0) out vec4 out_radiance;
 
+#ifdef SUNSHADE_DEVICE_INTERPOLATION
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+#endif
+
 vec3 vertex_vec3(uint index, uint offset) {
     uint base = index * FLOATS_PER_VERTEX + offset;
     return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
@@ -16,6 +21,10 @@ vec3 vertex_vec3(uint index, uint offset) {
 
 void main() {
     MaterialGpu material = materials[pc.material];
+#ifdef SUNSHADE_DEVICE_INTERPOLATION
+    vec3 position = v_position;
+    vec3 normal = safe_normalize(v_normal);
+#else
     uint first = pc.first_index + 3u * uint(gl_PrimitiveID);
     uint i0 = uint(int(indices[first]) + pc.vertex_offset);
     uint i1 = uint(int(indices[first + 1u]) + pc.vertex_offset);
@@ -24,6 +33,7 @@ void main() {
     vec3 l = triangle_barycentrics(clip_position(p0), clip_position(p1), clip_position(p2), pixel_ndc(gl_FragCoord.xy));
     vec3 position = l.x * p0 + l.y * p1 + l.z * p2;
     vec3 normal = safe_normalize(l.x * vertex_vec3(i0, 3u) + l.y * vertex_vec3(i1, 3u) + l.z * vertex_vec3(i2, 3u));
+#endif
     // Only double-sided materials reach here with back faces (single-sided ones are culled); glTF reverses
     // their normal.
     if (!gl_FrontFacing) {

@@ -4,6 +4,17 @@
 
 layout(location = 0) in vec3 in_position; // world [m]
 
+#ifdef SUNSHADE_DEVICE_INTERPOLATION
+// Only for `--interpolation device`: let the device interpolate position and normal (plane equations).
+layout(location = 1) in vec3 in_normal;
+layout(location = 0) out vec3 v_position;
+layout(location = 1) out vec3 v_normal;
+#endif
+
 void main() {
     gl_Position = clip_position(in_position);
+#ifdef SUNSHADE_DEVICE_INTERPOLATION
+    v_position = in_position;
+    v_normal = in_normal;
+#endif
 }

@@ -580,3 +580,23 @@ fn scene_directional_light_is_the_sun() {
         assert!(rel(img.get(50, 50)[c] as f64, want) <= 1e-6);
     }
 }
+
+#[test]
+fn every_interpolation_mode_renders_flat_faces_exactly() {
+    use sunshade::gpu::{ContextOptions, Interpolation, Renderer};
+    let dir = TempDir::new("modes");
+    let square = quad(Vec3::ZERO, Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.5, 0.0));
+    let scene = load(&dir.write("s.glb", &single_mesh_scene(&square, [0.7; 3], false, Transform::Identity)));
+    let s = settings(100, 100, ortho_front(1.0), sun(DVec3::new(0.3, 0.1, 1.0)));
+    let want = lambert(0.7, DVec3::Z, &s);
+    for mode in [Interpolation::Device, Interpolation::BarycentricF32, Interpolation::BarycentricF64] {
+        let mut r = Renderer::new(&ContextOptions { validation: true, device: None, interpolation: Some(mode) }).unwrap();
+        assert_eq!(r.interpolation(), mode);
+        let log = r.validation_log();
+        let (img, _) = r.render_scene(&scene, &s).unwrap();
+        drop(r);
+        common::assert_no_validation_messages(&log);
+        assert_eq!(img.covered_count(), 50 * 50, "{mode:?}");
+        assert!(rel(img.get(50, 50)[0] as f64, want) <= 1e-6, "{mode:?}: {:?} vs {want}", img.get(50, 50));
+    }
+}

@@ -4,6 +4,7 @@
 //! flag at fault.
 
 mod args;
+mod bench;
 mod diff;
 mod info;
 mod reference;
@@ -38,6 +39,8 @@ enum Command {
     Diff(Box<diff::DiffCommand>),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
+    /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
+    Bench(Box<bench::BenchArgs>),
 }
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
@@ -74,6 +77,7 @@ pub fn main() -> ExitCode {
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
+        Command::Bench(a) => bench::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

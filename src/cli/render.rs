@@ -10,7 +10,7 @@ use super::reference::ReferenceArgs;
 use super::{check_output_path, load_scene, print_phases, CliError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
-use crate::gpu::{ContextOptions, Renderer};
+use crate::gpu::{ContextOptions, Interpolation, Renderer};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -21,6 +21,10 @@ pub struct RenderArgs {
     /// Vulkan device: an index from `sunshade info`, or part of its name.
     #[arg(long, value_name = "INDEX|NAME")]
     pub device: Option<String>,
+    /// How the fragment shader interpolates position and normal: its own barycentrics in f64 (default where the
+    /// device has shaderFloat64) or f32, or the device's varyings (docs/accuracy.md compares them).
+    #[arg(long, value_name = "f64|f32|device")]
+    pub interpolation: Option<Interpolation>,
     /// Print the device and the time of each phase (instance, shader compile, upload, render, readback, encode).
     #[arg(short, long)]
     pub verbose: bool,
@@ -39,7 +43,8 @@ pub struct RenderArgs {
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     check_output_path(&a.output.output)?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
-    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
+    let options =
+        ContextOptions { device: a.device.clone(), interpolation: a.interpolation, ..ContextOptions::from_env() };
     let mut renderer = Renderer::new(&options)?;
     renderer.check_size(settings.width, settings.height)?;
     let t_upload = Instant::now();
@@ -52,12 +57,13 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if a.verbose {
         let info = renderer.device_info();
         eprintln!(
-            "sunshade: device {}: {} ({}, {} {})",
+            "sunshade: device {}: {} ({}, {} {}); interpolation {}",
             info.index,
             info.name,
             info.type_name(),
             info.driver_name,
-            info.driver_info
+            info.driver_info,
+            renderer.interpolation().name()
         );
         eprintln!(
             "sunshade: {} triangles, {}x{} pixels, {} covered",

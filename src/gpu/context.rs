@@ -15,19 +15,54 @@ use super::error::{GpuError, VkContext};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
-/// How to create the context.
+/// How the fragment shader gets the position and normal it shades.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interpolation {
+    /// The device's interpolated varyings (on lavapipe: f32 plane equations anchored at the window origin).
+    Device,
+    /// The fragment shader's own perspective-correct barycentrics, in f32.
+    BarycentricF32,
+    /// The same in f64 (needs `shaderFloat64`): exact weights, f32 interpolation after them.
+    BarycentricF64,
+}
+
+impl Interpolation {
+    pub fn name(self) -> &'static str {
+        match self {
+            Interpolation::Device => "device",
+            Interpolation::BarycentricF32 => "f32",
+            Interpolation::BarycentricF64 => "f64",
+        }
+    }
+}
+
+impl std::str::FromStr for Interpolation {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "device" => Ok(Interpolation::Device),
+            "f32" => Ok(Interpolation::BarycentricF32),
+            "f64" => Ok(Interpolation::BarycentricF64),
+            _ => Err(format!("'{s}' is not an interpolation (device, f32, f64)")),
+        }
+    }
+}
+
+/// How to create the context and renderer.
 #[derive(Clone, Debug, Default)]
 pub struct ContextOptions {
     /// Enable `VK_LAYER_KHRONOS_validation` and collect its messages.
     pub validation: bool,
     /// `--device`: an index into the device list, or a case-insensitive substring of a device name.
     pub device: Option<String>,
+    /// `None`: f64 barycentrics where the device has `shaderFloat64`, else f32.
+    pub interpolation: Option<Interpolation>,
 }
 
 impl ContextOptions {
     /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`.
     pub fn from_env() -> Self {
-        Self { validation: std::env::var("SUNSHADE_VALIDATION").is_ok_and(|v| v == "1"), device: None }
+        Self { validation: std::env::var("SUNSHADE_VALIDATION").is_ok_and(|v| v == "1"), ..Default::default() }
     }
 }
 

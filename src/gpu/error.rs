@@ -27,6 +27,8 @@ pub enum GpuError {
     ShaderCompile(String),
     #[error("{0}")]
     TooLarge(String),
+    #[error("{0}")]
+    Unsupported(String),
     #[error("{} Vulkan validation message(s); the first: {}", .0.len(), .0.first().map(String::as_str).unwrap_or(""))]
     Validation(Vec<String>),
 }

@@ -18,7 +18,7 @@ mod pipeline;
 mod renderer;
 pub mod shaders;
 
-pub use context::{list_devices, ContextOptions, ValidationLog};
+pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;
 pub use error::{GpuError, VULKAN_PACKAGES};
 pub use renderer::{FrameTimings, GpuScene, Renderer, SetupTimings};

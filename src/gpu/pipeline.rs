@@ -27,7 +27,13 @@ pub(crate) struct ScenePipeline {
 }
 
 impl ScenePipeline {
-    pub fn new(dev: &Arc<Device>, vertex_spirv: &[u32], fragment_spirv: &[u32]) -> Result<Self, GpuError> {
+    /// `with_normals`: the vertex shader also reads the normal (for device interpolation).
+    pub fn new(
+        dev: &Arc<Device>,
+        vertex_spirv: &[u32],
+        fragment_spirv: &[u32],
+        with_normals: bool,
+    ) -> Result<Self, GpuError> {
         let d = &dev.device;
         let mut out = Self {
             dev: dev.clone(),
@@ -75,7 +81,7 @@ impl ScenePipeline {
                         .set_layouts(&set_layouts),
                 )
                 .vk("vkAllocateDescriptorSets")?[0];
-            out.pipeline = create_pipeline(d, out.layout, vertex_spirv, fragment_spirv)?;
+            out.pipeline = create_pipeline(d, out.layout, vertex_spirv, fragment_spirv, with_normals)?;
         }
         Ok(out)
     }
@@ -86,6 +92,7 @@ unsafe fn create_pipeline(
     layout: vk::PipelineLayout,
     vertex_spirv: &[u32],
     fragment_spirv: &[u32],
+    with_normals: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device; shader modules are destroyed before returning.
     unsafe {
@@ -108,16 +115,19 @@ unsafe fn create_pipeline(
             stride: std::mem::size_of::<Vertex>() as u32,
             input_rate: vk::VertexInputRate::VERTEX,
         }];
-        // The vertex shader reads the position only; the fragment shader reads whole vertices from a buffer.
-        let vertex_attributes = [vk::VertexInputAttributeDescription {
-            location: 0,
+        // The vertex shader reads the position (and the normal only for device interpolation); otherwise the
+        // fragment shader reads whole vertices from a buffer.
+        let attribute = |location, offset| vk::VertexInputAttributeDescription {
+            location,
             binding: 0,
             format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        }];
+            offset,
+        };
+        let all_attributes = [attribute(0, 0), attribute(1, 12)];
+        let vertex_attributes = &all_attributes[..if with_normals { 2 } else { 1 }];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
-            .vertex_attribute_descriptions(&vertex_attributes);
+            .vertex_attribute_descriptions(vertex_attributes);
         let input_assembly =
             vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);

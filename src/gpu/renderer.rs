@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::context::{ContextOptions, Device, ValidationLog};
+use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::{GpuError, VkContext};
 use super::layout::{lights_bytes, material_gpu, push_constants, Vertex};
@@ -65,6 +65,7 @@ pub struct Renderer {
     pipeline: ScenePipeline,
     commands: Commands,
     setup: SetupTimings,
+    interpolation: Interpolation,
     dev: Arc<Device>,
 }
 
@@ -75,10 +76,22 @@ impl Renderer {
         let dev = Device::new(options)?;
         let instance = t0.elapsed();
         let t1 = Instant::now();
-        let defines: &[&str] = if dev.info.shader_float64 { &["SUNSHADE_F64_BARYCENTRICS"] } else { &[] };
+        let interpolation = match options.interpolation {
+            Some(Interpolation::BarycentricF64) if !dev.info.shader_float64 => {
+                return Err(GpuError::Unsupported(format!("{} has no shaderFloat64 for f64 interpolation", dev.info.name)));
+            }
+            Some(i) => i,
+            None if dev.info.shader_float64 => Interpolation::BarycentricF64,
+            None => Interpolation::BarycentricF32,
+        };
+        let defines: &[&str] = match interpolation {
+            Interpolation::Device => &["SUNSHADE_DEVICE_INTERPOLATION"],
+            Interpolation::BarycentricF32 => &[],
+            Interpolation::BarycentricF64 => &["SUNSHADE_F64_BARYCENTRICS"],
+        };
         let vs = shaders::compile("scene.vert", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
         let fs = shaders::compile("scene.frag", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
-        let pipeline = ScenePipeline::new(&dev, &vs, &fs)?;
+        let pipeline = ScenePipeline::new(&dev, &vs, &fs, interpolation == Interpolation::Device)?;
         let shader_compile = t1.elapsed();
         let commands = Commands::new(&dev)?;
         let renderer = Self {
@@ -87,6 +100,7 @@ impl Renderer {
             pipeline,
             commands,
             setup: SetupTimings { instance, shader_compile },
+            interpolation,
             dev,
         };
         renderer.check_validation()?;
@@ -95,6 +109,11 @@ impl Renderer {
 
     pub fn device_info(&self) -> &DeviceInfo {
         &self.dev.info
+    }
+
+    /// How the fragment shader interpolates.
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
     }
 
     pub fn setup_timings(&self) -> SetupTimings {

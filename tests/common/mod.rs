@@ -62,7 +62,7 @@ pub struct CheckedRenderer {
 
 impl CheckedRenderer {
     pub fn new() -> Self {
-        let renderer = Renderer::new(&ContextOptions { validation: true, device: None })
+        let renderer = Renderer::new(&ContextOptions { validation: true, ..Default::default() })
             .unwrap_or_else(|e| panic!("GPU tests need Vulkan with validation layers (make setup): {e}"));
         let log = renderer.validation_log();
         Self { renderer: Some(renderer), log }
