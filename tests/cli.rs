@@ -203,3 +203,41 @@ fn render_check_and_diff_agree_and_report() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("absent.exr"));
 }
+
+#[test]
+fn bench_reports_and_updates_a_marked_region() {
+    let dir = TempDir::new("cli-bench");
+    let input = dir.write("scene.glb", &scene());
+    let doc = dir.path("doc.md");
+    std::fs::write(
+        &doc,
+        "before\n<!-- sunshade bench: begin (generated; do not edit by hand) -->\nstale\n<!-- sunshade bench: end -->\nafter\n",
+    )
+    .unwrap();
+    let o = sunshade(&[
+        "bench",
+        s(&input),
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--repeat",
+        "1",
+        "--interpolation",
+        "f64,device",
+        "--update",
+        s(&doc),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("| scene.glb | f64 |") && table.contains("| scene.glb | device |"), "{table}");
+    let text = std::fs::read_to_string(&doc).unwrap();
+    assert!(text.starts_with("before\n") && text.ends_with("<!-- sunshade bench: end -->\nafter\n"), "{text}");
+    assert!(!text.contains("stale") && text.contains("| scene.glb | f64 |"), "{text}");
+    // A document without the markers is refused and left alone.
+    let plain = dir.path("plain.md");
+    std::fs::write(&plain, "no markers\n").unwrap();
+    let o = sunshade(&["bench", s(&input), "--width", "16", "--height", "16", "--repeat", "1", "--update", s(&plain)]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&plain).unwrap(), "no markers\n");
+}

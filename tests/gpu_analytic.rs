@@ -590,7 +590,8 @@ fn every_interpolation_mode_renders_flat_faces_exactly() {
     let s = settings(100, 100, ortho_front(1.0), sun(DVec3::new(0.3, 0.1, 1.0)));
     let want = lambert(0.7, DVec3::Z, &s);
     for mode in [Interpolation::Device, Interpolation::BarycentricF32, Interpolation::BarycentricF64] {
-        let mut r = Renderer::new(&ContextOptions { validation: true, device: None, interpolation: Some(mode) }).unwrap();
+        let mut r =
+            Renderer::new(&ContextOptions { validation: true, device: None, interpolation: Some(mode) }).unwrap();
         assert_eq!(r.interpolation(), mode);
         let log = r.validation_log();
         let (img, _) = r.render_scene(&scene, &s).unwrap();

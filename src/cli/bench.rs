@@ -163,7 +163,9 @@ fn bench_scenes(renderer: &mut Renderer, scenes: &[PathBuf], a: &BenchArgs) -> R
 fn default_scenes() -> Result<Vec<PathBuf>, CliError> {
     let dir = Path::new("models");
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| CliError::Usage(format!("{}: {e} (give scenes explicitly, or run from the repository)", dir.display())))?
+        .map_err(|e| {
+            CliError::Usage(format!("{}: {e} (give scenes explicitly, or run from the repository)", dir.display()))
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("glb" | "gltf")))
         .collect();
@@ -181,7 +183,17 @@ fn process_timing(scene: &Path, width: u32, height: u32, runs: u32) -> Result<St
     for _ in 0..runs {
         let t = Instant::now();
         let o = Command::new(&exe)
-            .args(["render", &scene.display().to_string(), "-o", &out.display().to_string(), "--width", &w, "--height", &h, "-v"])
+            .args([
+                "render",
+                &scene.display().to_string(),
+                "-o",
+                &out.display().to_string(),
+                "--width",
+                &w,
+                "--height",
+                &h,
+                "-v",
+            ])
             .output()?;
         wall.push(t.elapsed());
         if !o.status.success() {
@@ -236,13 +248,18 @@ fn update_region(doc: &Path, content: &str) -> Result<(), CliError> {
 fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }
 
 /// Today's date (UTC) as YYYY-MM-DD.
 fn today() -> String {
-    let days = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs() / 86_400) as i64;
+    let days =
+        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs() / 86_400) as i64;
     // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
     let z = days + 719_468;
     let era = z.div_euclid(146_097);

@@ -78,7 +78,10 @@ impl Renderer {
         let t1 = Instant::now();
         let interpolation = match options.interpolation {
             Some(Interpolation::BarycentricF64) if !dev.info.shader_float64 => {
-                return Err(GpuError::Unsupported(format!("{} has no shaderFloat64 for f64 interpolation", dev.info.name)));
+                return Err(GpuError::Unsupported(format!(
+                    "{} has no shaderFloat64 for f64 interpolation",
+                    dev.info.name
+                )));
             }
             Some(i) => i,
             None if dev.info.shader_float64 => Interpolation::BarycentricF64,
