@@ -6,6 +6,12 @@
 // BRDF kinds (MaterialGpu.kind.x); values match gpu::layout::BRDF_*.
 #define BRDF_LAMBERT 0u
 
+// Light models (LightBuffer.counts.y and .z); values match gpu::layout::*_MODEL_*.
+#define SUN_MODEL_DISK 0u
+#define SUN_MODEL_DELTA 1u
+#define DISK_MODEL_EXACT 0u
+#define DISK_MODEL_SMALL_SOURCE 1u
+
 struct MaterialGpu {
     vec4 kd;     // rgb: Lambertian albedo (dimensionless); w unused
     vec4 ks;     // reserved for specular BRDFs
@@ -31,7 +37,7 @@ layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
-    uvec4 counts; // x: number of disk lights
+    uvec4 counts; // x: number of disk lights; y: sun model; z: disk model
     DiskGpu disks[];
 } lights;
 

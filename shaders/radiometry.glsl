@@ -1,14 +1,185 @@
-// Radiometry in f32. Mirrors src/shading/radiometry.rs name for name (the Rust is the specification).
+// Radiometry in f32. Mirrors src/shading/radiometry.rs name for name (the Rust is the specification, and its
+// doc comments derive the formulas and say where precision is at stake).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_RADIOMETRY_GLSL
 #define SUNSHADE_RADIOMETRY_GLSL
 
-const float PI = 3.14159265358979323846;
-const float INV_PI = 0.31830988618379067154;
+#include "math.glsl"
 
 // Irradiance [W/m^2] from the sun as a direction (delta light): E = E_perp * max(0, n.l).
 vec3 sun_irradiance_delta(vec3 irradiance_normal, float n_dot_l) {
     return irradiance_normal * max(n_dot_l, 0.0);
+}
+
+// atan(t) - t without cancellation: the series for |t| < 0.5 (14 terms: below f32 rounding), else the difference.
+float atan_minus_identity(float t) {
+    if (abs(t) >= 0.5) {
+        return atan_accurate(t) - t;
+    }
+    float t2 = t * t;
+    float sum = 0.0;
+    for (int k = 14; k >= 1; --k) {
+        float sign = (k % 2 == 0) ? 1.0 : -1.0;
+        sum = sum * t2 + sign / float(2 * k + 1);
+    }
+    return sum * t2 * t;
+}
+
+// Irradiance [W/m^2] from the sun as a disk of angular diameter `angular_diameter`, exact also while it sets
+// (see the Rust for the derivation and the rewriting that avoids the cancellation of two terms of ~1/sigma).
+vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_diameter) {
+    float s = sin(0.5 * angular_diameter);
+    float c = cos(0.5 * angular_diameter);
+    if (cos_theta >= s) {
+        return irradiance_normal * cos_theta;
+    }
+    if (cos_theta <= -s) {
+        return vec3(0.0);
+    }
+    float sin_theta = sqrt((1.0 - cos_theta) * (1.0 + cos_theta));
+    float k = clamp((c * cos_theta) / (s * sin_theta), -1.0, 1.0);
+    float sin_phi0 = sqrt((1.0 - k) * (1.0 + k));
+    float pi_minus_phi0 = atan2_accurate(sin_phi0, -k);
+    float t = s * sin_theta * sin_phi0 / c;
+    float projected = s * s * (cos_theta * pi_minus_phi0 + t) + atan_minus_identity(t);
+    return irradiance_normal * (projected / (PI * s * s));
+}
+
+// Irradiance [W/m^2] from a uniform overcast sky of radiance L0: E = pi L0 (1 + cos t)/2.
+vec3 sky_irradiance(vec3 radiance, float n_dot_up) {
+    return PI * radiance * (0.5 * (1.0 + n_dot_up));
+}
+
+// The small-source estimate of a disk's projected solid angle [sr]: A cos_r cos_d / d^2.
+float disk_projected_solid_angle_small_source(vec3 x, vec3 n, vec3 center, vec3 direction, float radius) {
+    vec3 to_disk = center - x;
+    float d2 = dot(to_disk, to_disk);
+    if (d2 == 0.0) {
+        return 0.0;
+    }
+    float d = sqrt(d2);
+    float cos_receiver = max(dot(n, to_disk) / d, 0.0);
+    float cos_disk = max(-dot(direction, to_disk) / d, 0.0);
+    return PI * radius * radius * cos_receiver * cos_disk / d2;
+}
+
+// n.Phi for a disk entirely above the horizon (closed-form vector irradiance without cancellation).
+float full_disk_projected_solid_angle(vec3 n, vec3 d, vec3 r_perp, float h, float rho2, float radius) {
+    float h2 = h * h;
+    float r2 = radius * radius;
+    float a = rho2 + h2 + r2;
+    float rho = sqrt(rho2);
+    float diff = (rho - radius) * (rho + radius);
+    float s = sqrt(diff * diff + 2.0 * h2 * (rho2 + r2) + h2 * h2);
+    float b = rho2 + h2 - r2;
+    float axial = b >= 0.0 ? 2.0 * PI * r2 * h2 / (s * (s + b)) : 0.5 * PI * (1.0 - b / s);
+    float radial = 2.0 * PI * h * r2 / (s * (a + s));
+    return -axial * dot(n, d) - radial * dot(n, r_perp);
+}
+
+// tan(phi/2) for phi in [-pi, pi]; +-pi map to +-1e30 (f32's pi/2 lies above the true pi/2, where tan flips sign).
+float tan_half(float phi) {
+    if (phi >= PI) {
+        return 1e30;
+    }
+    if (phi <= -PI) {
+        return -1e30;
+    }
+    return tan(0.5 * phi);
+}
+
+// log1p(x)/x, 1 at 0, from log (0-1 ulp on lavapipe) by Goldberg's trick: u = 1 + x rounded, log(u)/(u - 1).
+float log1p_over_x(float x) {
+    float u = 1.0 + x;
+    if (u == 1.0) {
+        return 1.0;
+    }
+    return log(u) / (u - 1.0);
+}
+
+// (integral dphi/D, integral cos phi/D, integral sin phi/D) over [phi_a, phi_b], D = b0 + b cos phi.
+vec3 rim_integrals(float phi_a, float phi_b, float b0, float b) {
+    float shift = floor((phi_a + PI) / (2.0 * PI)) * 2.0 * PI;
+    float a = max(phi_a - shift, -PI);
+    float z = phi_b - shift;
+    vec2 pieces[2];
+    int count = 0;
+    if (min(z, PI) > a) {
+        pieces[count++] = vec2(a, min(z, PI));
+    }
+    if (min(z - 2.0 * PI, PI) > -PI) {
+        pieces[count++] = vec2(-PI, min(z - 2.0 * PI, PI));
+    }
+    float eps = b / b0;
+    float sq = sqrt((1.0 - eps) * (1.0 + eps));
+    float lambda = sqrt((1.0 - eps) / (1.0 + eps));
+    float one_minus_lambda = 2.0 * eps / (sqrt(1.0 + eps) * (sqrt(1.0 + eps) + sqrt(1.0 - eps)));
+    float inv_sq_minus_one = eps * eps / (sq * (1.0 + sq));
+    vec3 j = vec3(0.0);
+    for (int i = 0; i < count; ++i) {
+        float pa = pieces[i].x;
+        float pb = pieces[i].y;
+        float ta = tan_half(pa);
+        float tb = tan_half(pb);
+        float g_lambda = atan_accurate(lambda * tb) - atan_accurate(lambda * ta);
+        j.x += 2.0 / (b0 * sq) * g_lambda;
+        if (eps == 0.0) {
+            j.y += (sin(pb) - sin(pa)) / b0;
+        } else {
+            float da = atan_accurate(one_minus_lambda / (1.0 / ta + lambda * ta));
+            float db = atan_accurate(one_minus_lambda / (1.0 / tb + lambda * tb));
+            j.y += 2.0 * ((db - da) - g_lambda * inv_sq_minus_one) / b;
+        }
+        float dcos = 2.0 * sin(0.5 * (pa + pb)) * sin(0.5 * (pb - pa));
+        float denom = b0 + b * cos(pb);
+        j.z += dcos / denom * log1p_over_x(b * dcos / denom);
+    }
+    return j;
+}
+
+// The segment of a disk above the horizon: rim arc plus chord.
+float partial_disk_projected_solid_angle(vec3 n, vec3 d, vec3 q, vec3 r_perp, float h, float rho, float radius) {
+    vec3 e1 = rho > 0.0 ? -r_perp / rho : any_orthonormal_vector(d);
+    vec3 e2 = cross(d, e1);
+    float n1 = dot(n, e1);
+    float n2 = dot(n, e2);
+    float n_d = dot(n, d);
+    float m = sqrt(n1 * n1 + n2 * n2);
+    float gamma = atan2_accurate(n2, n1);
+    float kappa = clamp(-dot(n, q) / (radius * m), -1.0, 1.0);
+    float alpha = atan2_accurate(sqrt((1.0 - kappa) * (1.0 + kappa)), kappa);
+    float b0 = h * h + rho * rho + radius * radius;
+    float b = 2.0 * radius * rho;
+    vec3 j = rim_integrals(gamma - alpha, gamma + alpha, b0, b);
+    float rim = radius * (n_d * radius * j.x + (n_d * rho + h * n1) * j.y + h * n2 * j.z);
+    vec3 pa = q + radius * (cos(gamma - alpha) * e1 + sin(gamma - alpha) * e2);
+    vec3 pb = q + radius * (cos(gamma + alpha) * e1 + sin(gamma + alpha) * e2);
+    vec3 c = cross(pb, pa);
+    float theta = atan2_accurate(length(c), dot(pb, pa));
+    float chord = dot(n, c) >= 0.0 ? theta : -theta;
+    return -0.5 * (rim + chord);
+}
+
+// The exact projected solid angle [sr] of the part of a disk above the receiver's horizon: E = L0 * this.
+float disk_projected_solid_angle(vec3 x, vec3 n, vec3 center, vec3 direction, float radius) {
+    vec3 r = x - center;
+    float h = dot(r, direction);
+    if (!(h > 0.0 && radius > 0.0)) {
+        return 0.0;
+    }
+    vec3 r_perp = r - h * direction;
+    float rho2 = dot(r_perp, r_perp);
+    vec3 q = -r;
+    float n_d = dot(n, direction);
+    float n_perp_len = length(n - n_d * direction);
+    float nq = dot(n, q);
+    if (nq - radius * n_perp_len >= 0.0) {
+        return full_disk_projected_solid_angle(n, direction, r_perp, h, rho2, radius);
+    }
+    if (nq + radius * n_perp_len <= 0.0) {
+        return 0.0;
+    }
+    return partial_disk_projected_solid_angle(n, direction, q, r_perp, h, sqrt(rho2), radius);
 }
 
 #endif

@@ -5,10 +5,11 @@
 use glam::{DVec3, Mat4, Vec4};
 
 use crate::scene::camera::{near_far_around, AUTO_FOV_DEGREES};
-use crate::scene::{BoundingSphere, Camera, Lights, Projection, Scene, Sun};
+use crate::scene::{BoundingSphere, Camera, DiskLight, Lights, Projection, Scene, Sun};
 use crate::shading::radiometry::{
     degrees_to_radians, sun_irradiance_from_radiance, DEFAULT_SUN_IRRADIANCE, SUN_ANGULAR_DIAMETER_DEGREES,
 };
+use crate::shading::ShadingOptions;
 
 /// Default image size [pixels].
 pub const DEFAULT_WIDTH: u32 = 512;
@@ -23,9 +24,16 @@ pub struct RenderSettings {
     pub height: u32,
     pub camera: Camera,
     pub lights: Lights,
+    /// How the sun and disk lights are evaluated.
+    pub shading: ShadingOptions,
 }
 
 impl RenderSettings {
+    /// Settings with the default light models.
+    pub fn new(width: u32, height: u32, camera: Camera, lights: Lights) -> Self {
+        Self { width, height, camera, lights, shading: ShadingOptions::default() }
+    }
+
     /// Width / height.
     pub fn aspect(&self) -> f64 {
         self.width as f64 / self.height as f64
@@ -90,6 +98,17 @@ impl SunOptions {
     }
 }
 
+/// Lights and light models from the command line, besides the sun.
+#[derive(Clone, Debug, Default)]
+pub struct LightOptions {
+    pub sun: SunOptions,
+    /// Disk lights added to the scene's.
+    pub disks: Vec<DiskLight>,
+    /// Sky radiance replacing the scene's [W/(m²·sr)].
+    pub sky: Option<[f64; 3]>,
+    pub shading: ShadingOptions,
+}
+
 /// A combination of options that cannot be rendered; a usage error (exit code 2 at the CLI).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
@@ -105,7 +124,7 @@ pub fn sun_direction_from_angles(elevation_degrees: f64, azimuth_degrees: f64) -
     DVec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos())
 }
 
-/// Resolves the camera and lights of a render.
+/// Resolves the camera and lights of a render, with the sun the only light option.
 pub fn resolve(
     scene: &Scene,
     width: u32,
@@ -113,15 +132,35 @@ pub fn resolve(
     camera: &CameraOptions,
     sun: &SunOptions,
 ) -> Result<RenderSettings, SettingsError> {
+    resolve_with(scene, width, height, camera, &LightOptions { sun: sun.clone(), ..Default::default() })
+}
+
+/// Resolves the camera and lights of a render. The scene's lights come first; `--disk-light` adds disks,
+/// `--sky-radiance` replaces the sky, the sun flags override the scene's sun. A default sun (E⊥ 1000 W/m² from
+/// [`DEFAULT_SUN_DIRECTION`]) shines only where neither the scene nor the flags give any light.
+pub fn resolve_with(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    camera: &CameraOptions,
+    light_options: &LightOptions,
+) -> Result<RenderSettings, SettingsError> {
     if width == 0 || height == 0 {
         return Err(usage(format!("image size {width}x{height} is empty")));
     }
     let aspect = width as f64 / height as f64;
     let camera = resolve_camera(scene, aspect, camera)?;
     let mut lights = scene.lights.clone();
-    let sun = resolve_sun(scene.lights.sun, scene.lights.is_empty(), sun)?;
-    lights.sun = sun;
-    Ok(RenderSettings { width, height, camera, lights })
+    lights.disks.extend(light_options.disks.iter().copied());
+    if let Some(sky) = light_options.sky {
+        if sky.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(usage("--sky-radiance must be finite and non-negative"));
+        }
+        lights.sky = Some(sky.map(|v| v as f32));
+    }
+    let unlit = lights.sun.is_none() && lights.disks.is_empty() && lights.sky.is_none();
+    lights.sun = resolve_sun(scene.lights.sun, unlit, &light_options.sun)?;
+    Ok(RenderSettings { width, height, camera, lights, shading: light_options.shading })
 }
 
 fn resolve_camera(scene: &Scene, aspect: f64, opts: &CameraOptions) -> Result<Camera, SettingsError> {

@@ -36,7 +36,7 @@ fn ortho_front(ymag: f64) -> Camera {
 }
 
 fn settings(width: u32, height: u32, camera: Camera, lights: Lights) -> RenderSettings {
-    RenderSettings { width, height, camera, lights }
+    RenderSettings::new(width, height, camera, lights)
 }
 
 /// The expected radiance `(albedo/π) E⊥ max(0, n·l)` with the sun direction exactly as the renderer receives it.

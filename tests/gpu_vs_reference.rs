@@ -146,7 +146,7 @@ fn camera_inside_a_room_with_the_near_plane_cutting_walls_and_floor() {
         perspective(DVec3::new(-1.5, 2.5, 0.0), DVec3::new(-1.5, 0.0, 0.01), 60.0, 0.5),
     ];
     for (i, camera) in cams.into_iter().enumerate() {
-        let s = RenderSettings { width: 480, height: 320, camera, lights: sun_lights(DVec3::new(0.3, 1.0, 0.4)) };
+        let s = RenderSettings::new(480, 320, camera, sun_lights(DVec3::new(0.3, 1.0, 0.4)));
         check(&format!("room camera {i}"), &scene, &s, &mut gpu, 480 * 320 / 2);
     }
 }
@@ -165,7 +165,7 @@ fn triangles_crossing_the_near_plane_directly_ahead() {
     let mut gpu = CheckedRenderer::new();
     for znear in [0.05, 0.3, 1.0] {
         let camera = perspective(DVec3::new(0.2, 0.0, 0.5), DVec3::new(0.2, 0.0, -3.0), 75.0, znear);
-        let s = RenderSettings { width: 400, height: 300, camera, lights: sun_lights(DVec3::new(-0.2, 0.4, 1.0)) };
+        let s = RenderSettings::new(400, 300, camera, sun_lights(DVec3::new(-0.2, 0.4, 1.0)));
         check(&format!("near plane {znear}"), &scene, &s, &mut gpu, 400 * 300 / 20);
     }
 }
@@ -198,7 +198,7 @@ fn slivers_and_tiny_triangles() {
     let mut gpu = CheckedRenderer::new();
     for (w, h) in [(512, 512), (777, 333)] {
         let camera = perspective(DVec3::new(0.2, 0.3, 3.0), DVec3::ZERO, 45.0, 0.5);
-        let s = RenderSettings { width: w, height: h, camera, lights: sun_lights(DVec3::new(0.3, 0.5, 1.0)) };
+        let s = RenderSettings::new(w, h, camera, sun_lights(DVec3::new(0.3, 0.5, 1.0)));
         check("slivers and tiny triangles", &scene, &s, &mut gpu, (w * h / 10) as usize);
     }
 }
@@ -227,7 +227,7 @@ fn shared_edges_and_vertices_leave_no_gaps() {
         ],
     );
     let camera = perspective(DVec3::new(0.0, 0.3, 3.5), DVec3::ZERO, 45.0, 0.5);
-    let s = RenderSettings { width: 600, height: 400, camera, lights: sun_lights(DVec3::new(0.2, 0.6, 1.0)) };
+    let s = RenderSettings::new(600, 400, camera, sun_lights(DVec3::new(0.2, 0.6, 1.0)));
     let mut gpu = CheckedRenderer::new();
     check("fan and grid", &scene, &s, &mut gpu, 600 * 400 / 10);
     // No gaps: inside the fan's inscribed circle (projected), every pixel is covered on the GPU.
@@ -275,7 +275,7 @@ fn meshes_with_thousands_of_triangles() {
     );
     assert!(scene.triangle_count() > 50_000, "{}", scene.triangle_count());
     let camera = perspective(DVec3::new(0.0, 0.4, 3.0), DVec3::ZERO, 45.0, 0.5);
-    let s = RenderSettings { width: 800, height: 600, camera, lights: sun_lights(DVec3::new(0.5, 0.8, 0.6)) };
+    let s = RenderSettings::new(800, 600, camera, sun_lights(DVec3::new(0.5, 0.8, 0.6)));
     let mut gpu = CheckedRenderer::new();
     check("dense", &scene, &s, &mut gpu, 800 * 600 / 10);
 }
@@ -310,7 +310,7 @@ fn isolated_needles_at_a_size_that_is_not_a_power_of_two() {
     let dir = TempDir::new("needles");
     let scene = needle_field(&dir);
     let camera = perspective(DVec3::new(0.013, 0.007, 2.45), DVec3::new(0.013, 0.007, 0.0), 45.0, 0.5);
-    let s = RenderSettings { width: 1000, height: 1000, camera, lights: sun_lights(DVec3::new(0.1, 0.2, 1.0)) };
+    let s = RenderSettings::new(1000, 1000, camera, sun_lights(DVec3::new(0.1, 0.2, 1.0)));
     let mut gpu = CheckedRenderer::new();
     check_with("isolated needles", &scene, &s, &mut gpu, 100_000, 0);
 }

@@ -6,7 +6,9 @@ use clap::Args;
 use glam::DVec3;
 
 use crate::film::Exposure;
-use crate::settings::{CameraOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
+use crate::scene::DiskLight;
+use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
+use crate::shading::{DiskModel, ShadingOptions, SunModel};
 
 /// `x,y,z` → a finite vector.
 pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
@@ -31,6 +33,37 @@ pub fn parse_rgb(s: &str) -> Result<[f64; 3], String> {
         return Err(format!("'{s}': components must be non-negative"));
     }
     Ok(v.to_array())
+}
+
+/// A radiance: one non-negative number for all channels, or `r,g,b`.
+pub fn parse_radiance(s: &str) -> Result<[f64; 3], String> {
+    if s.contains(',') {
+        return parse_rgb(s);
+    }
+    let v = parse_finite(s)?;
+    if v < 0.0 {
+        return Err(format!("'{s}' must be non-negative"));
+    }
+    Ok([v; 3])
+}
+
+/// `x,y,z:nx,ny,nz:R:L0` → a disk light (centre [m], emission direction, radius [m], radiance, one value or r,g,b).
+pub fn parse_disk_light(s: &str) -> Result<DiskLight, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if parts.len() != 4 {
+        return Err(format!("expected centre:direction:radius:radiance (x,y,z:nx,ny,nz:R:L0), got '{s}'"));
+    }
+    let center = parse_vec3(parts[0])?;
+    let direction =
+        parse_vec3(parts[1])?.try_normalize().ok_or_else(|| format!("disk direction '{}' is zero", parts[1]))?;
+    let radius = parse_positive(parts[2])?;
+    let radiance = parse_radiance(parts[3])?;
+    Ok(DiskLight {
+        center: center.as_vec3(),
+        direction: direction.as_vec3(),
+        radius: radius as f32,
+        radiance: radiance.map(|v| v as f32),
+    })
 }
 
 /// A finite number.
@@ -117,11 +150,37 @@ pub struct SceneArgs {
     /// Per-channel factors on E⊥, r,g,b.
     #[arg(long, value_parser = parse_rgb, value_name = "R,G,B")]
     pub sun_color: Option<[f64; 3]>,
+
+    /// The sun as a disk (default: exact also while it sets) or as a single direction.
+    #[arg(long, default_value = "disk", value_name = "disk|delta")]
+    pub sun_model: SunModel,
+
+    /// Add a disk skylight: centre x,y,z [m], emission direction, radius [m], radiance L0 [W/(m²·sr)] (one value
+    /// or r,g,b). Repeatable.
+    #[arg(long = "disk-light", value_parser = parse_disk_light, allow_hyphen_values = true, value_name = "X,Y,Z:NX,NY,NZ:R:L0")]
+    pub disk_lights: Vec<DiskLight>,
+
+    /// Disk lights: the exact irradiance (default) or the small-source estimate L0·A·cosθr·cosθd/d².
+    #[arg(long, default_value = "exact", value_name = "exact|small-source")]
+    pub disk_model: DiskModel,
+
+    /// Overcast sky of uniform radiance L0 [W/(m²·sr)], one value or r,g,b (replaces the scene's sky).
+    #[arg(long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
+    pub sky_radiance: Option<[f64; 3]>,
 }
 
 impl SceneArgs {
     pub fn camera_options(&self) -> CameraOptions {
         CameraOptions { camera: self.camera, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
+    }
+
+    pub fn light_options(&self) -> LightOptions {
+        LightOptions {
+            sun: self.sun_options(),
+            disks: self.disk_lights.clone(),
+            sky: self.sky_radiance,
+            shading: ShadingOptions { sun: self.sun_model, disk: self.disk_model },
+        }
     }
 
     pub fn sun_options(&self) -> SunOptions {
@@ -164,5 +223,12 @@ mod tests {
         assert!(parse_rgb("1,-1,0").is_err());
         assert!(parse_positive("0").is_err());
         assert!(parse_finite("inf").is_err());
+        let d = parse_disk_light("0,3,0:0,-2,0:0.5:100,50,25").unwrap();
+        assert_eq!((d.center.y, d.direction.y, d.radius, d.radiance), (3.0, -1.0, 0.5, [100.0, 50.0, 25.0]));
+        assert_eq!(parse_disk_light("0,3,0:0,-1,0:0.5:7").unwrap().radiance, [7.0; 3]);
+        assert!(parse_disk_light("0,3,0:0,0,0:0.5:7").is_err());
+        assert!(parse_disk_light("0,3,0:0,-1,0:-0.5:7").is_err());
+        assert!(parse_disk_light("0,3,0:0,-1,0:0.5").is_err());
+        assert!(parse_radiance("-1").is_err());
     }
 }

@@ -122,7 +122,7 @@ fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), 
     for w in &scene.warnings {
         eprintln!("sunshade: warning: {}: {w}", a.scene.display());
     }
-    let settings = settings::resolve(&scene, a.width, a.height, &a.camera_options(), &a.sun_options())
+    let settings = settings::resolve_with(&scene, a.width, a.height, &a.camera_options(), &a.light_options())
         .map_err(|e| CliError::Usage(e.to_string()))?;
     Ok((scene, settings, load_time))
 }

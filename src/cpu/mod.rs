@@ -226,5 +226,5 @@ fn shade(scene: &Scene, settings: &RenderSettings, t: &Prepared, w: [f64; 3], vi
         viewer.truncate().as_dvec3()
     };
     let point = SurfacePoint { position, normal, to_viewer };
-    radiance_out(&scene.materials[t.material], &point, &settings.lights)
+    radiance_out(&scene.materials[t.material], &point, &settings.lights, &settings.shading)
 }

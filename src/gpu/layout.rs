@@ -4,8 +4,13 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::scene::{Brdf, Lights, Material};
 use crate::settings::RenderSettings;
+use crate::shading::{DiskModel, ShadingOptions, SunModel};
 
 pub const BRDF_LAMBERT: u32 = 0;
+pub const SUN_MODEL_DISK: u32 = 0;
+pub const SUN_MODEL_DELTA: u32 = 1;
+pub const DISK_MODEL_EXACT: u32 = 0;
+pub const DISK_MODEL_SMALL_SOURCE: u32 = 1;
 
 /// One vertex: world position [m] and unit normal, interleaved (`FLOATS_PER_VERTEX` = 6 floats in the shaders).
 #[repr(C)]
@@ -71,7 +76,7 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
 }
 
 /// The light buffer's bytes.
-pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
+pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
     let sun = match &lights.sun {
         Some(s) => SunGpu {
             direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
@@ -83,7 +88,15 @@ pub fn lights_bytes(lights: &Lights) -> Vec<u8> {
         Some(l) => [l[0], l[1], l[2], 1.0],
         None => [0.0; 4],
     };
-    let header = LightsHeader { sun, sky, counts: [lights.disks.len() as u32, 0, 0, 0] };
+    let sun_model = match shading.sun {
+        SunModel::Disk => SUN_MODEL_DISK,
+        SunModel::Delta => SUN_MODEL_DELTA,
+    };
+    let disk_model = match shading.disk {
+        DiskModel::Exact => DISK_MODEL_EXACT,
+        DiskModel::SmallSource => DISK_MODEL_SMALL_SOURCE,
+    };
+    let header = LightsHeader { sun, sky, counts: [lights.disks.len() as u32, sun_model, disk_model, 0] };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
         let disk = DiskGpu {

@@ -265,7 +265,7 @@ impl Renderer {
         self.lights = None;
         let lights = Buffer::with_data(
             &self.dev,
-            &lights_bytes(&settings.lights),
+            &lights_bytes(&settings.lights, &settings.shading),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             "lights",
         )?;

@@ -6,6 +6,7 @@
 /// Every file in `shaders/`, by name.
 pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../shaders/bindings.glsl")),
+    ("math.glsl", include_str!("../../shaders/math.glsl")),
     ("radiometry.glsl", include_str!("../../shaders/radiometry.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),

@@ -38,7 +38,8 @@ pub struct DiskLight {
 pub struct Lights {
     pub sun: Option<Sun>,
     pub disks: Vec<DiskLight>,
-    /// Overcast sky: uniform radiance [W/(m²·sr)] over the whole sphere of directions, per channel.
+    /// Overcast sky: uniform radiance [W/(m²·sr)] over the whole sphere of directions, per channel (no
+    /// occlusion: every surface sees the whole sky above its horizon).
     pub sky: Option<[f32; 3]>,
 }
 

@@ -3,8 +3,11 @@
 //! What is read: the chosen scene's node hierarchy (matrix or TRS transforms), every TRIANGLES primitive (other
 //! modes are skipped with a warning), u8/u16/u32 or no indices, POSITION and NORMAL (flat normals where a
 //! primitive has none, as the glTF spec requires), materials (`baseColorFactor` as the Lambertian albedo),
-//! cameras, and KHR_lights_punctual directional lights (the sun). Every problem is an error naming the file and
-//! the glTF object; nothing here panics on bad input.
+//! cameras, KHR_lights_punctual directional lights (the sun), disk skylights from node `extras`
+//! (`{"sunshade": {"light": "disk", "radius": R, "radiance": [r, g, b]}}`: a disk in the node's local XY plane at its
+//! origin, emitting towards local −Z) and the overcast sky from the scene's `extras`
+//! (`{"sunshade": {"sky_radiance": [r, g, b]}}`). Every problem is an error naming the file and the glTF object;
+//! nothing here panics on bad input.
 
 use std::path::{Path, PathBuf};
 
@@ -12,7 +15,7 @@ use glam::{DMat3, DMat4, DQuat, DVec3, Vec3};
 
 use super::accessor::AccessorReader;
 use super::camera::{Camera, Projection};
-use super::light::Sun;
+use super::light::{DiskLight, Sun};
 use super::material::{Brdf, Material};
 use super::uri::{self, UriTarget};
 use super::{Mesh, Scene};
@@ -118,6 +121,12 @@ impl<'a> Loader<'a> {
             let m = read_material(&material)?;
             self.scene.materials.push(m);
         }
+        if let Some(sky) = sunshade_extras(gscene.extras()).map_err(|e| format!("scene {}: {e}", gscene.index()))? {
+            if let Some(v) = sky.get("sky_radiance") {
+                let radiance = rgb(v).map_err(|e| format!("scene {} extras: sky_radiance {e}", gscene.index()))?;
+                self.scene.lights.sky = Some(radiance);
+            }
+        }
         let mut path = Vec::new();
         for node in gscene.nodes() {
             self.visit(&node, DMat4::IDENTITY, &mut path)?;
@@ -141,6 +150,9 @@ impl<'a> Loader<'a> {
         }
         if let Some(light) = node.light() {
             self.add_light(node, &light, &world);
+        }
+        if let Some(extras) = sunshade_extras(node.extras()).map_err(|e| format!("node {}: {e}", node.index()))? {
+            self.add_extras_light(node, &extras, &world)?;
         }
         path.push(node.index());
         for child in node.children() {
@@ -288,6 +300,72 @@ impl<'a> Loader<'a> {
             )),
         }
     }
+}
+
+impl Loader<'_> {
+    /// A disk light given by a node's `extras`.
+    fn add_extras_light(&mut self, node: &gltf::Node, extras: &serde_json::Value, world: &DMat4) -> Result<(), String> {
+        let at = |what: &str| format!("node {} extras: {what}", node.index());
+        match extras.get("light").and_then(|v| v.as_str()) {
+            Some("disk") => {}
+            Some(other) => {
+                self.scene
+                    .warnings
+                    .push(format!("{}; ignored", at(&format!("light '{other}' is not a sunshade light (disk)"))));
+                return Ok(());
+            }
+            None => return Ok(()),
+        }
+        let radius = extras
+            .get("radius")
+            .and_then(|v| v.as_f64())
+            .filter(|r| r.is_finite() && *r > 0.0)
+            .ok_or_else(|| at("disk light needs \"radius\": a positive number [m]"))?;
+        let radiance = rgb(extras.get("radiance").ok_or_else(|| at("disk light needs \"radiance\" [W/(m²·sr)]"))?)
+            .map_err(|e| at(&format!("radiance {e}")))?;
+        // The disk lies in the local XY plane; in world space it spans ex, ey. Its emission direction is the
+        // plane's normal on the side of the node's −Z (a mirrored node mirrors the light with it).
+        let (ex, ey) = (world.transform_vector3(DVec3::X), world.transform_vector3(DVec3::Y));
+        let normal = ex.cross(ey);
+        let minus_z = world.transform_vector3(-DVec3::Z);
+        let Some(direction) = (normal * normal.dot(minus_z).signum()).try_normalize() else {
+            return Err(at("the node's transform flattens the disk"));
+        };
+        let (lx, ly) = (ex.length(), ey.length());
+        if (lx - ly).abs() > 1e-6 * lx.max(ly) || ex.dot(ey).abs() > 1e-6 * lx * ly {
+            self.scene
+                .warnings
+                .push(at("disk light under a non-uniform scale or shear: drawn as the disk of equal area"));
+        }
+        let scale = normal.length().sqrt();
+        self.scene.lights.disks.push(DiskLight {
+            center: world.transform_point3(DVec3::ZERO).as_vec3(),
+            direction: direction.as_vec3(),
+            radius: (radius * scale) as f32,
+            radiance,
+        });
+        Ok(())
+    }
+}
+
+/// The `"sunshade"` object of an `extras` value, if any.
+fn sunshade_extras(extras: &gltf::json::Extras) -> Result<Option<serde_json::Value>, String> {
+    let Some(raw) = extras else { return Ok(None) };
+    let value: serde_json::Value = serde_json::from_str(raw.get()).map_err(|e| format!("extras are not JSON: {e}"))?;
+    Ok(value.get("sunshade").cloned())
+}
+
+/// A radiance: `[r, g, b]` or one number for all three, finite and non-negative [W/(m²·sr)].
+fn rgb(v: &serde_json::Value) -> Result<[f32; 3], String> {
+    let values: Vec<f64> = match v {
+        serde_json::Value::Number(n) => vec![n.as_f64().unwrap_or(f64::NAN); 3],
+        serde_json::Value::Array(a) if a.len() == 3 => a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
+        _ => return Err("must be a number or [r, g, b]".into()),
+    };
+    if values.iter().any(|x| !(x.is_finite() && *x >= 0.0 && *x <= f32::MAX as f64)) {
+        return Err(format!("{values:?} must be finite and non-negative"));
+    }
+    Ok([values[0] as f32, values[1] as f32, values[2] as f32])
 }
 
 fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {

@@ -4,7 +4,10 @@
 //! the GLSL in `shaders/` (`radiometry.glsl`, `brdf.glsl`, `shade.glsl`) mirrors it name for name in f32.
 
 pub mod brdf;
+pub mod quadrature;
 pub mod radiometry;
 mod shade;
 
-pub use shade::{radiance_out, safe_normalize, SurfacePoint};
+pub use shade::{
+    disk_geometry, irradiance, radiance_out, safe_normalize, DiskModel, ShadingOptions, SunModel, SurfacePoint,
+};

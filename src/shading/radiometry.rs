@@ -9,6 +9,8 @@
 
 use std::f64::consts::PI;
 
+use glam::DVec3;
+
 /// The sun's mean angular diameter seen from the Earth [degrees].
 pub const SUN_ANGULAR_DIAMETER_DEGREES: f64 = 0.53;
 
@@ -72,6 +74,238 @@ pub fn sun_irradiance_delta(irradiance_normal: f64, n_dot_l: f64) -> f64 {
     irradiance_normal * n_dot_l.max(0.0)
 }
 
+/// `atan(t) − t` without the cancellation of the direct difference for small `t` (≈ −t³/3): the Taylor series
+/// for `|t| < 0.5` (error below 1e-17 with 28 terms), the difference itself beyond, where it loses at most a factor
+/// 14 of relative precision.
+pub fn atan_minus_identity(t: f64) -> f64 {
+    if t.abs() >= 0.5 {
+        return t.atan() - t;
+    }
+    let t2 = t * t;
+    // Σ_{k≥1} (−1)^k t^{2k+1}/(2k+1), summed from the smallest term up.
+    let mut sum = 0.0;
+    for k in (1..=28).rev() {
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        sum = sum * t2 + sign / (2 * k + 1) as f64;
+    }
+    sum * t2 * t
+}
+
+/// Irradiance [W/m²] from the sun as a disk (a cone of directions of half-angle δ/2 and uniform radiance) on a
+/// surface whose normal makes angle θ with the sun's centre (`cos_theta = n·l`).
+///
+/// While the whole disk is above the horizon (`cos θ ≥ sin(δ/2)`) the result is exactly `E⊥ cos θ` (the cap's
+/// projected solid angle is `π sin²(δ/2) cos θ`). Within δ/2 of the horizon only part of the disk is visible; by
+/// the contour integral over its boundary (the cap's rim above the horizon and the horizon arc inside the cap;
+/// the same result as Snyder's sphere-light formula, e.g. Lagarde & de Rousiers 2014, §4.7.2):
+///
+/// `E/L = s² cosθ (π − φ₀) − c s sinθ sin φ₀ + atan(t)`, with `s, c = sin, cos(δ/2)`,
+/// `cos φ₀ = cot(δ/2) cot θ`, `t = s sinθ sinφ₀ / c`.
+///
+/// Precision: for the sun the last two terms are each about `1/σ ≈ 216` and cancel to ~1e-3. Since
+/// `c s sinθ sinφ₀ = c² t`, the sum is rewritten `s² (cosθ (π − φ₀) + t) + (atan(t) − t)`, and `atan(t) − t` is
+/// taken from its series: no term cancels. `acos` is avoided in favour of `atan2` (lavapipe's `acos` is off by up to
+/// 4e-4). E goes to 0 continuously and monotonically as the sun sets.
+pub fn sun_irradiance_disk(irradiance_normal: f64, cos_theta: f64, angular_diameter: f64) -> f64 {
+    let (s, c) = (0.5 * angular_diameter).sin_cos();
+    if cos_theta >= s {
+        return irradiance_normal * cos_theta;
+    }
+    if cos_theta <= -s {
+        return 0.0;
+    }
+    let sin_theta = ((1.0 - cos_theta) * (1.0 + cos_theta)).sqrt();
+    let k = ((c * cos_theta) / (s * sin_theta)).clamp(-1.0, 1.0);
+    let sin_phi0 = ((1.0 - k) * (1.0 + k)).sqrt();
+    let pi_minus_phi0 = sin_phi0.atan2(-k);
+    let t = s * sin_theta * sin_phi0 / c;
+    let projected = s * s * (cos_theta * pi_minus_phi0 + t) + atan_minus_identity(t);
+    irradiance_normal * projected / (PI * s * s)
+}
+
+/// Irradiance [W/m²] from a uniform overcast sky of radiance `L0` [W/(m²·sr)] over the whole sphere, unoccluded,
+/// on a surface tilted by `t` from up (`n_dot_up = cos t`): `E = π L0 (1 + cos t)/2`.
+pub fn sky_irradiance(radiance: f64, n_dot_up: f64) -> f64 {
+    PI * radiance * 0.5 * (1.0 + n_dot_up)
+}
+
+/// A disk light's geometry in world space: centre [m], unit emission direction, radius [m].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskGeometry {
+    pub center: DVec3,
+    pub direction: DVec3,
+    pub radius: f64,
+}
+
+/// The lecture's small-source estimate of a disk's projected solid angle [sr] from `x` with normal `n`:
+/// `A cosθ_receiver cosθ_disk / d²` (`A = πR²`, d the distance to the centre; each cosine clamped at 0). Under a
+/// disk at height f facing down it is `A (n·l)⁴ / f²` on the floor. `E ≈ L0 ·` this.
+pub fn disk_projected_solid_angle_small_source(x: DVec3, n: DVec3, disk: &DiskGeometry) -> f64 {
+    let to_disk = disk.center - x;
+    let d2 = to_disk.length_squared();
+    if d2 == 0.0 {
+        return 0.0;
+    }
+    let d = d2.sqrt();
+    let cos_receiver = (n.dot(to_disk) / d).max(0.0);
+    let cos_disk = (-disk.direction.dot(to_disk) / d).max(0.0);
+    PI * disk.radius * disk.radius * cos_receiver * cos_disk / d2
+}
+
+/// The exact projected solid angle [sr] of the part of a disk that lies above the horizon of a receiver at `x`
+/// with unit normal `n` (0 behind the disk's emitting face): `E = L0 ·` this.
+///
+/// By Stokes' theorem the projected solid angle of a region is `−½ ∮ n·(p × dp)/|p|²` around its boundary (the
+/// contour form of the irradiance integral; Lambert's polygon formula is its special case). For a disk
+/// entirely above the horizon the integral has a closed form, the vector irradiance
+/// `Φ = −2πR²h²/(S(S + ρ² + h² − R²)) d − 2πhR²/(S(a + S)) r⊥`, with h the receiver's height above the disk plane,
+/// r⊥ its offset from the axis in that plane (ρ = |r⊥|), `a = ρ² + h² + R²`, `S² = a² − 4ρ²R²`; on the axis it
+/// gives `πR²/(R² + h²)` and its d-component is the parallel-plane view factor
+/// `(π/2)(1 − (h² + ρ² − R²)/S)`. Written this way nothing cancels (the textbook `1 − (…)/S` loses four digits
+/// for R/h = 0.05 in f32) and nothing divides by ρ.
+///
+/// A disk cut by the horizon leaves a circular segment, bounded by an arc of the rim and a chord in the horizon
+/// plane. The chord contributes half the angle it subtends; the arc, `½∫(A0 + A1 cosφ + A2 sinφ)/(B0 + B cosφ)`,
+/// is integrated in closed form with tangent half-angles ([`rim_integrals`]).
+pub fn disk_projected_solid_angle(x: DVec3, n: DVec3, disk: &DiskGeometry) -> f64 {
+    let (d, radius) = (disk.direction, disk.radius);
+    let r = x - disk.center;
+    let h = r.dot(d);
+    if !(h > 0.0 && radius > 0.0) {
+        return 0.0;
+    }
+    let r_perp = r - h * d;
+    let rho2 = r_perp.length_squared();
+    // Rim points relative to x: p(φ) = q + R (cos φ e1 + sin φ e2), q = C − x. Their height above the horizon is
+    // n·q + R (n_perp · u(φ)), between n·q − R|n_perp| and n·q + R|n_perp|.
+    let q = -r;
+    let n_d = n.dot(d);
+    let n_perp_len = (n - n_d * d).length();
+    let nq = n.dot(q);
+    if nq - radius * n_perp_len >= 0.0 {
+        return full_disk_projected_solid_angle(n, d, r_perp, h, rho2, radius);
+    }
+    if nq + radius * n_perp_len <= 0.0 {
+        return 0.0;
+    }
+    partial_disk_projected_solid_angle(n, d, q, r_perp, h, rho2.sqrt(), radius)
+}
+
+/// `n·Φ` for a disk entirely above the horizon (see [`disk_projected_solid_angle`]).
+fn full_disk_projected_solid_angle(n: DVec3, d: DVec3, r_perp: DVec3, h: f64, rho2: f64, radius: f64) -> f64 {
+    let (h2, r2) = (h * h, radius * radius);
+    let a = rho2 + h2 + r2;
+    // S² = a² − 4ρ²R² = (ρ² − R²)² + 2h²(ρ² + R²) + h⁴, a sum of non-negative terms.
+    let rho = rho2.sqrt();
+    let diff = (rho - radius) * (rho + radius);
+    let s = (diff * diff + 2.0 * h2 * (rho2 + r2) + h2 * h2).sqrt();
+    let b = rho2 + h2 - r2;
+    // (π/2)(1 − b/S): when b ≥ 0 the difference cancels, and 1 − b/S = 4R²h²/(S(S + b)) instead.
+    let axial = if b >= 0.0 { 2.0 * PI * r2 * h2 / (s * (s + b)) } else { 0.5 * PI * (1.0 - b / s) };
+    let radial = 2.0 * PI * h * r2 / (s * (a + s));
+    -axial * n.dot(d) - radial * n.dot(r_perp)
+}
+
+/// The segment of a disk above the horizon: rim arc plus chord (see [`disk_projected_solid_angle`]).
+fn partial_disk_projected_solid_angle(
+    n: DVec3,
+    d: DVec3,
+    q: DVec3,
+    r_perp: DVec3,
+    h: f64,
+    rho: f64,
+    radius: f64,
+) -> f64 {
+    // Frame in the disk plane: e1 from the receiver's axis foot towards the axis (any direction on the axis).
+    let e1 = if rho > 0.0 { -r_perp / rho } else { d.any_orthonormal_vector() };
+    let e2 = d.cross(e1);
+    let (n1, n2, n_d) = (n.dot(e1), n.dot(e2), n.dot(d));
+    // Visible arc: n·q + R m cos(φ − γ) ≥ 0.
+    let m = (n1 * n1 + n2 * n2).sqrt();
+    let gamma = n2.atan2(n1);
+    let kappa = (-n.dot(q) / (radius * m)).clamp(-1.0, 1.0);
+    let alpha = ((1.0 - kappa) * (1.0 + kappa)).sqrt().atan2(kappa);
+    let (b0, b) = (h * h + rho * rho + radius * radius, 2.0 * radius * rho);
+    let (j0, jc, js) = rim_integrals(gamma - alpha, gamma + alpha, b0, b);
+    // The integrand's numerator, R [n_d R + (n_d ρ + h n1) cos φ + h n2 sin φ].
+    let rim = radius * (n_d * radius * j0 + (n_d * rho + h * n1) * jc + h * n2 * js);
+    // The chord from the arc's end back to its start, in the horizon plane: half the angle it subtends, signed.
+    let rim_point = |phi: f64| q + radius * (phi.cos() * e1 + phi.sin() * e2);
+    let (pa, pb) = (rim_point(gamma - alpha), rim_point(gamma + alpha));
+    let cross = pb.cross(pa);
+    let theta = cross.length().atan2(pb.dot(pa));
+    let chord = theta * n.dot(cross).signum();
+    -0.5 * (rim + chord)
+}
+
+/// `(∫dφ/D, ∫cos φ dφ/D, ∫sin φ dφ/D)` over `[φa, φb]` (length ≤ 2π), `D = B0 + B cos φ`, `0 ≤ B < B0`.
+///
+/// The arc is cut at ±π so that each piece has finite tangent half-angles `t = tan(φ/2)`. With `ε = B/B0` and
+/// `λ = √((1−ε)/(1+ε))`: `∫dφ/D = 2/(B0√(1−ε²)) [atan(λt)]`, and `∫cos φ/D = (Δφ − B0∫dφ/D)/B`, which cancels
+/// as ε → 0 (near the disk's axis); it is computed from `atan(t) − atan(λt) = atan((1−λ)/(1/t + λt))` and
+/// `1/√(1−ε²) − 1 = ε²/(√(1−ε²)(1 + √(1−ε²)))`, both O(ε), so the division by ε is harmless.
+/// `∫sin φ/D = ln((B0 + B cos φa)/(B0 + B cos φb))/B` is taken as `Δcos/(…) · log1p(x)/x`.
+pub fn rim_integrals(phi_a: f64, phi_b: f64, b0: f64, b: f64) -> (f64, f64, f64) {
+    let mut pieces = [(0.0, 0.0); 3];
+    let mut count = 0;
+    let mut push = |a: f64, z: f64| {
+        if z > a {
+            pieces[count] = (a, z);
+            count += 1;
+        }
+    };
+    // Bring the arc's start into [−π, π) and cut at π (the arc may wrap once).
+    let shift = ((phi_a + PI) / (2.0 * PI)).floor() * 2.0 * PI;
+    let (a, z) = ((phi_a - shift).max(-PI), phi_b - shift);
+    push(a, z.min(PI));
+    push(-PI, (z - 2.0 * PI).min(PI));
+    let eps = b / b0;
+    let sq = ((1.0 - eps) * (1.0 + eps)).sqrt();
+    let lambda = ((1.0 - eps) / (1.0 + eps)).sqrt();
+    let one_minus_lambda = 2.0 * eps / ((1.0 + eps).sqrt() * ((1.0 + eps).sqrt() + (1.0 - eps).sqrt()));
+    let inv_sq_minus_one = eps * eps / (sq * (1.0 + sq));
+    let (mut j0, mut jc, mut js) = (0.0, 0.0, 0.0);
+    for &(pa, pb) in &pieces[..count] {
+        let (ta, tb) = (tan_half(pa), tan_half(pb));
+        // atan(λt); at t = ±∞ (φ = ±π) the limits ±π/2.
+        let g_lambda = (lambda * tb).atan() - (lambda * ta).atan();
+        j0 += 2.0 / (b0 * sq) * g_lambda;
+        if eps == 0.0 {
+            jc += (pb.sin() - pa.sin()) / b0;
+        } else {
+            let diff = |t: f64| (one_minus_lambda / (1.0 / t + lambda * t)).atan();
+            let g1_minus_glambda = diff(tb) - diff(ta);
+            jc += 2.0 * (g1_minus_glambda - g_lambda * inv_sq_minus_one) / b;
+        }
+        let dcos = 2.0 * (0.5 * (pa + pb)).sin() * (0.5 * (pb - pa)).sin(); // cos φa − cos φb
+        let denom = b0 + b * pb.cos();
+        let x = b * dcos / denom;
+        js += dcos / denom * log1p_over_x(x);
+    }
+    (j0, jc, js)
+}
+
+/// `tan(φ/2)` for φ in [−π, π], with ±π mapped to ±1e30 explicitly: in f32, π/2 rounds above the true π/2 and
+/// its tangent comes out hugely *negative*, which would flip an `atan` by π.
+fn tan_half(phi: f64) -> f64 {
+    if phi >= PI {
+        1e30
+    } else if phi <= -PI {
+        -1e30
+    } else {
+        (0.5 * phi).tan()
+    }
+}
+
+/// `log1p(x)/x`, 1 at x = 0.
+pub fn log1p_over_x(x: f64) -> f64 {
+    if x == 0.0 {
+        1.0
+    } else {
+        x.ln_1p() / x
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,6 +360,250 @@ mod tests {
         let disk = |a: f64| rel(small_cone_solid_angle(PI * a.tan().powi(2), 1.0), cone_solid_angle(a));
         assert!((disk(a_sun) - 0.75 * a_sun * a_sun).abs() < 1e-9);
         assert!((disk(PI / 3.0) - 2.0).abs() < 1e-12);
+    }
+
+    use crate::shading::quadrature::integrate;
+
+    /// `∫_a^b f` by `panels` Gauss–Legendre panels of `order` points: converges on near-singular integrands.
+    fn composite(a: f64, b: f64, panels: usize, order: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
+        let h = (b - a) / panels as f64;
+        (0..panels).map(|i| integrate(a + i as f64 * h, a + (i + 1) as f64 * h, order, &mut f)).sum()
+    }
+
+    /// Projected solid angle of the visible part of a disk by Gauss–Legendre over the visible region itself.
+    /// In the disk plane, with w along the in-plane part of n and v across it, the region above the horizon is
+    /// `a > a*` within the disk; with `a = R sin θ`, `b = R cos θ · s` it becomes the rectangle
+    /// `θ ∈ [asin(a*/R), π/2]`, `s ∈ [−1, 1]`, `dA = R² cos²θ dθ ds`, on which the integrand
+    /// `n·y · h / |y|⁴` is smooth. Independent of the contour formula.
+    fn disk_numerical(x: DVec3, n: DVec3, disk: &DiskGeometry, panels: usize) -> f64 {
+        let (d, radius) = (disk.direction, disk.radius);
+        let q = disk.center - x;
+        let h = -d.dot(q);
+        if h <= 0.0 {
+            return 0.0;
+        }
+        let n_perp = n - n.dot(d) * d;
+        let m = n_perp.length();
+        let w = if m > 0.0 { n_perp / m } else { d.any_orthonormal_vector() };
+        let v = d.cross(w);
+        // n·(q + a w + b v) = n·q + a m > 0  ⇔  a > a*.
+        let theta_lo = if m > 0.0 {
+            (-n.dot(q) / (m * radius)).clamp(-1.0, 1.0).asin()
+        } else if n.dot(q) > 0.0 {
+            -0.5 * PI
+        } else {
+            return 0.0;
+        };
+        let f = |theta: f64, s: f64| {
+            let (st, ct) = theta.sin_cos();
+            let y = q + radius * st * w + radius * ct * s * v;
+            let d2 = y.length_squared();
+            n.dot(y).max(0.0) * h / (d2 * d2) * radius * radius * ct * ct
+        };
+        composite(theta_lo, 0.5 * PI, panels, 24, |theta| composite(-1.0, 1.0, panels, 24, |s| f(theta, s)))
+    }
+
+    /// The numerical value, checked converged by doubling the panels.
+    fn disk_converged(x: DVec3, n: DVec3, disk: &DiskGeometry) -> f64 {
+        let (a, b) = (disk_numerical(x, n, disk, 6), disk_numerical(x, n, disk, 12));
+        assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-9), "quadrature not converged at {x} {n}: {a} {b}");
+        b
+    }
+
+    fn down_disk(height: f64, radius: f64) -> DiskGeometry {
+        DiskGeometry { center: DVec3::new(0.0, height, 0.0), direction: -DVec3::Y, radius }
+    }
+
+    #[test]
+    fn disk_on_axis_and_off_axis_match_the_view_factor_formulas() {
+        for (f, r) in [(2.0, 0.1), (2.0, 0.5), (2.0, 2.0), (2.0, 8.0), (1.0, 1e-3)] {
+            let disk = down_disk(f, r);
+            let on_axis = disk_projected_solid_angle(DVec3::ZERO, DVec3::Y, &disk);
+            assert!(rel(on_axis, PI * r * r / (r * r + f * f)) < 1e-14, "{f} {r}: {on_axis}");
+            for rho in [0.01, 0.3, 1.0, 1.999, 2.0, 2.001, 5.0, 40.0] {
+                let x = DVec3::new(rho * 0.6, 0.0, rho * 0.8);
+                let got = disk_projected_solid_angle(x, DVec3::Y, &disk);
+                let (a, b) = (f * f + rho * rho + r * r, f * f + rho * rho - r * r);
+                let s = (a * a - 4.0 * rho * rho * r * r).sqrt();
+                let want = 0.5 * PI * (1.0 - b / s);
+                // The textbook form itself cancels for small sources: compare to its own precision.
+                let tol = 1e-13 * (a / (want * s)).max(1.0);
+                assert!(rel(got, want) < tol.max(1e-12), "f {f} R {r} ρ {rho}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn disk_matches_numerical_integration_for_any_orientation() {
+        let disk = DiskGeometry {
+            center: DVec3::new(0.2, 2.0, -0.1),
+            direction: DVec3::new(0.1, -1.0, 0.2).normalize(),
+            radius: 0.8,
+        };
+        let mut worst = 0.0f64;
+        let mut partial = 0;
+        for i in 0..60 {
+            let a = i as f64 * 0.7;
+            let x = DVec3::new(1.3 * a.sin(), 0.3 * (1.7 * a).cos(), 1.1 * (0.6 * a).cos());
+            let n = DVec3::new((1.3 * a).cos(), (0.9 * a).sin() + 0.2, (2.1 * a).sin()).normalize();
+            let got = disk_projected_solid_angle(x, n, &disk);
+            let want = disk_converged(x, n, &disk);
+            let q = disk.center - x;
+            let n_perp = (n - n.dot(disk.direction) * disk.direction).length();
+            if (n.dot(q)).abs() < disk.radius * n_perp {
+                partial += 1;
+            }
+            if want > 1e-9 {
+                worst = worst.max(rel(got, want));
+            } else {
+                assert!(got.abs() < 1e-9, "{got} vs {want}");
+            }
+        }
+        assert!(partial > 10, "only {partial} partly visible cases");
+        assert!(worst < 1e-10, "worst relative error {worst}");
+    }
+
+    #[test]
+    fn tilted_receivers_under_a_disk_partly_below_their_horizon() {
+        let disk = down_disk(2.0, 1.5);
+        for tilt_degrees in [30.0, 60.0, 89.0, 89.99] {
+            let t = degrees_to_radians(tilt_degrees);
+            let n = DVec3::new(t.sin(), t.cos(), 0.0);
+            for x in [DVec3::ZERO, DVec3::new(0.5, 0.0, 0.3), DVec3::new(-1.0, 0.5, 0.0), DVec3::new(1.4, 0.0, -0.2)] {
+                let got = disk_projected_solid_angle(x, n, &disk);
+                let want = disk_converged(x, n, &disk);
+                assert!(rel(got, want) < 1e-10, "{tilt_degrees}° at {x}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn receivers_behind_or_in_the_plane_of_the_disk_get_nothing() {
+        let disk = down_disk(2.0, 1.0);
+        assert_eq!(disk_projected_solid_angle(DVec3::new(0.0, 3.0, 0.0), -DVec3::Y, &disk), 0.0);
+        assert_eq!(disk_projected_solid_angle(DVec3::new(3.0, 2.0, 0.0), DVec3::Y, &disk), 0.0);
+        // Facing away from the disk: the whole disk is below the horizon.
+        assert_eq!(disk_projected_solid_angle(DVec3::ZERO, -DVec3::Y, &disk), 0.0);
+    }
+
+    #[test]
+    fn small_source_estimate_on_the_floor_is_l0_a_cos4_over_f2() {
+        let disk = down_disk(2.0, 0.1);
+        for x in [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.5), DVec3::new(-3.0, 0.0, 2.0)] {
+            let cos = 2.0 / (disk.center - x).length();
+            let want = PI * 0.01 * cos.powi(4) / 4.0;
+            assert!(rel(disk_projected_solid_angle_small_source(x, DVec3::Y, &disk), want) < 1e-14);
+        }
+        // The estimate converges to the exact value as the disk shrinks, and differs for a big one.
+        let exact = |r: f64| disk_projected_solid_angle(DVec3::ZERO, DVec3::Y, &down_disk(2.0, r));
+        let small = |r: f64| disk_projected_solid_angle_small_source(DVec3::ZERO, DVec3::Y, &down_disk(2.0, r));
+        assert!(rel(small(0.01), exact(0.01)) < 3e-5);
+        assert!(rel(small(2.0), exact(2.0)) > 0.5);
+    }
+
+    #[test]
+    fn rim_integrals_match_quadrature_on_and_off_the_axis() {
+        for (b0, b) in [(2.0, 0.0), (2.0, 1e-9), (2.0, 1e-3), (2.0, 1.0), (2.0, 1.99)] {
+            for (pa, pb) in [(-0.3, 1.2), (2.0, 4.0), (-3.5, -2.9), (-1.0, 5.0), (0.0, 2.0 * PI)] {
+                let (j0, jc, js) = rim_integrals(pa, pb, b0, b);
+                let w0 = composite(pa, pb, 200, 32, |p| 1.0 / (b0 + b * p.cos()));
+                let wc = composite(pa, pb, 200, 32, |p| p.cos() / (b0 + b * p.cos()));
+                let ws = composite(pa, pb, 200, 32, |p| p.sin() / (b0 + b * p.cos()));
+                for (g, w) in [(j0, w0), (jc, wc), (js, ws)] {
+                    assert!((g - w).abs() < 1e-11 * w0.abs(), "B0 {b0} B {b} [{pa}, {pb}]: {g} vs {w}");
+                }
+            }
+        }
+    }
+
+    /// The sun's projected solid angle by quadrature over the cap's directions: polar angle β from the sun's
+    /// centre, azimuth ψ, visible where n·ω > 0 (a ψ-interval for each β).
+    fn sun_numerical(cos_theta: f64, sigma: f64, order: usize) -> f64 {
+        let sin_theta = (1.0 - cos_theta * cos_theta).sqrt();
+        let inner = |beta: f64| {
+            // n·ω = cos β cos θ + sin β sin θ cos ψ > 0.
+            let (sb, cb) = beta.sin_cos();
+            let f = |psi: f64| (cb * cos_theta + sb * sin_theta * psi.cos()).max(0.0) * sb;
+            let bound = if sb * sin_theta == 0.0 { 2.0 } else { -cb * cos_theta / (sb * sin_theta) };
+            if bound <= -1.0 {
+                integrate(0.0, 2.0 * PI, order, f)
+            } else if bound >= 1.0 {
+                0.0
+            } else {
+                2.0 * integrate(0.0, bound.acos(), order, f)
+            }
+        };
+        // The ψ-interval changes form where the bound crosses ±1.
+        let mut cuts = vec![0.0, sigma];
+        let b = (cos_theta / sin_theta).abs().atan();
+        if b > 0.0 && b < sigma {
+            cuts.insert(1, b);
+        }
+        cuts.windows(2).map(|w| integrate(w[0], w[1], order, inner)).sum()
+    }
+
+    #[test]
+    fn partly_set_sun_matches_numerical_integration_over_the_cap() {
+        for diameter_degrees in [0.53, 5.0, 30.0] {
+            let delta = degrees_to_radians(diameter_degrees);
+            let sigma = 0.5 * delta;
+            for frac in [-0.999, -0.7, -0.3, 0.0, 0.2, 0.6, 0.95, 0.999] {
+                let theta = 0.5 * PI - frac * sigma;
+                let e = sun_irradiance_disk(1.0, theta.cos(), delta);
+                let want = sun_numerical(theta.cos(), sigma, 200) / sun_projected_solid_angle(delta);
+                assert!(
+                    (e - want).abs() < 1e-10 * want.max(1e-12) + 1e-14,
+                    "δ {diameter_degrees}° frac {frac}: {e} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sun_irradiance_is_continuous_and_monotone_through_sunset() {
+        let delta = degrees_to_radians(0.53);
+        let sigma = 0.5 * delta;
+        let steps = 20_000;
+        let mut prev = f64::INFINITY;
+        let mut max_jump = 0.0f64;
+        for i in 0..=steps {
+            // Elevation of the centre from +2σ down to −2σ.
+            let elevation = sigma * (2.0 - 4.0 * i as f64 / steps as f64);
+            let e = sun_irradiance_disk(1000.0, elevation.sin(), delta);
+            assert!(e <= prev + 1e-12, "not monotone at elevation {elevation}");
+            if prev.is_finite() {
+                max_jump = max_jump.max(prev - e);
+            }
+            prev = e;
+        }
+        // A step of 4σ/20000 in elevation moves E by at most E⊥ · step (the slope of E⊥ sin(elevation) ≤ E⊥).
+        let step = 4.0 * sigma / steps as f64;
+        assert!(max_jump <= 1000.0 * step * 1.0001, "jump {max_jump} > {}", 1000.0 * step);
+        assert_eq!(sun_irradiance_disk(1000.0, (-1.01 * sigma).sin(), delta), 0.0);
+        let above = (1.01 * sigma).sin();
+        assert_eq!(sun_irradiance_disk(1000.0, above, delta), 1000.0 * above);
+        // Half set: E/E⊥ = 2σ/(3π) to leading order (the visible half-disk's mean elevation is 4σ/(3π)).
+        let half = sun_irradiance_disk(1.0, 0.0, delta);
+        assert!(rel(half, 2.0 * sigma / (3.0 * PI)) < 1e-4, "{half}");
+    }
+
+    #[test]
+    fn sky_irradiance_of_an_overcast_day() {
+        assert!(rel(sky_irradiance(100.0, 1.0), PI * 100.0) < 1e-15);
+        assert!(rel(sky_irradiance(100.0, 0.0), PI * 50.0) < 1e-15);
+        assert_eq!(sky_irradiance(100.0, -1.0), 0.0);
+    }
+
+    #[test]
+    fn atan_minus_identity_is_accurate_near_zero() {
+        for t in [1e-8, 1e-4, 0.01, 0.3, 0.49, 0.5, 2.0, -0.2] {
+            // Reference from the series in higher effective precision: compare with atan(t) − t where that is
+            // well conditioned, and with −t³/3 + t⁵/5 for tiny t.
+            let got = atan_minus_identity(t);
+            let want = if t.abs() < 1e-3 { -t.powi(3) / 3.0 + t.powi(5) / 5.0 } else { t.atan() - t };
+            let tol = if t.abs() < 1e-3 { 1e-15 } else { 1e-15 / (want / t).abs() };
+            assert!(rel(got, want) < tol.max(1e-15), "{t}: {got} vs {want}");
+        }
     }
 
     #[test]
