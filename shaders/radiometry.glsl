@@ -137,6 +137,36 @@ vec3 rim_integrals(float phi_a, float phi_b, float b0, float b) {
     return j;
 }
 
+// A partly visible disk's segment is integrated directly when it is thin (rim arc half-angle below this) or the
+// receiver is at least a radius from every point of the disk; the contour form is used otherwise (see the Rust).
+const float THIN_SEGMENT_ALPHA = 0.3;
+// 16-point Gauss-Legendre, the positive half (nodes, weights); the rule is symmetric.
+const float GL16_X[8] = float[8](0.095012509837637441, 0.28160355077925892, 0.45801677765722737, 0.61787624440264377, 0.755404408355003, 0.86563120238783176, 0.9445750230732326, 0.98940093499164994);
+const float GL16_W[8] = float[8](0.18945061045506864, 0.18260341504492364, 0.16915651939500265, 0.14959598881657671, 0.12462897125553407, 0.095158511682492605, 0.062253523938647456, 0.027152459411754176);
+
+// The projected solid angle of a visible segment by 16 x 16 Gauss-Legendre over beta in [0, alpha] and
+// s in [-1, 1]: the integrand (n.y) h / |y|^4 R^2 sin^2(beta) is positive and smooth, so nothing cancels.
+float segment_projected_solid_angle(vec3 n, vec3 d, vec3 q, float h, float radius, float alpha) {
+    vec3 w = normalize(n - dot(n, d) * d);
+    vec3 v = cross(d, w);
+    float sum = 0.0;
+    for (int i = 0; i < 16; ++i) {
+        float xb = i < 8 ? -GL16_X[7 - i] : GL16_X[i - 8];
+        float wb = i < 8 ? GL16_W[7 - i] : GL16_W[i - 8];
+        float beta = 0.5 * alpha * (xb + 1.0);
+        float sb = sin(beta);
+        float cb = cos(beta);
+        for (int j = 0; j < 16; ++j) {
+            float xs = j < 8 ? -GL16_X[7 - j] : GL16_X[j - 8];
+            float ws = j < 8 ? GL16_W[7 - j] : GL16_W[j - 8];
+            vec3 y = q + radius * cb * w + radius * sb * xs * v;
+            float d2 = dot(y, y);
+            sum += wb * ws * max(dot(n, y), 0.0) * h / (d2 * d2) * radius * radius * sb * sb;
+        }
+    }
+    return sum * 0.5 * alpha;
+}
+
 // The segment of a disk above the horizon: rim arc plus chord.
 float partial_disk_projected_solid_angle(vec3 n, vec3 d, vec3 q, vec3 r_perp, float h, float rho, float radius) {
     vec3 e1 = rho > 0.0 ? -r_perp / rho : any_orthonormal_vector(d);
@@ -148,6 +178,10 @@ float partial_disk_projected_solid_angle(vec3 n, vec3 d, vec3 q, vec3 r_perp, fl
     float gamma = atan2_accurate(n2, n1);
     float kappa = clamp(-dot(n, q) / (radius * m), -1.0, 1.0);
     float alpha = atan2_accurate(sqrt((1.0 - kappa) * (1.0 + kappa)), kappa);
+    float beyond_rim = max(rho - radius, 0.0);
+    if (alpha < THIN_SEGMENT_ALPHA || h * h + beyond_rim * beyond_rim >= radius * radius) {
+        return segment_projected_solid_angle(n, d, q, h, radius, alpha);
+    }
     float b0 = h * h + rho * rho + radius * radius;
     float b = 2.0 * radius * rho;
     vec3 j = rim_integrals(gamma - alpha, gamma + alpha, b0, b);

@@ -15,8 +15,9 @@ use sunshade::authoring::shapes::{cube, grid, quad, triangle_soup, uv_sphere, Me
 use sunshade::authoring::{GltfBuilder, Node, Transform};
 use sunshade::compare::{self, DiffOptions, PixelDiff};
 use sunshade::cpu::{self, ReferenceOptions};
-use sunshade::scene::{Camera, Lights, Projection, Scene, Sun};
+use sunshade::scene::{Camera, DiskLight, Lights, Projection, Scene, Sun};
 use sunshade::settings::{self, CameraOptions, RenderSettings, SunOptions};
+use sunshade::shading::{DiskModel, ShadingOptions, SunModel};
 
 const INTERIOR_REL_TOLERANCE: f64 = 1e-5;
 
@@ -313,4 +314,63 @@ fn isolated_needles_at_a_size_that_is_not_a_power_of_two() {
     let s = RenderSettings::new(1000, 1000, camera, sun_lights(DVec3::new(0.1, 0.2, 1.0)));
     let mut gpu = CheckedRenderer::new();
     check_with("isolated needles", &scene, &s, &mut gpu, 100_000, 0);
+}
+
+#[test]
+fn every_light_and_model_on_the_teapot_and_spheres() {
+    let mut gpu = CheckedRenderer::new();
+    for model in ["teapot.glb", "spheres.glb"] {
+        let scene = common::load(&models_dir().join(model));
+        let bs = scene.bounding_sphere().unwrap();
+        // Disk lights outside the model, placed and sized by its bounding sphere (centre c, radius r).
+        let disk = |offset: [f64; 3], radius: f64, l: f32| {
+            let at = DVec3::from_array(offset) * bs.radius;
+            DiskLight {
+                center: (bs.center + at).as_vec3(),
+                direction: (-at).normalize().as_vec3(),
+                radius: (radius * bs.radius) as f32,
+                radiance: [l, 0.8 * l, 0.6 * l],
+            }
+        };
+        let top = disk([0.0, 1.6, 0.7], 0.5, 300.0);
+        let side = disk([1.4, 0.3, 1.2], 0.2, 800.0);
+        let sun = |elevation_degrees: f64| Sun {
+            direction: settings::sun_direction_from_angles(elevation_degrees, 40.0).as_vec3(),
+            irradiance: [1000.0; 3],
+            angular_diameter: 0.53f32.to_radians(),
+        };
+        let cases: Vec<(&str, Lights, ShadingOptions)> = vec![
+            (
+                "disk skylights, exact",
+                Lights { disks: vec![top, side], ..Default::default() },
+                ShadingOptions::default(),
+            ),
+            (
+                "disk skylights, small source",
+                Lights { disks: vec![top, side], ..Default::default() },
+                ShadingOptions { disk: DiskModel::SmallSource, ..Default::default() },
+            ),
+            (
+                "overcast sky",
+                Lights { sky: Some([100.0, 90.0, 80.0]), ..Default::default() },
+                ShadingOptions::default(),
+            ),
+            ("sun setting (disk)", Lights { sun: Some(sun(0.1)), ..Default::default() }, ShadingOptions::default()),
+            (
+                "sun setting (delta)",
+                Lights { sun: Some(sun(0.1)), ..Default::default() },
+                ShadingOptions { sun: SunModel::Delta, ..Default::default() },
+            ),
+            (
+                "everything",
+                Lights { sun: Some(sun(30.0)), disks: vec![top], sky: Some([20.0, 20.0, 25.0]) },
+                ShadingOptions::default(),
+            ),
+        ];
+        let base = settings::resolve(&scene, 480, 360, &CameraOptions::default(), &SunOptions::default()).unwrap();
+        for (name, lights, shading) in &cases {
+            let s = RenderSettings { lights: lights.clone(), shading: *shading, ..base.clone() };
+            check(&format!("{model}, {name}"), &scene, &s, &mut gpu, 480 * 360 / 20);
+        }
+    }
 }
