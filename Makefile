@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models bench clean
+.PHONY: setup build render test lint models bench images clean
 
 setup:
 	@./scripts/setup.sh
@@ -26,6 +26,13 @@ lint:
 bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
+
+# Regenerates the pictures in README.md: one scene per kind of light.
+images: build
+	mkdir -p docs/images
+	for m in teapot.glb room.gltf overcast.glb sunset.glb; do \
+		$(SUNSHADE) render models/$$m -o docs/images/$${m%.*}.png --width 640 --height 480 || exit 1; \
+	done
 
 # Regenerates the generated scenes in models/.
 models:
