@@ -58,7 +58,12 @@ fn camera_node(b: &mut GltfBuilder, eye: Vec3, target: Vec3, yfov_degrees: f32) 
     let forward = (target - eye).normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let look = Quat::from_mat3(&glam::Mat3::from_cols(right, right.cross(forward), -forward));
-    b.add_node(Node { name: Some("camera".into()), camera: Some(cam), transform: trs(eye.to_array(), look, 1.0), ..Default::default() })
+    b.add_node(Node {
+        name: Some("camera".into()),
+        camera: Some(cam),
+        transform: trs(eye.to_array(), look, 1.0),
+        ..Default::default()
+    })
 }
 
 /// A node holding a disk skylight (local XY plane, emitting towards local −Z) of radius [m] and radiance
@@ -67,12 +72,21 @@ fn ceiling_disk(b: &mut GltfBuilder, center: Vec3, radius: f32, radiance: f32) -
     b.add_node(Node {
         name: Some("disk skylight".into()),
         transform: trs(center.to_array(), Quat::from_axis_angle(Vec3::X, -90f32.to_radians()), 1.0),
-        extras: Some(json!({ "sunshade": { "light": "disk", "radius": radius, "radiance": [radiance, radiance, radiance] } })),
+        extras: Some(
+            json!({ "sunshade": { "light": "disk", "radius": radius, "radiance": [radiance, radiance, radiance] } }),
+        ),
         ..Default::default()
     })
 }
 
-fn mesh_node(b: &mut GltfBuilder, name: &str, mesh: &MeshData, albedo: [f32; 3], double_sided: bool, transform: Transform) -> usize {
+fn mesh_node(
+    b: &mut GltfBuilder,
+    name: &str,
+    mesh: &MeshData,
+    albedo: [f32; 3],
+    double_sided: bool,
+    transform: Transform,
+) -> usize {
     let m = b.add_material(name, albedo, double_sided, None);
     let mesh = b.add_mesh(name, &[mesh.primitive(Some(m))]);
     b.add_node(Node { name: Some(name.into()), mesh: Some(mesh), transform, ..Default::default() })
@@ -85,7 +99,14 @@ fn room() -> GltfBuilder {
     let upright = Quat::from_axis_angle(Vec3::X, 90f32.to_radians());
     let mut roots = vec![
         mesh_node(&mut b, "floor", &grid(Vec3::ZERO, 6.0, 30), [0.6, 0.58, 0.55], false, Transform::Identity),
-        mesh_node(&mut b, "back wall", &grid(Vec3::ZERO, 6.0, 20), [0.75, 0.72, 0.68], true, trs([0.0, 3.0, -3.0], upright, 1.0)),
+        mesh_node(
+            &mut b,
+            "back wall",
+            &grid(Vec3::ZERO, 6.0, 20),
+            [0.75, 0.72, 0.68],
+            true,
+            trs([0.0, 3.0, -3.0], upright, 1.0),
+        ),
         mesh_node(
             &mut b,
             "left wall",
@@ -94,8 +115,22 @@ fn room() -> GltfBuilder {
             true,
             trs([-3.0, 3.0, 0.0], Quat::from_axis_angle(Vec3::Y, 90f32.to_radians()) * upright, 1.0),
         ),
-        mesh_node(&mut b, "sphere", &uv_sphere(Vec3::new(0.8, 0.5, -0.6), 0.5, 32, 64), [0.85, 0.3, 0.2], false, Transform::Identity),
-        mesh_node(&mut b, "box", &cube(0.4), [0.3, 0.5, 0.85], false, trs([-1.0, 0.4, 0.4], Quat::from_axis_angle(Vec3::Y, 0.5), 1.0)),
+        mesh_node(
+            &mut b,
+            "sphere",
+            &uv_sphere(Vec3::new(0.8, 0.5, -0.6), 0.5, 32, 64),
+            [0.85, 0.3, 0.2],
+            false,
+            Transform::Identity,
+        ),
+        mesh_node(
+            &mut b,
+            "box",
+            &cube(0.4),
+            [0.3, 0.5, 0.85],
+            false,
+            trs([-1.0, 0.4, 0.4], Quat::from_axis_angle(Vec3::Y, 0.5), 1.0),
+        ),
     ];
     roots.push(ceiling_disk(&mut b, Vec3::new(0.0, 2.5, 0.0), 0.6, 3000.0));
     roots.push(camera_node(&mut b, Vec3::new(2.6, 2.2, 2.9), Vec3::new(-0.4, 0.4, -0.8), 60.0));
@@ -106,7 +141,8 @@ fn room() -> GltfBuilder {
 /// The teapot on a ground plane under an overcast sky of 300 W/(m²·sr) (about 940 W/m² on the ground), no sun.
 fn overcast(teapot: &sunshade::scene::Scene) -> GltfBuilder {
     let mut b = GltfBuilder::new();
-    let mut roots = vec![mesh_node(&mut b, "ground", &grid(Vec3::ZERO, 12.0, 24), [0.4, 0.45, 0.35], false, Transform::Identity)];
+    let mut roots =
+        vec![mesh_node(&mut b, "ground", &grid(Vec3::ZERO, 12.0, 24), [0.4, 0.45, 0.35], false, Transform::Identity)];
     for (i, mesh) in teapot.meshes.iter().enumerate() {
         let data = MeshData {
             positions: mesh.positions.iter().map(|p| p.to_array()).collect(),
@@ -124,19 +160,32 @@ fn overcast(teapot: &sunshade::scene::Scene) -> GltfBuilder {
 /// is partly set for the ground, which then receives a few W/m².
 fn sunset() -> GltfBuilder {
     let mut b = GltfBuilder::new();
-    let mut roots = vec![mesh_node(&mut b, "ground", &grid(Vec3::ZERO, 10.0, 20), [0.5, 0.5, 0.5], false, Transform::Identity)];
+    let mut roots =
+        vec![mesh_node(&mut b, "ground", &grid(Vec3::ZERO, 10.0, 20), [0.5, 0.5, 0.5], false, Transform::Identity)];
     for (i, x) in [-1.5f32, 0.0, 1.5].iter().enumerate() {
         let sphere = uv_sphere(Vec3::new(*x, 0.5, 0.0), 0.5, 32, 64);
         roots.push(mesh_node(&mut b, &format!("sphere {i}"), &sphere, [0.8, 0.75, 0.7], false, Transform::Identity));
     }
-    roots.push(mesh_node(&mut b, "box", &cube(0.5), [0.7, 0.7, 0.8], false, trs([0.8, 0.5, -1.5], Quat::from_axis_angle(Vec3::Y, 0.6), 1.0)));
+    roots.push(mesh_node(
+        &mut b,
+        "box",
+        &cube(0.5),
+        [0.7, 0.7, 0.8],
+        false,
+        trs([0.8, 0.5, -1.5], Quat::from_axis_angle(Vec3::Y, 0.6), 1.0),
+    ));
     let sun = b.add_directional_light([1.0, 0.9, 0.75], 1000.0);
     // Towards the sun: elevation 0.1°, azimuth −80° (from −X, a little in front). The light shines along its node's
     // −Z, so the node's +Z points at the sun.
     let (el, az) = (0.1f32.to_radians(), (-80f32).to_radians());
     let to_sun = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
     let rot = Quat::from_rotation_arc(Vec3::Z, to_sun);
-    roots.push(b.add_node(Node { name: Some("sun".into()), light: Some(sun), transform: trs([0.0, 5.0, 0.0], rot, 1.0), ..Default::default() }));
+    roots.push(b.add_node(Node {
+        name: Some("sun".into()),
+        light: Some(sun),
+        transform: trs([0.0, 5.0, 0.0], rot, 1.0),
+        ..Default::default()
+    }));
     roots.push(camera_node(&mut b, Vec3::new(0.5, 2.2, 6.5), Vec3::new(0.0, 0.4, 0.0), 45.0));
     b.add_scene(&roots, None);
     b
@@ -167,6 +216,9 @@ fn main() -> std::io::Result<()> {
     let teapot = sunshade::scene::load(&dir.join("teapot.glb")).map_err(std::io::Error::other)?;
     overcast(&teapot).write(&dir.join("overcast.glb"))?;
     sunset().write(&dir.join("sunset.glb"))?;
-    println!("wrote square.gltf (+ .bin), cube.glb, spheres.glb, room.gltf (+ .bin), overcast.glb, sunset.glb in {}", dir.display());
+    println!(
+        "wrote square.gltf (+ .bin), cube.glb, spheres.glb, room.gltf (+ .bin), overcast.glb, sunset.glb in {}",
+        dir.display()
+    );
     Ok(())
 }

@@ -241,3 +241,38 @@ fn bench_reports_and_updates_a_marked_region() {
     assert_eq!(o.status.code(), Some(2));
     assert_eq!(std::fs::read_to_string(&plain).unwrap(), "no markers\n");
 }
+
+#[test]
+fn disk_light_and_sky_flags_light_a_floor_as_the_formulas_say() {
+    let dir = TempDir::new("cli-lights");
+    let mut b = GltfBuilder::new();
+    let m = b.add_material("floor", [0.5; 3], false, None);
+    let mesh = b
+        .add_mesh("floor", &[quad(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)).primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    let input = dir.write("floor.glb", &b);
+    let out = dir.path("lit.exr");
+    // Camera straight down at the floor's centre; a disk of R = 1 at height 2 above it; a sky of 10.
+    let common = ["--eye", "0,5,0", "--target", "0,0,0", "--up", "0,0,-1", "--width", "33", "--height", "33"];
+    let mut args =
+        vec!["reference", s(&input), "-o", s(&out), "--disk-light", "0,2,0:0,-1,0:1:100", "--sky-radiance", "10"];
+    args.extend_from_slice(&common);
+    let o = sunshade(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = sunshade::film::read_image(&out).unwrap();
+    // Centre pixel: (0.5/π)(π·100·1/(1 + 4) + π·10) = 0.5·(20 + 10) = 15.
+    let centre = img.get(16, 16)[0] as f64;
+    assert!((centre - 15.0).abs() < 1e-5 * 15.0, "{centre}");
+    // With a disk light on the command line, no default sun is added; the same with the GPU and validation.
+    let gpu_out = dir.path("gpu.exr");
+    let mut args =
+        vec!["render", s(&input), "-o", s(&gpu_out), "--disk-light", "0,2,0:0,-1,0:1:100", "--sky-radiance", "10"];
+    args.extend_from_slice(&common);
+    let o = sunshade(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let g = sunshade::film::read_image(&gpu_out).unwrap().get(16, 16)[0] as f64;
+    assert!((g - 15.0).abs() < 1e-5 * 15.0, "{g}");
+    assert_refused(&dir, &input, &["--disk-light", "0,2,0:0,0,0:1:100"], 2, "--disk-light");
+    assert_refused(&dir, &input, &["--disk-model", "huge"], 2, "--disk-model");
+}
