@@ -5,6 +5,9 @@
 
 // BRDF kinds (MaterialGpu.kind.x); values match gpu::layout::BRDF_*.
 #define BRDF_LAMBERT 0u
+#define BRDF_PHONG 1u
+#define BRDF_BLINN_PHONG 2u
+#define BRDF_WARD 3u
 
 // Light models (LightBuffer.counts.y and .z); values match gpu::layout::*_MODEL_*.
 #define SUN_MODEL_DISK 0u
@@ -13,9 +16,9 @@
 #define DISK_MODEL_SMALL_SOURCE 1u
 
 struct MaterialGpu {
-    vec4 kd;     // rgb: Lambertian albedo (dimensionless); w unused
-    vec4 ks;     // reserved for specular BRDFs
-    vec4 params; // reserved for specular BRDFs
+    vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
+    vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
+    vec4 params; // x, y: Ward alpha_x, alpha_y
     uvec4 kind;  // x: BRDF kind; y: 1 if double-sided
 };
 
@@ -37,7 +40,8 @@ layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
-    uvec4 counts; // x: number of disk lights; y: sun model; z: disk model
+    uvec4 counts;   // x: number of disk lights; y: sun model; z: disk model; w: samples per axis (disks, sky)
+    uvec4 sampling; // x: samples per axis over the sun's disk
     DiskGpu disks[];
 } lights;
 
@@ -46,8 +50,8 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
     uint indices[];
 };
 
-// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz (world space).
-#define FLOATS_PER_VERTEX 6u
+// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space).
+#define FLOATS_PER_VERTEX 10u
 layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
     float vertex_data[];
 };

@@ -43,12 +43,19 @@ float atan2_accurate(float y, float x) {
     return y > 0.0 ? HALF_PI - r : -HALF_PI - r;
 }
 
-// A unit vector orthogonal to the unit vector v (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
-vec3 any_orthonormal_vector(vec3 v) {
+// A unit vector orthogonal to the unit vector v (Duff et al. 2017, "Building an Orthonormal Basis, Revisited");
+// mirrors orthonormal_to in src/shading/shade.rs.
+vec3 orthonormal_to(vec3 v) {
     float s = v.z >= 0.0 ? 1.0 : -1.0;
     float a = -1.0 / (s + v.z);
     float b = v.x * v.y * a;
     return vec3(b, s + v.y * v.y * a, -v.y);
+}
+
+// log1p(x) by Goldberg's trick from log (0-1 ulp on lavapipe).
+float log1p_accurate(float x) {
+    float u = 1.0 + x;
+    return u == 1.0 ? x : log(u) * x / (u - 1.0);
 }
 
 #endif

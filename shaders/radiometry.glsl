@@ -169,7 +169,7 @@ float segment_projected_solid_angle(vec3 n, vec3 d, vec3 q, float h, float radiu
 
 // The segment of a disk above the horizon: rim arc plus chord.
 float partial_disk_projected_solid_angle(vec3 n, vec3 d, vec3 q, vec3 r_perp, float h, float rho, float radius) {
-    vec3 e1 = rho > 0.0 ? -r_perp / rho : any_orthonormal_vector(d);
+    vec3 e1 = rho > 0.0 ? -r_perp / rho : orthonormal_to(d);
     vec3 e2 = cross(d, e1);
     float n1 = dot(n, e1);
     float n2 = dot(n, e2);

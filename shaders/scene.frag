@@ -12,6 +12,7 @@ layout(location = 0) out vec4 out_radiance;
 #ifdef SUNSHADE_DEVICE_INTERPOLATION
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec4 v_tangent;
 #endif
 
 vec3 vertex_vec3(uint index, uint offset) {
@@ -19,11 +20,28 @@ vec3 vertex_vec3(uint index, uint offset) {
     return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
 }
 
+vec4 vertex_vec4(uint index, uint offset) {
+    uint base = index * FLOATS_PER_VERTEX + offset;
+    return vec4(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u], vertex_data[base + 3u]);
+}
+
+// The part of t orthogonal to the unit normal n, normalised; the default tangent (world +X projected, else +Z)
+// where that vanishes. Mirrors orthonormal_tangent / default_tangent in src/scene/tangent.rs.
+vec3 orthonormal_tangent(vec3 t, vec3 n) {
+    vec3 o = t - n * dot(n, t);
+    if (dot(o, o) > 1e-20) {
+        return normalize(o);
+    }
+    vec3 x = vec3(1.0, 0.0, 0.0) - n * n.x;
+    return dot(x, x) > 1e-12 ? normalize(x) : normalize(vec3(0.0, 0.0, 1.0) - n * n.z);
+}
+
 void main() {
     MaterialGpu material = materials[pc.material];
 #ifdef SUNSHADE_DEVICE_INTERPOLATION
     vec3 position = v_position;
     vec3 normal = safe_normalize(v_normal);
+    vec4 tangent = v_tangent;
 #else
     uint first = pc.first_index + 3u * uint(gl_PrimitiveID);
     uint i0 = uint(int(indices[first]) + pc.vertex_offset);
@@ -33,6 +51,7 @@ void main() {
     vec3 l = triangle_barycentrics(clip_position(p0), clip_position(p1), clip_position(p2), pixel_ndc(gl_FragCoord.xy));
     vec3 position = l.x * p0 + l.y * p1 + l.z * p2;
     vec3 normal = safe_normalize(l.x * vertex_vec3(i0, 3u) + l.y * vertex_vec3(i1, 3u) + l.z * vertex_vec3(i2, 3u));
+    vec4 tangent = l.x * vertex_vec4(i0, 6u) + l.y * vertex_vec4(i1, 6u) + l.z * vertex_vec4(i2, 6u);
 #endif
     // Only double-sided materials reach here with back faces (single-sided ones are culled); glTF reverses
     // their normal.
@@ -40,5 +59,11 @@ void main() {
         normal = -normal;
     }
     vec3 to_viewer = pc.viewer.w != 0.0 ? safe_normalize(pc.viewer.xyz - position) : pc.viewer.xyz;
-    out_radiance = vec4(radiance_out(material, position, normal, to_viewer), 1.0);
+    Frame frame;
+    frame.position = position;
+    frame.normal = normal;
+    frame.tangent = orthonormal_tangent(tangent.xyz, normal);
+    frame.bitangent = (tangent.w < 0.0 ? -1.0 : 1.0) * cross(normal, frame.tangent);
+    frame.to_viewer = to_viewer;
+    out_radiance = vec4(radiance_out(material, frame), 1.0);
 }

@@ -1,4 +1,5 @@
-// Outgoing radiance at a surface point. Mirrors src/shading/shade.rs name for name.
+// Outgoing radiance at a surface point. Mirrors src/shading/shade.rs name for name: the same formulas and the same
+// deterministic sample points, so that the GPU and the CPU reference differ only by rounding.
 #ifndef SUNSHADE_SHADE_GLSL
 #define SUNSHADE_SHADE_GLSL
 
@@ -10,6 +11,15 @@ vec3 safe_normalize(vec3 v) {
     float len2 = dot(v, v);
     return len2 > 0.0 ? v * inversesqrt(len2) : vec3(0.0);
 }
+
+// The local frame of a surface point.
+struct Frame {
+    vec3 position;
+    vec3 normal;
+    vec3 tangent;
+    vec3 bitangent;
+    vec3 to_viewer;
+};
 
 // Irradiance [W/m^2] per channel from all the lights (models chosen by lights.counts.y (sun) and .z (disks)).
 vec3 irradiance(vec3 position, vec3 normal) {
@@ -35,13 +45,203 @@ vec3 irradiance(vec3 position, vec3 normal) {
     return e;
 }
 
-// Outgoing radiance [W/(m^2 sr)] per channel. `normal` is unit (or 0) on the side being seen.
-vec3 radiance_out(MaterialGpu material, vec3 position, vec3 normal, vec3 to_viewer) {
+// The specular lobe of a material (without ks) for light from l.
+float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
+    uint kind = m.kind.x;
+    if (kind == BRDF_PHONG) {
+        return phong_lobe(p.normal, l, p.to_viewer, m.ks.w);
+    }
+    if (kind == BRDF_BLINN_PHONG) {
+        return blinn_phong_lobe(p.normal, l, p.to_viewer, m.ks.w);
+    }
+    if (kind == BRDF_WARD) {
+        return ward_lobe(p.normal, p.tangent, p.bitangent, l, p.to_viewer, m.params.x, m.params.y);
+    }
+    return 0.0;
+}
+
+// integral of lobe (n.w)+ over the sun's cap, per unit radiance: a midpoint grid in (beta, phi).
+float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_diameter, uint per_axis) {
+    float sigma = 0.5 * angular_diameter;
+    vec3 t = orthonormal_to(direction);
+    vec3 b = cross(direction, t);
+    float k = float(per_axis);
+    float d_beta = sigma / k;
+    float d_phi = 2.0 * PI / k;
+    float sum = 0.0;
+    for (uint i = 0u; i < per_axis; ++i) {
+        float beta = (float(i) + 0.5) * d_beta;
+        float sb = sin(beta);
+        float cb = cos(beta);
+        for (uint j = 0u; j < per_axis; ++j) {
+            float phi = (float(j) + 0.5) * d_phi;
+            vec3 w = cb * direction + sb * (cos(phi) * t + sin(phi) * b);
+            float c = dot(p.normal, w);
+            if (c > 0.0) {
+                sum += specular_lobe(m, p, w) * c * sb;
+            }
+        }
+    }
+    return sum * d_beta * d_phi;
+}
+
+// integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance (segment coordinates).
+float disk_lobe_integral(MaterialGpu m, Frame p, vec3 center, vec3 d, float radius, uint per_axis) {
+    vec3 n = p.normal;
+    vec3 q = center - p.position;
+    float h = -dot(d, q);
+    if (!(h > 0.0 && radius > 0.0)) {
+        return 0.0;
+    }
+    vec3 n_perp = n - dot(n, d) * d;
+    float mlen = length(n_perp);
+    float nq = dot(n, q);
+    vec3 w;
+    float alpha;
+    if (nq - radius * mlen >= 0.0) {
+        w = mlen > 0.0 ? n_perp / mlen : orthonormal_to(d);
+        alpha = PI;
+    } else if (nq + radius * mlen <= 0.0) {
+        return 0.0;
+    } else {
+        float kappa = clamp(-nq / (radius * mlen), -1.0, 1.0);
+        w = n_perp / mlen;
+        alpha = atan2_accurate(sqrt((1.0 - kappa) * (1.0 + kappa)), kappa);
+    }
+    vec3 v = cross(d, w);
+    float k = float(per_axis);
+    float d_beta = alpha / k;
+    float d_s = 2.0 / k;
+    float sum = 0.0;
+    for (uint i = 0u; i < per_axis; ++i) {
+        float beta = (float(i) + 0.5) * d_beta;
+        float sb = sin(beta);
+        float cb = cos(beta);
+        for (uint j = 0u; j < per_axis; ++j) {
+            float s = -1.0 + (float(j) + 0.5) * d_s;
+            vec3 y = q + radius * cb * w + radius * sb * s * v;
+            float dist2 = dot(y, y);
+            float dist = sqrt(dist2);
+            vec3 omega = y / dist;
+            float c = dot(n, omega);
+            if (c > 0.0) {
+                sum += specular_lobe(m, p, omega) * c * h / (dist2 * dist) * radius * radius * sb * sb;
+            }
+        }
+    }
+    return sum * d_beta * d_s;
+}
+
+// exp(x) - 1 without cancellation for small x (Kahan's trick).
+float exp_minus_one(float x) {
+    float u = exp(x);
+    if (u == 1.0) {
+        return x;
+    }
+    float um1 = u - 1.0;
+    if (um1 == -1.0) {
+        return -1.0;
+    }
+    return um1 * x / log(u);
+}
+
+// integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
+// inverse CDF, each sample weighted by lobe/pdf (see the Rust).
+float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
+    vec3 n = p.normal;
+    vec3 v = p.to_viewer;
+    uint kind = m.kind.x;
+    float k = float(per_axis);
+    float sum = 0.0;
+    for (uint i = 0u; i < per_axis; ++i) {
+        float xi1 = (float(i) + 0.5) / k;
+        for (uint j = 0u; j < per_axis; ++j) {
+            float xi2 = (float(j) + 0.5) / k;
+            float phi = 2.0 * PI * xi2;
+            if (kind == BRDF_PHONG) {
+                float e = m.ks.w;
+                vec3 r = mirror(v, n);
+                vec3 t = orthonormal_to(r);
+                vec3 b = cross(r, t);
+                float x = log(1.0 - xi1) / (e + 1.0);
+                float one_minus_cos = -exp_minus_one(x);
+                float cos_a = 1.0 - one_minus_cos;
+                float sin_a = sqrt(one_minus_cos * (1.0 + cos_a));
+                vec3 omega = cos_a * r + sin_a * (cos(phi) * t + sin(phi) * b);
+                sum += (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
+            } else if (kind == BRDF_BLINN_PHONG) {
+                float e = m.ks.w;
+                vec3 t = orthonormal_to(n);
+                vec3 b = cross(n, t);
+                float x = log(1.0 - xi1) / (e + 1.0);
+                float one_minus_cos = -exp_minus_one(x);
+                float cos_h = 1.0 - one_minus_cos;
+                float sin_h = sqrt(one_minus_cos * (1.0 + cos_h));
+                vec3 h = cos_h * n + sin_h * (cos(phi) * t + sin(phi) * b);
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    sum += blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
+                }
+            } else if (kind == BRDF_WARD) {
+                float ax = m.params.x;
+                float ay = m.params.y;
+                float phi_h = atan2_accurate(ay * sin(phi), ax * cos(phi));
+                float sp = sin(phi_h);
+                float cp = cos(phi_h);
+                float tan2 = -log(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
+                float cos_d = 1.0 / sqrt(1.0 + tan2);
+                float sin_d = sqrt(tan2) * cos_d;
+                vec3 h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    sum += max(dot(n, omega), 0.0) / (vh * cos_d);
+                }
+            }
+        }
+    }
+    return sum / (k * k);
+}
+
+// Outgoing radiance [W/(m^2 sr)] per channel. `p.normal` is unit (or 0) on the side being seen.
+vec3 radiance_out(MaterialGpu material, Frame p) {
     // An undefined (zero) normal reflects nothing: n.l = 0 would otherwise read as a surface edge-on to every light.
-    if (dot(normal, normal) == 0.0) {
+    if (dot(p.normal, p.normal) == 0.0) {
         return vec3(0.0);
     }
-    return lambert_brdf(material.kd.rgb) * irradiance(position, normal);
+    vec3 radiance = lambert_brdf(material.kd.rgb) * irradiance(p.position, p.normal);
+    if (material.kind.x == BRDF_LAMBERT) {
+        return radiance;
+    }
+    vec3 specular = vec3(0.0);
+    if (lights.sun.irradiance.w != 0.0) {
+        vec3 l = lights.sun.direction.xyz;
+        if (lights.counts.y == SUN_MODEL_DELTA) {
+            specular += specular_lobe(material, p, l) * max(dot(p.normal, l), 0.0) * lights.sun.irradiance.rgb;
+        } else {
+            float delta = lights.sun.direction.w;
+            float s = sin(0.5 * delta);
+            float integral = sun_lobe_integral(material, p, l, delta, lights.sampling.x);
+            specular += integral * lights.sun.irradiance.rgb / (PI * s * s);
+        }
+    }
+    for (uint i = 0u; i < lights.counts.x; ++i) {
+        DiskGpu d = lights.disks[i];
+        float integral;
+        if (lights.counts.z == DISK_MODEL_SMALL_SOURCE) {
+            vec3 to_center = safe_normalize(d.center_radius.xyz - p.position);
+            integral = specular_lobe(material, p, to_center)
+                * disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        } else {
+            integral = disk_lobe_integral(material, p, d.center_radius.xyz, d.direction.xyz, d.center_radius.w, lights.counts.w);
+        }
+        specular += integral * d.radiance.rgb;
+    }
+    if (lights.sky.w != 0.0) {
+        specular += sky_lobe_integral(material, p, lights.counts.w) * lights.sky.rgb;
+    }
+    return radiance + material.ks.rgb * specular;
 }
 
 #endif

@@ -6,9 +6,9 @@ use clap::Args;
 use glam::DVec3;
 
 use crate::film::Exposure;
-use crate::scene::DiskLight;
+use crate::scene::{BrdfKind, DiskLight};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
-use crate::shading::{DiskModel, ShadingOptions, SunModel};
+use crate::shading::{DiskModel, ShadingOptions, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS};
 
 /// `x,y,z` → a finite vector.
 pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
@@ -167,6 +167,24 @@ pub struct SceneArgs {
     /// Overcast sky of uniform radiance L0 [W/(m²·sr)], one value or r,g,b (replaces the scene's sky).
     #[arg(long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
     pub sky_radiance: Option<[f64; 3]>,
+
+    /// Map every material's glTF metallic-roughness onto this BRDF (README "BRDFs"); `lambert` forces Lambert.
+    #[arg(long, value_name = "lambert|phong|blinn-phong|ward")]
+    pub brdf: Option<BrdfKind>,
+
+    /// Samples for integrating specular lobes over disk lights and the sky (a stratified grid; rounded up to a
+    /// square).
+    #[arg(long, default_value_t = DEFAULT_SAMPLES_PER_AXIS * DEFAULT_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub samples: u32,
+
+    /// Samples for integrating specular lobes over the sun's disk (--sun-model disk; rounded up to a square).
+    #[arg(long, default_value_t = DEFAULT_SUN_SAMPLES_PER_AXIS * DEFAULT_SUN_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub sun_samples: u32,
+}
+
+/// The side of the smallest square grid with at least `samples` cells.
+pub fn per_axis(samples: u32) -> u32 {
+    (samples as f64).sqrt().ceil() as u32
 }
 
 impl SceneArgs {
@@ -179,7 +197,12 @@ impl SceneArgs {
             sun: self.sun_options(),
             disks: self.disk_lights.clone(),
             sky: self.sky_radiance,
-            shading: ShadingOptions { sun: self.sun_model, disk: self.disk_model },
+            shading: ShadingOptions {
+                sun: self.sun_model,
+                disk: self.disk_model,
+                sun_samples_per_axis: per_axis(self.sun_samples),
+                samples_per_axis: per_axis(self.samples),
+            },
         }
     }
 

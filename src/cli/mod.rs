@@ -117,7 +117,10 @@ fn one_line(e: &anyhow::Error) -> String {
 /// Loads the scene and resolves the render settings; prints the loader's warnings.
 fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
     let t = Instant::now();
-    let scene = scene::load_with_options(&a.scene, &LoadOptions { scene: a.scene_index })?;
+    let mut scene = scene::load_with_options(&a.scene, &LoadOptions { scene: a.scene_index })?;
+    if let Some(kind) = a.brdf {
+        scene.map_brdfs(kind);
+    }
     let load_time = t.elapsed();
     for w in &scene.warnings {
         eprintln!("sunshade: warning: {}: {w}", a.scene.display());

@@ -32,6 +32,7 @@ use self::raster::RasterTriangle;
 use self::transform::clip_position;
 use self::viewport::{snap, Viewport};
 use crate::film::Image;
+use crate::scene::tangent::orthonormal_tangent;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::{radiance_out, safe_normalize, SurfacePoint};
@@ -168,14 +169,12 @@ fn prepare(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions)
     for mesh in &scene.meshes {
         let material = &scene.materials[mesh.material];
         // The vertex shader, once per vertex.
-        let vertices: Vec<ClipVertex> = mesh
-            .positions
-            .iter()
-            .zip(&mesh.normals)
-            .map(|(p, n)| {
-                let clip = clip_position(&m, *p);
+        let vertices: Vec<ClipVertex> = (0..mesh.positions.len())
+            .map(|i| {
+                let (p, n, t) = (mesh.positions[i], mesh.normals[i], mesh.tangents[i]);
+                let clip = clip_position(&m, p);
                 let window = if clip_mask(clip) == 0 { viewport.window_from_vertex(clip) } else { Vec3::NAN };
-                ClipVertex { clip, window, attributes: [p.x, p.y, p.z, n.x, n.y, n.z] }
+                ClipVertex { clip, window, attributes: [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, t.z, t.w] }
             })
             .collect();
         for tri in mesh.indices.chunks_exact(3) {
@@ -220,11 +219,15 @@ fn shade(scene: &Scene, settings: &RenderSettings, t: &Prepared, w: [f64; 3], vi
     if t.flip_normal {
         normal = -normal;
     }
+    // Surface frame: the interpolated tangent made orthogonal to the normal; bitangent w (n × t).
+    let tangent = orthonormal_tangent(DVec3::new(a[6], a[7], a[8]), normal);
+    let handedness = if a[9] < 0.0 { -1.0 } else { 1.0 };
+    let bitangent = handedness * normal.cross(tangent);
     let to_viewer = if viewer.w != 0.0 {
         safe_normalize(viewer.truncate().as_dvec3() - position)
     } else {
         viewer.truncate().as_dvec3()
     };
-    let point = SurfacePoint { position, normal, to_viewer };
+    let point = SurfacePoint { position, normal, tangent, bitangent, to_viewer };
     radiance_out(&scene.materials[t.material], &point, &settings.lights, &settings.shading)
 }

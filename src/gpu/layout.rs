@@ -7,17 +7,22 @@ use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadingOptions, SunModel};
 
 pub const BRDF_LAMBERT: u32 = 0;
+pub const BRDF_PHONG: u32 = 1;
+pub const BRDF_BLINN_PHONG: u32 = 2;
+pub const BRDF_WARD: u32 = 3;
 pub const SUN_MODEL_DISK: u32 = 0;
 pub const SUN_MODEL_DELTA: u32 = 1;
 pub const DISK_MODEL_EXACT: u32 = 0;
 pub const DISK_MODEL_SMALL_SOURCE: u32 = 1;
 
-/// One vertex: world position [m] and unit normal, interleaved (`FLOATS_PER_VERTEX` = 6 floats in the shaders).
+/// One vertex: world position [m], unit normal, unit tangent and handedness, interleaved
+/// (`FLOATS_PER_VERTEX` = 10 floats in the shaders).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
+    pub tangent: [f32; 4],
 }
 
 #[repr(C)]
@@ -50,7 +55,10 @@ pub struct DiskGpu {
 pub struct LightsHeader {
     pub sun: SunGpu,
     pub sky: [f32; 4],
+    /// Disk count, sun model, disk model, samples per axis for disks and the sky.
     pub counts: [u32; 4],
+    /// Samples per axis over the sun's disk; the rest unused.
+    pub sampling: [u32; 4],
 }
 
 #[repr(C)]
@@ -66,12 +74,18 @@ pub struct PushConstants {
 }
 
 pub fn material_gpu(m: &Material) -> MaterialGpu {
-    let Brdf::Lambert { albedo } = m.brdf;
+    let (kd, ks) = (m.brdf.kd(), m.brdf.ks());
+    let (kind, exponent, alpha) = match m.brdf {
+        Brdf::Lambert { .. } => (BRDF_LAMBERT, 0.0, [0.0, 0.0]),
+        Brdf::Phong { exponent, .. } => (BRDF_PHONG, exponent, [0.0, 0.0]),
+        Brdf::BlinnPhong { exponent, .. } => (BRDF_BLINN_PHONG, exponent, [0.0, 0.0]),
+        Brdf::Ward { alpha_x, alpha_y, .. } => (BRDF_WARD, 0.0, [alpha_x, alpha_y]),
+    };
     MaterialGpu {
-        kd: [albedo[0], albedo[1], albedo[2], 0.0],
-        ks: [0.0; 4],
-        params: [0.0; 4],
-        kind: [BRDF_LAMBERT, m.double_sided as u32, 0, 0],
+        kd: [kd[0], kd[1], kd[2], 0.0],
+        ks: [ks[0], ks[1], ks[2], exponent],
+        params: [alpha[0], alpha[1], 0.0, 0.0],
+        kind: [kind, m.double_sided as u32, 0, 0],
     }
 }
 
@@ -96,7 +110,12 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
         DiskModel::Exact => DISK_MODEL_EXACT,
         DiskModel::SmallSource => DISK_MODEL_SMALL_SOURCE,
     };
-    let header = LightsHeader { sun, sky, counts: [lights.disks.len() as u32, sun_model, disk_model, 0] };
+    let header = LightsHeader {
+        sun,
+        sky,
+        counts: [lights.disks.len() as u32, sun_model, disk_model, shading.samples_per_axis],
+        sampling: [shading.sun_samples_per_axis, 0, 0, 0],
+    };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
         let disk = DiskGpu {
@@ -129,11 +148,11 @@ mod tests {
     #[test]
     fn sizes_match_std430() {
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
-        assert_eq!(std::mem::size_of::<LightsHeader>(), 64);
+        assert_eq!(std::mem::size_of::<LightsHeader>(), 80);
         assert_eq!(std::mem::size_of::<DiskGpu>(), 48);
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
         assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
-        assert_eq!(std::mem::size_of::<Vertex>(), 24);
+        assert_eq!(std::mem::size_of::<Vertex>(), 40);
     }
 }

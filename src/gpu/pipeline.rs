@@ -117,14 +117,14 @@ unsafe fn create_pipeline(
         }];
         // The vertex shader reads the position (and the normal only for device interpolation); otherwise the
         // fragment shader reads whole vertices from a buffer.
-        let attribute = |location, offset| vk::VertexInputAttributeDescription {
-            location,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset,
-        };
-        let all_attributes = [attribute(0, 0), attribute(1, 12)];
-        let vertex_attributes = &all_attributes[..if with_normals { 2 } else { 1 }];
+        let attribute =
+            |location, format, offset| vk::VertexInputAttributeDescription { location, binding: 0, format, offset };
+        let all_attributes = [
+            attribute(0, vk::Format::R32G32B32_SFLOAT, 0),
+            attribute(1, vk::Format::R32G32B32_SFLOAT, 12),
+            attribute(2, vk::Format::R32G32B32A32_SFLOAT, 24),
+        ];
+        let vertex_attributes = &all_attributes[..if with_normals { 3 } else { 1 }];
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&vertex_bindings)
             .vertex_attribute_descriptions(vertex_attributes);

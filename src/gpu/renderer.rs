@@ -177,12 +177,11 @@ impl Renderer {
                 material: mesh.material as u32,
                 double_sided: scene.materials[mesh.material].double_sided,
             });
-            vertices.extend(
-                mesh.positions
-                    .iter()
-                    .zip(&mesh.normals)
-                    .map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
-            );
+            vertices.extend((0..mesh.positions.len()).map(|i| Vertex {
+                position: mesh.positions[i].to_array(),
+                normal: mesh.normals[i].to_array(),
+                tangent: mesh.tangents[i].to_array(),
+            }));
             indices.extend_from_slice(&mesh.indices);
         }
         let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();

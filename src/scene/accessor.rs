@@ -19,6 +19,26 @@ impl AccessorReader<'_> {
         Ok(raw.chunks_exact(3).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32]).collect())
     }
 
+    /// Reads `VEC4` `FLOAT` data (tangents: xyz and the handedness w).
+    pub fn read_vec4_f32(&self, accessor: &gltf::Accessor) -> Result<Vec<[f32; 4]>, String> {
+        expect_layout(accessor, Dimensions::Vec4, &[DataType::F32])?;
+        let raw = self.read_components(accessor)?;
+        Ok(raw.chunks_exact(4).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32]).collect())
+    }
+
+    /// Reads `VEC2` texture coordinates: `FLOAT`, or normalized unsigned bytes or shorts (glTF allows those).
+    pub fn read_texcoords(&self, accessor: &gltf::Accessor) -> Result<Vec<[f32; 2]>, String> {
+        expect_layout(accessor, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16])?;
+        let scale = match accessor.data_type() {
+            DataType::U8 if accessor.normalized() => 1.0 / 255.0,
+            DataType::U16 if accessor.normalized() => 1.0 / 65535.0,
+            DataType::F32 => 1.0,
+            _ => return Err(format!("accessor {}: integer texture coordinates must be normalized", accessor.index())),
+        };
+        let raw = self.read_components(accessor)?;
+        Ok(raw.chunks_exact(2).map(|c| [(c[0] * scale) as f32, (c[1] * scale) as f32]).collect())
+    }
+
     /// Reads `SCALAR` unsigned-integer data of any width (indices).
     pub fn read_indices(&self, accessor: &gltf::Accessor) -> Result<Vec<u32>, String> {
         expect_layout(accessor, Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32])?;

@@ -2,7 +2,9 @@
 //!
 //! What is read: the chosen scene's node hierarchy (matrix or TRS transforms), every TRIANGLES primitive (other
 //! modes are skipped with a warning), u8/u16/u32 or no indices, POSITION and NORMAL (flat normals where a
-//! primitive has none, as the glTF spec requires), materials (`baseColorFactor` as the Lambertian albedo),
+//! primitive has none, as the glTF spec requires), TANGENT or TEXCOORD_0 (for tangents), materials
+//! (`baseColorFactor` as the Lambertian albedo, or the BRDF of the material's
+//! `{"sunshade": {"brdf": …}}` extras),
 //! cameras, KHR_lights_punctual directional lights (the sun), disk skylights from node `extras`
 //! (`{"sunshade": {"light": "disk", "radius": R, "radiance": [r, g, b]}}`: a disk in the node's local XY plane at its
 //! origin, emitting towards local −Z) and the overcast sky from the scene's `extras`
@@ -11,12 +13,13 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DMat3, DMat4, DQuat, DVec3, Vec3};
+use glam::{DMat3, DMat4, DQuat, DVec3, Vec3, Vec4};
 
 use super::accessor::AccessorReader;
 use super::camera::{Camera, Projection};
 use super::light::{DiskLight, Sun};
-use super::material::{Brdf, Material};
+use super::material::{Brdf, Material, MetallicRoughness};
+use super::tangent::{default_tangent, orthonormal_tangent, tangents_from_uv, triangle_tangent};
 use super::uri::{self, UriTarget};
 use super::{Mesh, Scene};
 use crate::shading::radiometry::{degrees_to_radians, SUN_ANGULAR_DIAMETER_DEGREES};
@@ -219,6 +222,35 @@ impl<'a> Loader<'a> {
         }
 
         let mut out = Mesh { name, material: self.material_index(primitive), ..Default::default() };
+        // Tangent sources: TANGENT (transformed as a direction, handedness flipped by a mirroring node), else
+        // TEXCOORD_0.
+        let file_tangents = match primitive.get(&gltf::Semantic::Tangents) {
+            Some(acc) => {
+                let t = self.reader.read_vec4_f32(&acc).map_err(|e| format!("{}: TANGENT: {e}", out.name))?;
+                if t.len() != vertex_count {
+                    return Err(format!("{}: TANGENT has {} elements, POSITION {vertex_count}", out.name, t.len()));
+                }
+                let w_sign = det.signum();
+                Some(
+                    t.iter()
+                        .map(|t| {
+                            (linear * DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64), w_sign * t[3].signum() as f64)
+                        })
+                        .collect::<Vec<_>>(),
+                )
+            }
+            None => None,
+        };
+        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
+            Some(acc) if file_tangents.is_none() => {
+                let uv = self.reader.read_texcoords(&acc).map_err(|e| format!("{}: TEXCOORD_0: {e}", out.name))?;
+                if uv.len() != vertex_count {
+                    return Err(format!("{}: TEXCOORD_0 has {} elements, POSITION {vertex_count}", out.name, uv.len()));
+                }
+                Some(uv)
+            }
+            _ => None,
+        };
         match primitive.get(&gltf::Semantic::Normals) {
             Some(acc) => {
                 let normals = self.reader.read_vec3_f32(&acc).map_err(|e| format!("{}: NORMAL: {e}", out.name))?;
@@ -238,6 +270,17 @@ impl<'a> Loader<'a> {
                         w.try_normalize().unwrap_or(DVec3::ZERO).as_vec3()
                     })
                     .collect();
+                out.tangents = match (&file_tangents, &uvs) {
+                    (Some(t), _) => t
+                        .iter()
+                        .zip(&out.normals)
+                        .map(|((t, w), n)| orthonormal_tangent(*t, n.as_dvec3()).as_vec3().extend(*w as f32))
+                        .collect(),
+                    (None, Some(uv)) => tangents_from_uv(&positions, &out.normals, uv, &indices),
+                    (None, None) => {
+                        out.normals.iter().map(|n| default_tangent(n.as_dvec3()).as_vec3().extend(1.0)).collect()
+                    }
+                };
                 out.positions = positions;
                 out.indices = indices;
             }
@@ -246,12 +289,34 @@ impl<'a> Loader<'a> {
                 // world-space (re-wound) corners so that it points to the front side.
                 for tri in indices.chunks_exact(3) {
                     let [a, b, c] = [0, 1, 2].map(|k| positions[tri[k] as usize]);
-                    let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
-                    let n = n.try_normalize().unwrap_or(DVec3::ZERO).as_vec3();
+                    let nd = (b.as_dvec3() - a.as_dvec3())
+                        .cross(c.as_dvec3() - a.as_dvec3())
+                        .try_normalize()
+                        .unwrap_or(DVec3::ZERO);
+                    let n = nd.as_vec3();
                     let base = out.positions.len() as u32;
                     out.positions.extend([a, b, c]);
                     out.normals.extend([n, n, n]);
                     out.indices.extend([base, base + 1, base + 2]);
+                    let tangents: [Vec4; 3] = match (&file_tangents, &uvs) {
+                        (Some(t), _) => [0, 1, 2].map(|k| {
+                            let (t, w) = t[tri[k] as usize];
+                            orthonormal_tangent(t, nd).as_vec3().extend(w as f32)
+                        }),
+                        (None, Some(uv)) => {
+                            let p = [a, b, c].map(|p| p.as_dvec3());
+                            let (t, w) = match triangle_tangent(p, [0, 1, 2].map(|k| uv[tri[k] as usize])) {
+                                Some((t, bt)) => {
+                                    let t = orthonormal_tangent(t, nd);
+                                    (t, if nd.cross(t).dot(bt) < 0.0 { -1.0 } else { 1.0 })
+                                }
+                                None => (default_tangent(nd), 1.0),
+                            };
+                            [t.as_vec3().extend(w); 3]
+                        }
+                        (None, None) => [default_tangent(nd).as_vec3().extend(1.0); 3],
+                    };
+                    out.tangents.extend(tangents);
                 }
             }
         }
@@ -390,12 +455,54 @@ fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {
 fn read_material(material: &gltf::Material) -> Result<Material, String> {
     let index = material.index().unwrap_or(0);
     let name = material.name().map_or_else(|| format!("material {index}"), |n| format!("material '{n}'"));
-    let [r, g, b, _] = material.pbr_metallic_roughness().base_color_factor();
+    let pbr = material.pbr_metallic_roughness();
+    let [r, g, b, _] = pbr.base_color_factor();
     let albedo = [r, g, b];
     if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Err(format!("{name}: baseColorFactor {albedo:?} is outside [0, 1]"));
     }
-    Ok(Material { name, double_sided: material.double_sided(), brdf: Brdf::Lambert { albedo } })
+    let metallic_roughness =
+        MetallicRoughness { base_color: albedo, metallic: pbr.metallic_factor(), roughness: pbr.roughness_factor() };
+    let extras = sunshade_extras(material.extras()).map_err(|e| format!("{name}: {e}"))?;
+    let brdf = match extras.as_ref().and_then(|x| x.get("brdf")) {
+        Some(_) => {
+            brdf_from_extras(extras.as_ref().expect("checked"), albedo).map_err(|e| format!("{name} extras: {e}"))?
+        }
+        None => Brdf::Lambert { albedo },
+    };
+    brdf.validate().map_err(|e| format!("{name}: {e}"))?;
+    Ok(Material { name, double_sided: material.double_sided(), brdf, pbr: metallic_roughness })
+}
+
+/// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
+/// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor).
+fn brdf_from_extras(x: &serde_json::Value, base_color: [f32; 3]) -> Result<Brdf, String> {
+    let kind = x.get("brdf").and_then(|v| v.as_str()).ok_or("\"brdf\" must be a string")?;
+    let color = |key: &str| -> Result<[f32; 3], String> {
+        rgb(x.get(key).ok_or_else(|| format!("{kind} needs \"{key}\""))?).map_err(|e| format!("{key} {e}"))
+    };
+    let number = |key: &str| -> Result<f32, String> {
+        x.get(key)
+            .and_then(|v| v.as_f64())
+            .filter(|v| v.is_finite())
+            .map(|v| v as f32)
+            .ok_or_else(|| format!("{kind} needs \"{key}\": a number"))
+    };
+    Ok(match kind {
+        "lambert" => Brdf::Lambert { albedo: if x.get("albedo").is_some() { color("albedo")? } else { base_color } },
+        "phong" => Brdf::Phong { kd: color("kd")?, ks: color("ks")?, exponent: number("exponent")? },
+        "blinn-phong" => Brdf::BlinnPhong { kd: color("kd")?, ks: color("ks")?, exponent: number("exponent")? },
+        "ward" => {
+            let (alpha_x, alpha_y) = if x.get("alpha").is_some() {
+                let a = number("alpha")?;
+                (a, a)
+            } else {
+                (number("alpha_x")?, number("alpha_y")?)
+            };
+            Brdf::Ward { kd: color("kd")?, ks: color("ks")?, alpha_x, alpha_y }
+        }
+        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward")),
+    })
 }
 
 fn read_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {

@@ -12,14 +12,15 @@ pub mod camera;
 pub mod light;
 mod load;
 pub mod material;
+pub mod tangent;
 mod uri;
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 
 pub use camera::{Camera, Projection};
 pub use light::{DiskLight, Lights, Sun};
 pub use load::{load, load_with_options, LoadError, LoadOptions};
-pub use material::{Brdf, Material};
+pub use material::{Brdf, BrdfKind, Material, MetallicRoughness};
 
 /// A loaded scene: everything both renderers need apart from the per-render settings.
 #[derive(Clone, Debug, Default)]
@@ -45,6 +46,9 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Unit vertex normals in world space (a zero vector where the file's normal was zero).
     pub normals: Vec<Vec3>,
+    /// Unit tangents (the αx direction of anisotropic BRDFs) orthogonal to the normals, w = handedness ±1:
+    /// from TANGENT, else from TEXCOORD_0, else [`tangent::default_tangent`].
+    pub tangents: Vec<Vec4>,
     /// Triangle list; counter-clockwise (seen from the front) in world space.
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
@@ -72,6 +76,14 @@ pub struct BoundingSphere {
 }
 
 impl Scene {
+    /// Replaces every material's BRDF by the `--brdf` mapping of its glTF metallic-roughness parameters
+    /// ([`Brdf::from_metallic_roughness`]).
+    pub fn map_brdfs(&mut self, kind: BrdfKind) {
+        for m in &mut self.materials {
+            m.brdf = Brdf::from_metallic_roughness(kind, m.pbr);
+        }
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(Mesh::triangle_count).sum()
     }

@@ -9,5 +9,7 @@ pub mod radiometry;
 mod shade;
 
 pub use shade::{
-    disk_geometry, irradiance, radiance_out, safe_normalize, DiskModel, ShadingOptions, SunModel, SurfacePoint,
+    disk_geometry, disk_lobe_integral, irradiance, orthonormal_to, radiance_out, safe_normalize, sky_lobe_integral,
+    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS,
+    DEFAULT_SUN_SAMPLES_PER_AXIS,
 };

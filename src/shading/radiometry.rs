@@ -217,7 +217,7 @@ fn partial_disk_projected_solid_angle(
     radius: f64,
 ) -> f64 {
     // Frame in the disk plane: e1 from the receiver's axis foot towards the axis (any direction on the axis).
-    let e1 = if rho > 0.0 { -r_perp / rho } else { d.any_orthonormal_vector() };
+    let e1 = if rho > 0.0 { -r_perp / rho } else { super::orthonormal_to(d) };
     let e2 = d.cross(e1);
     let (n1, n2, n_d) = (n.dot(e1), n.dot(e2), n.dot(d));
     // Visible arc: n·q + R m cos(φ − γ) ≥ 0.
