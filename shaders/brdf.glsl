@@ -16,8 +16,11 @@ float one_minus_dot(vec3 a, vec3 b) {
 }
 
 // (1 - x)^e as exp(e log1p(-x)); 1 for e = 0, 0 for x >= 1 when e > 0. Replaces pow(cos, e), whose base is
-// already rounded (lavapipe: pow(0.999, 1e4) is 6e-4 off).
+// already rounded (lavapipe: pow(0.999, 1e4) is 6e-4 off). SUNSHADE_NAIVE_MATH (diagnostics) restores pow.
 float cos_power(float one_minus_cos, float exponent) {
+#ifdef SUNSHADE_NAIVE_MATH
+    return pow(max(1.0 - one_minus_cos, 0.0), exponent);
+#else
     if (exponent == 0.0) {
         return 1.0;
     }
@@ -25,6 +28,7 @@ float cos_power(float one_minus_cos, float exponent) {
         return 0.0;
     }
     return exp(exponent * log1p_accurate(-one_minus_cos));
+#endif
 }
 
 // The mirror direction of l about n: 2(n.l)n - l (GLSL's reflect() has the opposite sign convention).

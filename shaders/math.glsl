@@ -52,10 +52,68 @@ vec3 orthonormal_to(vec3 v) {
     return vec3(b, s + v.y * v.y * a, -v.y);
 }
 
-// log1p(x) by Goldberg's trick from log (0-1 ulp on lavapipe).
+// ln(u) for u > 0 with a small relative error everywhere, 1 at u = 1 included. lavapipe's log has a small
+// absolute error (~6e-8) but not a small relative one near u = 1: for u just below 1 it computes
+// -1 + log2(1.99...) and cancels (measured: up to 2e-3 relative error for u in (0.999, 1); this function stays
+// within 2e-7 from 2^-20 to 2^20; docs/platform.md). Here
+// u = m 2^k with m in [sqrt(1/2), sqrt(2)), and ln m = 2 atanh(s), s = (m - 1)/(m + 1), |s| <= 0.172, summed as
+// 2 s (1 + s^2/3 + ... + s^12/13): the truncation is below 1e-10 relative, m - 1 is exact (Sterbenz) and every
+// other step rounds once, so the result carries a few ulp of relative error even where ln u is tiny.
+float log_accurate(float u) {
+#ifdef SUNSHADE_NAIVE_MATH
+    return log(u);
+#else
+    int k;
+    float m = frexp(u, k);
+    if (m < 0.70710678118) {
+        m *= 2.0;
+        k -= 1;
+    }
+    float s = (m - 1.0) / (m + 1.0);
+    float s2 = s * s;
+    float series = 1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0
+        + s2 * (1.0 / 11.0 + s2 * (1.0 / 13.0))))));
+    return 2.0 * s * series + float(k) * 0.69314718055994530942;
+#endif
+}
+
+// log1p(x) by Goldberg's trick: u = 1 + x rounded, ln(u) x / (u - 1), with the accurate ln above. `precise`
+// keeps the compiler from folding (1 + x) - 1 into x (NIR does that to inexact arithmetic), which undoes the trick.
 float log1p_accurate(float x) {
-    float u = 1.0 + x;
-    return u == 1.0 ? x : log(u) * x / (u - 1.0);
+#ifdef SUNSHADE_NAIVE_MATH
+    return log(1.0 + x);
+#else
+    precise float u = 1.0 + x;
+    precise float um1 = u - 1.0;
+    return u == 1.0 ? x : log_accurate(u) * x / um1;
+#endif
+}
+
+// exp(x) - 1 without cancellation for small x (Kahan's trick): (u - 1) x / ln u with u = exp(x) rounded. `precise`
+// keeps u - 1 as computed (see log1p_over_x) and log_accurate keeps ln u accurate near 1.
+float exp_minus_one(float x) {
+    precise float u = exp(x);
+    if (u == 1.0) {
+        return x;
+    }
+    precise float um1 = u - 1.0;
+    if (um1 == -1.0) {
+        return -1.0;
+    }
+    return um1 * x / log_accurate(u);
+}
+
+// asinh(x) without cancellation: sign(x) log1p(|x| + x^2 / (1 + sqrt(1 + x^2))) (the device's asinh goes through
+// log(x + sqrt(x^2 + 1)), which loses the digits of small x); ln(2|x|) where x^2 would overflow.
+float asinh_accurate(float x) {
+    float a = abs(x);
+    float r = a > 1e18 ? log_accurate(a) + 0.69314718055994530942 : log1p_accurate(a + a * a / (1.0 + sqrt(1.0 + a * a)));
+    return x < 0.0 ? -r : r;
+}
+
+// sinh(z) without cancellation near 0: (expm1(z) - expm1(-z)) / 2.
+float sinh_accurate(float z) {
+    return 0.5 * (exp_minus_one(z) - exp_minus_one(-z));
 }
 
 #endif

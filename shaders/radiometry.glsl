@@ -88,13 +88,15 @@ float tan_half(float phi) {
     return tan(0.5 * phi);
 }
 
-// log1p(x)/x, 1 at 0, from log (0-1 ulp on lavapipe) by Goldberg's trick: u = 1 + x rounded, log(u)/(u - 1).
+// log1p(x)/x, 1 at 0, by Goldberg's trick: u = 1 + x rounded, ln(u)/(u - 1). `precise` keeps the compiler from
+// folding (1 + x) - 1 into x (NIR does that to inexact arithmetic on lavapipe), which would undo the trick.
 float log1p_over_x(float x) {
-    float u = 1.0 + x;
+    precise float u = 1.0 + x;
+    precise float um1 = u - 1.0;
     if (u == 1.0) {
         return 1.0;
     }
-    return log(u) / (u - 1.0);
+    return log_accurate(u) / um1;
 }
 
 // (integral dphi/D, integral cos phi/D, integral sin phi/D) over [phi_a, phi_b], D = b0 + b cos phi.

@@ -60,35 +60,35 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
     return 0.0;
 }
 
-// integral of lobe (n.w)+ over the sun's cap, per unit radiance: a midpoint grid in (beta, phi).
-float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_diameter, uint per_axis) {
-    float sigma = 0.5 * angular_diameter;
-    vec3 t = orthonormal_to(direction);
-    vec3 b = cross(direction, t);
-    float k = float(per_axis);
-    float d_beta = sigma / k;
-    float d_phi = 2.0 * PI / k;
-    float sum = 0.0;
-    for (uint i = 0u; i < per_axis; ++i) {
-        float beta = (float(i) + 0.5) * d_beta;
-        float sb = sin(beta);
-        float cb = cos(beta);
-        for (uint j = 0u; j < per_axis; ++j) {
-            float phi = (float(j) + 0.5) * d_phi;
-            vec3 w = cb * direction + sb * (cos(phi) * t + sin(phi) * b);
-            float c = dot(p.normal, w);
-            if (c > 0.0) {
-                sum += specular_lobe(m, p, w) * c * sb;
-            }
-        }
+// The angular width [rad] about a lobe's peak over which the disk integral crowds its samples (see the Rust).
+float lobe_width(MaterialGpu m) {
+    uint kind = m.kind.x;
+    if (kind == BRDF_PHONG) {
+        return 1.0 / sqrt(m.ks.w + 1.0);
     }
-    return sum * d_beta * d_phi;
+    if (kind == BRDF_BLINN_PHONG) {
+        return 2.0 / sqrt(m.ks.w + 1.0);
+    }
+    if (kind == BRDF_WARD) {
+        return 2.0 * sqrt(m.params.x * m.params.y);
+    }
+    return PI;
 }
 
-// integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance (segment coordinates).
-float disk_lobe_integral(MaterialGpu m, Frame p, vec3 center, vec3 d, float radius, uint per_axis) {
+// The point for u in (0, 1) of a grid on [a, b] graded about c with width w, x = c + w sinh(z), and its density
+// dx/du: (x, dx/du). sinh and asinh without cancellation near 0 (math.glsl).
+vec2 sinh_warp(float a, float b, float c, float w, float u) {
+    float za = asinh_accurate((a - c) / w);
+    float zb = asinh_accurate((b - c) / w);
+    float z = za + u * (zb - za);
+    return vec2(clamp(c + w * sinh_accurate(z), a, b), w * (zb - za) * cosh(z));
+}
+
+// integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance, for the disk of radius
+// `radius` centred at q from the point, emitting along d: segment coordinates, the grid graded about the lobe's
+// peak (see the Rust).
+float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis) {
     vec3 n = p.normal;
-    vec3 q = center - p.position;
     float h = -dot(d, q);
     if (!(h > 0.0 && radius > 0.0)) {
         return 0.0;
@@ -109,40 +109,55 @@ float disk_lobe_integral(MaterialGpu m, Frame p, vec3 center, vec3 d, float radi
         alpha = atan2_accurate(sqrt((1.0 - kappa) * (1.0 + kappa)), kappa);
     }
     vec3 v = cross(d, w);
+    vec3 r = mirror(p.to_viewer, n);
+    float toward = min(dot(r, d), -1e-6);
+    float t = h / -toward;
+    vec3 rel = t * r - q;
+    float footprint = t * lobe_width(m) / -toward;
+    float off = length(rel);
+    if (off > radius) {
+        float outside = off - radius;
+        footprint = footprint * footprint / (footprint + outside);
+        rel *= radius / off;
+    }
+    float a = dot(rel, w) / radius;
+    float beta_c = min(a >= 1.0 ? 0.0 : (a <= -1.0 ? PI : atan2_accurate(sqrt((1.0 - a) * (1.0 + a)), a)), alpha);
+    float sbc = sin(beta_c);
+    float cbc = cos(beta_c);
+    float s_c = sbc > 0.0 ? clamp(dot(rel, v) / (radius * sbc), -1.0, 1.0) : 0.0;
+    float rate_beta = radius * sqrt(sbc * sbc + cbc * cbc * s_c * s_c);
+    float width_beta = min(footprint / max(rate_beta, 1e-30), 16.0 * alpha);
+    float width_s = min(footprint / max(radius * sbc, 1e-30), 32.0);
     float k = float(per_axis);
-    float d_beta = alpha / k;
-    float d_s = 2.0 / k;
     float sum = 0.0;
     for (uint i = 0u; i < per_axis; ++i) {
-        float beta = (float(i) + 0.5) * d_beta;
-        float sb = sin(beta);
-        float cb = cos(beta);
+        vec2 bw = sinh_warp(0.0, alpha, beta_c, width_beta, (float(i) + 0.5) / k);
+        float sb = sin(bw.x);
+        float cb = cos(bw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            float s = -1.0 + (float(j) + 0.5) * d_s;
-            vec3 y = q + radius * cb * w + radius * sb * s * v;
+            vec2 sw = sinh_warp(-1.0, 1.0, s_c, width_s, (float(j) + 0.5) / k);
+            vec3 y = q + radius * cb * w + radius * sb * sw.x * v;
             float dist2 = dot(y, y);
             float dist = sqrt(dist2);
             vec3 omega = y / dist;
             float c = dot(n, omega);
             if (c > 0.0) {
-                sum += specular_lobe(m, p, omega) * c * h / (dist2 * dist) * radius * radius * sb * sb;
+                sum += specular_lobe(m, p, omega) * c * h / (dist2 * dist) * radius * radius * sb * sb * bw.y * sw.y;
             }
         }
     }
-    return sum * d_beta * d_s;
+    return sum / (k * k);
 }
 
-// exp(x) - 1 without cancellation for small x (Kahan's trick).
-float exp_minus_one(float x) {
-    float u = exp(x);
-    if (u == 1.0) {
-        return x;
-    }
-    float um1 = u - 1.0;
-    if (um1 == -1.0) {
-        return -1.0;
-    }
-    return um1 * x / log(u);
+// integral of lobe (n.w)+ over the part of a disk light above the horizon, per unit radiance.
+float disk_lobe_integral(MaterialGpu m, Frame p, vec3 center, vec3 d, float radius, uint per_axis) {
+    return segment_lobe_integral(m, p, center - p.position, d, radius, per_axis);
+}
+
+// integral of lobe (n.w)+ over the sun's cap, per unit radiance: the cap is the disk of radius tan(delta/2) one
+// unit away, facing back (see the Rust).
+float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_diameter, uint per_axis) {
+    return segment_lobe_integral(m, p, direction, -direction, tan(0.5 * angular_diameter), per_axis);
 }
 
 // integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
@@ -163,7 +178,7 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
                 vec3 r = mirror(v, n);
                 vec3 t = orthonormal_to(r);
                 vec3 b = cross(r, t);
-                float x = log(1.0 - xi1) / (e + 1.0);
+                float x = log1p_accurate(-xi1) / (e + 1.0);
                 float one_minus_cos = -exp_minus_one(x);
                 float cos_a = 1.0 - one_minus_cos;
                 float sin_a = sqrt(one_minus_cos * (1.0 + cos_a));
@@ -173,7 +188,7 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
                 float e = m.ks.w;
                 vec3 t = orthonormal_to(n);
                 vec3 b = cross(n, t);
-                float x = log(1.0 - xi1) / (e + 1.0);
+                float x = log1p_accurate(-xi1) / (e + 1.0);
                 float one_minus_cos = -exp_minus_one(x);
                 float cos_h = 1.0 - one_minus_cos;
                 float sin_h = sqrt(one_minus_cos * (1.0 + cos_h));
@@ -189,7 +204,7 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
                 float phi_h = atan2_accurate(ay * sin(phi), ax * cos(phi));
                 float sp = sin(phi_h);
                 float cp = cos(phi_h);
-                float tan2 = -log(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
+                float tan2 = -log_accurate(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
                 float cos_d = 1.0 / sqrt(1.0 + tan2);
                 float sin_d = sqrt(tan2) * cos_d;
                 vec3 h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;

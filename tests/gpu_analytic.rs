@@ -591,7 +591,8 @@ fn every_interpolation_mode_renders_flat_faces_exactly() {
     let want = lambert(0.7, DVec3::Z, &s);
     for mode in [Interpolation::Device, Interpolation::BarycentricF32, Interpolation::BarycentricF64] {
         let mut r =
-            Renderer::new(&ContextOptions { validation: true, device: None, interpolation: Some(mode) }).unwrap();
+            Renderer::new(&ContextOptions { validation: true, interpolation: Some(mode), ..Default::default() })
+                .unwrap();
         assert_eq!(r.interpolation(), mode);
         let log = r.validation_log();
         let (img, _) = r.render_scene(&scene, &s).unwrap();

@@ -2,6 +2,7 @@
 //!
 //! It knows glTF (JSON and GLB) and nothing else. Geometry helpers ([`shapes`]) build the meshes.
 
+pub mod chart;
 pub mod shapes;
 
 use std::path::Path;

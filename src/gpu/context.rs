@@ -57,6 +57,9 @@ pub struct ContextOptions {
     pub device: Option<String>,
     /// `None`: f64 barycentrics where the device has `shaderFloat64`, else f32.
     pub interpolation: Option<Interpolation>,
+    /// Diagnostics only: compile the shaders with the textbook formulas (`pow(cos α, e)`, the device's `log`)
+    /// instead of the accurate ones, to measure what those gain (`sunshade bench --brdf-chart`).
+    pub naive_math: bool,
 }
 
 impl ContextOptions {

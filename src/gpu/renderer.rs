@@ -87,13 +87,16 @@ impl Renderer {
             None if dev.info.shader_float64 => Interpolation::BarycentricF64,
             None => Interpolation::BarycentricF32,
         };
-        let defines: &[&str] = match interpolation {
-            Interpolation::Device => &["SUNSHADE_DEVICE_INTERPOLATION"],
-            Interpolation::BarycentricF32 => &[],
-            Interpolation::BarycentricF64 => &["SUNSHADE_F64_BARYCENTRICS"],
-        };
-        let vs = shaders::compile("scene.vert", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
-        let fs = shaders::compile("scene.frag", shaders::SOURCES, defines).map_err(GpuError::ShaderCompile)?;
+        let mut defines = vec![match interpolation {
+            Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
+            Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
+            Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
+        }];
+        if options.naive_math {
+            defines.push("SUNSHADE_NAIVE_MATH");
+        }
+        let vs = shaders::compile("scene.vert", shaders::SOURCES, &defines).map_err(GpuError::ShaderCompile)?;
+        let fs = shaders::compile("scene.frag", shaders::SOURCES, &defines).map_err(GpuError::ShaderCompile)?;
         let pipeline = ScenePipeline::new(&dev, &vs, &fs, interpolation == Interpolation::Device)?;
         let shader_compile = t1.elapsed();
         let commands = Commands::new(&dev)?;

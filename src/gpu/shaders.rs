@@ -58,7 +58,12 @@ mod tests {
     #[test]
     fn every_embedded_stage_compiles() {
         for (name, _) in SOURCES.iter().filter(|(n, _)| !n.ends_with(".glsl")) {
-            for defines in [&[][..], &["SUNSHADE_F64_BARYCENTRICS"][..], &["SUNSHADE_DEVICE_INTERPOLATION"][..]] {
+            for defines in [
+                &["SUNSHADE_F32_BARYCENTRICS"][..],
+                &["SUNSHADE_F64_BARYCENTRICS"][..],
+                &["SUNSHADE_DEVICE_INTERPOLATION"][..],
+                &["SUNSHADE_F64_BARYCENTRICS", "SUNSHADE_NAIVE_MATH"][..],
+            ] {
                 let words = compile(name, SOURCES, defines).unwrap_or_else(|e| panic!("{e}"));
                 assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
             }

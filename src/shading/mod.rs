@@ -3,6 +3,7 @@
 //! This Rust code is the specification. It is written for f64 and used as is by the CPU reference renderer;
 //! the GLSL in `shaders/` (`radiometry.glsl`, `brdf.glsl`, `shade.glsl`) mirrors it name for name in f32.
 
+pub mod albedo;
 pub mod brdf;
 pub mod quadrature;
 pub mod radiometry;
