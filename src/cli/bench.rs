@@ -10,27 +10,27 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::args::parse_positive;
+use super::generated::{machine, today, update_region};
 use super::CliError;
+use crate::authoring::chart;
 use crate::compare::{self, DiffOptions};
 use crate::cpu::{self, ReferenceOptions};
-use crate::gpu::{ContextOptions, Interpolation, Renderer};
+use crate::gpu::{ContextOptions, DeviceInfo, Interpolation, Renderer};
 use crate::scene::{self, LoadOptions};
 use crate::settings::{self, CameraOptions, SunOptions};
-
-/// Marks the region of a Markdown file that `--update` replaces.
-pub const BEGIN_MARK: &str = "<!-- sunshade bench: begin (generated; do not edit by hand) -->";
-pub const END_MARK: &str = "<!-- sunshade bench: end -->";
+use crate::shading::SunModel;
+use glam::DVec3;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Scenes to measure (default: every .glb and .gltf in models/).
     pub scenes: Vec<PathBuf>,
-    /// Image width [pixels].
-    #[arg(long, default_value_t = 1024)]
-    pub width: u32,
-    /// Image height [pixels].
-    #[arg(long, default_value_t = 1024)]
-    pub height: u32,
+    /// Image width [pixels] (default 1024).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height [pixels] (default 1024).
+    #[arg(long)]
+    pub height: Option<u32>,
     /// Timed runs per measurement (after one warm-up run); the median is reported.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
@@ -53,6 +53,12 @@ pub struct BenchArgs {
     /// Interpolation modes to measure, comma-separated (default: the renderer's default only).
     #[arg(long, value_delimiter = ',', value_name = "f64,f32,device")]
     pub interpolation: Vec<Interpolation>,
+    /// Instead of scenes, measure the BRDF chart (a sphere per BRDF and parameter under the sun from three
+    /// directions, 256 × 256 unless --width/--height are given): the GPU's error against the reference with the
+    /// accurate shader formulas and with the textbook ones (`pow(cos α, e)`, the device's `log`), and the GPU
+    /// frame time of each. Its --update region is "brdf-chart".
+    #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs"])]
+    pub brdf_chart: bool,
 }
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -65,6 +71,10 @@ fn ms(d: Duration) -> f64 {
 }
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
+    if a.brdf_chart {
+        return brdf_chart(a);
+    }
+    let (width, height) = (a.width.unwrap_or(1024), a.height.unwrap_or(1024));
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
     let modes: Vec<Option<Interpolation>> =
         if a.interpolation.is_empty() { vec![None] } else { a.interpolation.iter().copied().map(Some).collect() };
@@ -73,25 +83,21 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     for mode in modes {
         let options = ContextOptions { device: a.device.clone(), interpolation: mode, ..ContextOptions::from_env() };
         let mut renderer = Renderer::new(&options)?;
-        renderer.check_size(a.width, a.height)?;
+        renderer.check_size(width, height)?;
         info = Some(renderer.device_info().clone());
-        rows.extend(bench_scenes(&mut renderer, &scenes, a)?);
+        rows.extend(bench_scenes(&mut renderer, &scenes, a, (width, height))?);
     }
     let info = info.expect("at least one mode");
     let mut out = String::new();
     out += &format!(
-        "Measured by `sunshade bench` on {}: {} ({} threads); Vulkan device {} ({}, {} {}); {} build; {}×{} pixels; \
+        "Measured by `sunshade bench` on {}: {}; Vulkan device {}; {} build; {}×{} pixels; \
          median of {} warm runs; tolerance {:e} relative with a floor of 1% of the peak.\n\n",
         today(),
-        cpu_model(),
-        std::thread::available_parallelism().map_or(1, |n| n.get()),
-        info.name,
-        info.type_name(),
-        info.driver_name,
-        info.driver_info,
-        if cfg!(debug_assertions) { "debug" } else { "release" },
-        a.width,
-        a.height,
+        machine(),
+        device_description(&info),
+        build(),
+        width,
+        height,
         a.repeat,
         a.fail_rel,
     );
@@ -103,25 +109,125 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.process_runs > 0 {
         out += "\n";
-        out += &process_timing(a.process_scene.as_ref().unwrap_or(&scenes[0]), a.width, a.height, a.process_runs)?;
+        out += &process_timing(a.process_scene.as_ref().unwrap_or(&scenes[0]), width, height, a.process_runs)?;
     }
     print!("{out}");
     for doc in &a.update {
-        update_region(doc, &out)?;
+        update_region(doc, "", &out)?;
         eprintln!("sunshade bench: updated {}", doc.display());
     }
     Ok(())
 }
 
+fn device_description(info: &DeviceInfo) -> String {
+    format!("{} ({}, {} {})", info.name, info.type_name(), info.driver_name, info.driver_info)
+}
+
+fn build() -> &'static str {
+    if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    }
+}
+
+/// `--brdf-chart`: per chart material, the largest relative error over the three suns (interior pixels, floor 1%
+/// of the peak) and the median GPU frame time, with the accurate and with the textbook shader formulas.
+fn brdf_chart(a: &BenchArgs) -> Result<(), CliError> {
+    let (width, height) = (a.width.unwrap_or(256), a.height.unwrap_or(256));
+    let dir = std::env::temp_dir().join(format!("sunshade-brdf-chart-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| CliError::Usage(format!("{}: {e}", dir.display())))?;
+    let result = brdf_chart_in(a, &dir, width, height);
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = result?;
+    print!("{out}");
+    for doc in &a.update {
+        update_region(doc, "brdf-chart", &out)?;
+        eprintln!("sunshade bench: updated {}", doc.display());
+    }
+    Ok(())
+}
+
+fn brdf_chart_in(a: &BenchArgs, dir: &Path, width: u32, height: u32) -> Result<String, CliError> {
+    let mut renderers = Vec::new();
+    for naive_math in [false, true] {
+        let options = ContextOptions { device: a.device.clone(), naive_math, ..ContextOptions::from_env() };
+        let r = Renderer::new(&options)?;
+        r.check_size(width, height)?;
+        renderers.push(r);
+    }
+    let info = renderers[0].device_info().clone();
+    let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
+    let mut out = format!(
+        "Measured by `sunshade bench --brdf-chart` on {}: {}; Vulkan device {}, {} interpolation; {} build; \
+         {}×{} pixels; delta sun at {:?}° from the view; error relative to max(|GPU|, |CPU|, 1% of the peak), \
+         interior pixels; GPU frame: median of {} warm runs over the three suns.\n\n",
+        today(),
+        machine(),
+        device_description(&info),
+        renderers[0].interpolation().name(),
+        build(),
+        width,
+        height,
+        chart::SUN_FROM_VIEW_DEGREES,
+        a.repeat,
+    );
+    out += "| material | peak [W/(m²·sr)] | max rel, accurate formulas | max rel, textbook formulas | textbook / accurate | GPU frame, accurate [ms] | GPU frame, textbook [ms] |\n";
+    out += "|---|---:|---:|---:|---:|---:|---:|\n";
+    for material in chart::brdf_chart() {
+        let path = dir.join(chart::file_name(&material));
+        chart::sphere_scene(&material).write(&path).map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        let scene = scene::load_with_options(&path, &LoadOptions::default())?;
+        let (mut errors, mut times, mut peak) = ([0.0f64; 2], [Vec::new(), Vec::new()], 0.0f64);
+        for degrees in chart::SUN_FROM_VIEW_DEGREES {
+            let sun =
+                SunOptions { direction: Some(DVec3::from_array(chart::sun_direction(degrees))), ..Default::default() };
+            let mut s = settings::resolve(&scene, width, height, &CameraOptions::default(), &sun)
+                .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+            s.shading.sun = SunModel::Delta;
+            let cpu_image = cpu::render(&scene, &s, &reference);
+            for (k, renderer) in renderers.iter_mut().enumerate() {
+                let gpu_scene = renderer.upload(&scene)?;
+                let (gpu_image, _) = renderer.render(&gpu_scene, &s)?;
+                for _ in 0..a.repeat {
+                    times[k].push(renderer.render(&gpu_scene, &s)?.1.render);
+                }
+                let (report, _) = compare::diff(&gpu_image, &cpu_image, &DiffOptions::default())
+                    .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
+                errors[k] = errors[k].max(report.max_rel_interior);
+                peak = peak.max(report.peak);
+            }
+        }
+        let [t0, t1] = times.map(median);
+        out += &format!(
+            "| {} | {:.3e} | {:.2e} | {:.2e} | {:.0} | {:.2} | {:.2} |\n",
+            material.name,
+            peak,
+            errors[0],
+            errors[1],
+            errors[1] / errors[0],
+            ms(t0),
+            ms(t1)
+        );
+        eprintln!("sunshade bench: {} done", material.name);
+    }
+    Ok(out)
+}
+
 /// One table row per scene, for this renderer.
-fn bench_scenes(renderer: &mut Renderer, scenes: &[PathBuf], a: &BenchArgs) -> Result<Vec<String>, CliError> {
+fn bench_scenes(
+    renderer: &mut Renderer,
+    scenes: &[PathBuf],
+    a: &BenchArgs,
+    (width, height): (u32, u32),
+) -> Result<Vec<String>, CliError> {
     let options =
         ReferenceOptions { sub_pixel_bits: renderer.device_info().sub_pixel_precision_bits, ..Default::default() };
     let diff_options = DiffOptions { fail_rel: Some(a.fail_rel), ..Default::default() };
     let mut rows = Vec::new();
     for path in scenes {
         let scene = scene::load_with_options(path, &LoadOptions::default())?;
-        let s = settings::resolve(&scene, a.width, a.height, &CameraOptions::default(), &SunOptions::default())
+        let s = settings::resolve(&scene, width, height, &CameraOptions::default(), &SunOptions::default())
             .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
         let gpu_scene = renderer.upload(&scene)?;
         let (gpu_image, _) = renderer.render(&gpu_scene, &s)?; // warm-up: the device compiles shaders at first draw
@@ -229,46 +335,4 @@ fn process_timing(scene: &Path, width: u32, height: u32, runs: u32) -> Result<St
     s.pop();
     s += ".\n";
     Ok(s)
-}
-
-/// Replaces the text between [`BEGIN_MARK`] and [`END_MARK`] in `doc`.
-fn update_region(doc: &Path, content: &str) -> Result<(), CliError> {
-    let text = std::fs::read_to_string(doc).map_err(|e| CliError::Usage(format!("{}: {e}", doc.display())))?;
-    let (Some(b), Some(e)) = (text.find(BEGIN_MARK), text.find(END_MARK)) else {
-        return Err(CliError::Usage(format!("{}: no '{BEGIN_MARK}' ... '{END_MARK}' region", doc.display())));
-    };
-    if e < b {
-        return Err(CliError::Usage(format!("{}: the bench markers are out of order", doc.display())));
-    }
-    let new = format!("{}{BEGIN_MARK}\n{content}{}", &text[..b], &text[e..]);
-    crate::film::write_atomically(doc, |w| std::io::Write::write_all(w, new.as_bytes()))?;
-    Ok(())
-}
-
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
-}
-
-/// Today's date (UTC) as YYYY-MM-DD.
-fn today() -> String {
-    let days =
-        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs() / 86_400) as i64;
-    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + (m <= 2) as i64;
-    format!("{y:04}-{m:02}-{d:02}")
 }

@@ -3,9 +3,11 @@
 //! Exit codes: 0 success, 1 failure, 2 usage error. Every error is one line on stderr that names the file or the
 //! flag at fault.
 
+mod albedo;
 mod args;
 mod bench;
 mod diff;
+mod generated;
 mod info;
 mod reference;
 mod render;
@@ -41,6 +43,9 @@ enum Command {
     Info(info::InfoArgs),
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     Bench(Box<bench::BenchArgs>),
+    /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
+    /// light integrals per sample count; with a scene, the albedo of its materials.
+    Albedo(albedo::AlbedoArgs),
 }
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
@@ -78,6 +83,7 @@ pub fn main() -> ExitCode {
         Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Albedo(a) => albedo::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,61 @@
+//! Generated regions of Markdown files: the commands that measure (`bench`, `albedo`) write their tables between
+//! markers, so that every published figure comes from a command and names the machine it ran on.
+
+use std::path::Path;
+
+use super::CliError;
+
+/// The markers around the region `name` ("" for the bench's main table).
+pub fn markers(name: &str) -> (String, String) {
+    let tag = if name.is_empty() { "sunshade bench".to_string() } else { format!("sunshade {name}") };
+    (format!("<!-- {tag}: begin (generated; do not edit by hand) -->"), format!("<!-- {tag}: end -->"))
+}
+
+/// Replaces the text between the markers of region `name` in `doc` with `content` (atomically).
+pub fn update_region(doc: &Path, name: &str, content: &str) -> Result<(), CliError> {
+    let (begin, end) = markers(name);
+    let text = std::fs::read_to_string(doc).map_err(|e| CliError::Usage(format!("{}: {e}", doc.display())))?;
+    let (Some(b), Some(e)) = (text.find(&begin), text.find(&end)) else {
+        return Err(CliError::Usage(format!("{}: no '{begin}' ... '{end}' region", doc.display())));
+    };
+    if e < b {
+        return Err(CliError::Usage(format!("{}: the markers of '{name}' are out of order", doc.display())));
+    }
+    let new = format!("{}{begin}\n{content}{}", &text[..b], &text[e..]);
+    crate::film::write_atomically(doc, |w| std::io::Write::write_all(w, new.as_bytes()))?;
+    Ok(())
+}
+
+/// The CPU's model name (from /proc/cpuinfo) or the architecture.
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// "<cpu model> (<n> threads)".
+pub fn machine() -> String {
+    format!("{} ({} threads)", cpu_model(), std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// Today's date (UTC) as YYYY-MM-DD.
+pub fn today() -> String {
+    let days =
+        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs() / 86_400) as i64;
+    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + (m <= 2) as i64;
+    format!("{y:04}-{m:02}-{d:02}")
+}
