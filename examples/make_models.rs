@@ -206,6 +206,36 @@ fn spheres() -> GltfBuilder {
     b
 }
 
+/// One sphere per BRDF on a grey floor: Lambert, Phong, Blinn-Phong, isotropic and anisotropic Ward (material
+/// extras, README "BRDFs"). No light: the README's pictures light it with the sun, a disk skylight and the sky.
+fn brdfs() -> GltfBuilder {
+    let mut b = GltfBuilder::new();
+    let mut roots =
+        vec![mesh_node(&mut b, "floor", &grid(Vec3::ZERO, 8.0, 16), [0.5, 0.5, 0.5], false, Transform::Identity)];
+    let materials = [
+        ("Lambert", json!({ "brdf": "lambert", "albedo": [0.75, 0.45, 0.3] })),
+        ("Phong e=80", json!({ "brdf": "phong", "kd": [0.15, 0.3, 0.6], "ks": [0.35, 0.35, 0.35], "exponent": 80 })),
+        (
+            "Blinn-Phong e=300",
+            json!({ "brdf": "blinn-phong", "kd": [0.15, 0.5, 0.2], "ks": [0.35, 0.35, 0.35], "exponent": 300 }),
+        ),
+        ("Ward α=0.15", json!({ "brdf": "ward", "kd": [0.5, 0.15, 0.15], "ks": [0.4, 0.4, 0.4], "alpha": 0.15 })),
+        (
+            "Ward αx=0.05 αy=0.3",
+            json!({ "brdf": "ward", "kd": [0.4, 0.4, 0.45], "ks": [0.5, 0.5, 0.5], "alpha_x": 0.05, "alpha_y": 0.3 }),
+        ),
+    ];
+    for (i, (name, extras)) in materials.into_iter().enumerate() {
+        let m = b.add_material(name, [0.5; 3], false, Some(json!({ "sunshade": extras })));
+        let x = (i as f32 - 2.0) * 1.2;
+        let mesh = b.add_mesh(name, &[uv_sphere(Vec3::new(x, 0.5, 0.0), 0.5, 48, 96).primitive(Some(m))]);
+        roots.push(b.add_node(Node { name: Some(name.into()), mesh: Some(mesh), ..Default::default() }));
+    }
+    roots.push(camera_node(&mut b, Vec3::new(0.0, 1.8, 6.0), Vec3::new(0.0, 0.4, 0.0), 36.0));
+    b.add_scene(&roots, None);
+    b
+}
+
 fn main() -> std::io::Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     std::fs::create_dir_all(&dir)?;
@@ -216,8 +246,9 @@ fn main() -> std::io::Result<()> {
     let teapot = sunshade::scene::load(&dir.join("teapot.glb")).map_err(std::io::Error::other)?;
     overcast(&teapot).write(&dir.join("overcast.glb"))?;
     sunset().write(&dir.join("sunset.glb"))?;
+    brdfs().write(&dir.join("brdfs.glb"))?;
     println!(
-        "wrote square.gltf (+ .bin), cube.glb, spheres.glb, room.gltf (+ .bin), overcast.glb, sunset.glb in {}",
+        "wrote square.gltf (+ .bin), cube.glb, spheres.glb, room.gltf (+ .bin), overcast.glb, sunset.glb, brdfs.glb in {}",
         dir.display()
     );
     Ok(())

@@ -317,9 +317,9 @@ fn isolated_needles_at_a_size_that_is_not_a_power_of_two() {
 }
 
 #[test]
-fn every_light_and_model_on_the_teapot_and_spheres() {
+fn every_light_and_model_on_the_teapot_and_the_sphere_scenes() {
     let mut gpu = CheckedRenderer::new();
-    for model in ["teapot.glb", "spheres.glb"] {
+    for model in ["teapot.glb", "spheres.glb", "brdfs.glb"] {
         let scene = common::load(&models_dir().join(model));
         let bs = scene.bounding_sphere().unwrap();
         // Disk lights outside the model, placed and sized by its bounding sphere (centre c, radius r).
