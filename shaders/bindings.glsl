@@ -9,17 +9,28 @@
 #define BRDF_BLINN_PHONG 2u
 #define BRDF_WARD 3u
 
-// Light models (LightBuffer.counts.y and .z); values match gpu::layout::*_MODEL_*.
-#define SUN_MODEL_DISK 0u
-#define SUN_MODEL_DELTA 1u
-#define DISK_MODEL_EXACT 0u
-#define DISK_MODEL_SMALL_SOURCE 1u
+// Which lights a frame has, and their models (the VARIANT_* constants below); values match gpu::layout.
+#define LIGHT_ABSENT 0u
+#define SUN_DISK 1u
+#define SUN_DELTA 2u
+#define DISKS_EXACT 1u
+#define DISKS_SMALL_SOURCE 2u
+#define SKY_PRESENT 1u
+
+// The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
+// material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
+// is created. That matters: on lavapipe, code present in the shader costs time even where no pixel runs it
+// (docs/accuracy.md, "Pipeline variants").
+layout(constant_id = 0) const uint VARIANT_BRDF = 0u;  // BRDF_*
+layout(constant_id = 1) const uint VARIANT_SUN = 0u;   // LIGHT_ABSENT, SUN_DISK or SUN_DELTA
+layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EXACT or DISKS_SMALL_SOURCE
+layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
 
 struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
     vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
     vec4 params; // x, y: Ward alpha_x, alpha_y
-    uvec4 kind;  // x: BRDF kind; y: 1 if double-sided
+    uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided
 };
 
 struct SunGpu {
@@ -40,7 +51,7 @@ layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
-    uvec4 counts;   // x: number of disk lights; y: sun model; z: disk model; w: samples per axis (disks, sky)
+    uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
     uvec4 sampling; // x: samples per axis over the sun's disk
     DiskGpu disks[];
 } lights;

@@ -21,25 +21,25 @@ struct Frame {
     vec3 to_viewer;
 };
 
-// Irradiance [W/m^2] per channel from all the lights (models chosen by lights.counts.y (sun) and .z (disks)).
+// Irradiance [W/m^2] per channel from all the lights (which, and their models: the pipeline variant).
 vec3 irradiance(vec3 position, vec3 normal) {
     vec3 e = vec3(0.0);
-    if (lights.sun.irradiance.w != 0.0) {
+    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
         float n_dot_l = dot(normal, lights.sun.direction.xyz);
-        if (lights.counts.y == SUN_MODEL_DELTA) {
+        if (VARIANT_SUN == SUN_DELTA) {
             e += sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
         } else {
             e += sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, lights.sun.direction.w);
         }
     }
-    for (uint i = 0u; i < lights.counts.x; ++i) {
+    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
         DiskGpu d = lights.disks[i];
-        float omega = lights.counts.z == DISK_MODEL_SMALL_SOURCE
+        float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
             ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
             : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
         e += d.radiance.rgb * omega;
     }
-    if (lights.sky.w != 0.0) {
+    if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
         e += sky_irradiance(lights.sky.rgb, normal.y);
     }
     return e;
@@ -47,7 +47,7 @@ vec3 irradiance(vec3 position, vec3 normal) {
 
 // The specular lobe of a material (without ks) for light from l.
 float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
-    uint kind = m.kind.x;
+    uint kind = VARIANT_BRDF;
     if (kind == BRDF_PHONG) {
         return phong_lobe(p.normal, l, p.to_viewer, m.ks.w);
     }
@@ -62,7 +62,7 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
 
 // The angular width [rad] about a lobe's peak over which the disk integral crowds its samples (see the Rust).
 float lobe_width(MaterialGpu m) {
-    uint kind = m.kind.x;
+    uint kind = VARIANT_BRDF;
     if (kind == BRDF_PHONG) {
         return 1.0 / sqrt(m.ks.w + 1.0);
     }
@@ -165,7 +165,7 @@ float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_di
 float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
     vec3 n = p.normal;
     vec3 v = p.to_viewer;
-    uint kind = m.kind.x;
+    uint kind = VARIANT_BRDF;
     float k = float(per_axis);
     float sum = 0.0;
     for (uint i = 0u; i < per_axis; ++i) {
@@ -226,13 +226,13 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         return vec3(0.0);
     }
     vec3 radiance = lambert_brdf(material.kd.rgb) * irradiance(p.position, p.normal);
-    if (material.kind.x == BRDF_LAMBERT) {
+    if (VARIANT_BRDF == BRDF_LAMBERT) {
         return radiance;
     }
     vec3 specular = vec3(0.0);
-    if (lights.sun.irradiance.w != 0.0) {
+    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
         vec3 l = lights.sun.direction.xyz;
-        if (lights.counts.y == SUN_MODEL_DELTA) {
+        if (VARIANT_SUN == SUN_DELTA) {
             specular += specular_lobe(material, p, l) * max(dot(p.normal, l), 0.0) * lights.sun.irradiance.rgb;
         } else {
             float delta = lights.sun.direction.w;
@@ -241,10 +241,10 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             specular += integral * lights.sun.irradiance.rgb / (PI * s * s);
         }
     }
-    for (uint i = 0u; i < lights.counts.x; ++i) {
+    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
         DiskGpu d = lights.disks[i];
         float integral;
-        if (lights.counts.z == DISK_MODEL_SMALL_SOURCE) {
+        if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
             vec3 to_center = safe_normalize(d.center_radius.xyz - p.position);
             integral = specular_lobe(material, p, to_center)
                 * disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
@@ -253,7 +253,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         }
         specular += integral * d.radiance.rgb;
     }
-    if (lights.sky.w != 0.0) {
+    if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
         specular += sky_lobe_integral(material, p, lights.counts.w) * lights.sky.rgb;
     }
     return radiance + material.ks.rgb * specular;

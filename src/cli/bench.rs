@@ -186,16 +186,21 @@ fn brdf_chart_in(a: &BenchArgs, dir: &Path, width: u32, height: u32) -> Result<S
                 .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
             s.shading.sun = SunModel::Delta;
             let cpu_image = cpu::render(&scene, &s, &reference);
+            let mut uploaded = Vec::new();
             for (k, renderer) in renderers.iter_mut().enumerate() {
                 let gpu_scene = renderer.upload(&scene)?;
                 let (gpu_image, _) = renderer.render(&gpu_scene, &s)?;
-                for _ in 0..a.repeat {
-                    times[k].push(renderer.render(&gpu_scene, &s)?.1.render);
-                }
                 let (report, _) = compare::diff(&gpu_image, &cpu_image, &DiffOptions::default())
                     .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
                 errors[k] = errors[k].max(report.max_rel_interior);
                 peak = peak.max(report.peak);
+                uploaded.push(gpu_scene);
+            }
+            // Interleaved, so that drift in the machine's speed falls on both alike.
+            for _ in 0..a.repeat {
+                for (k, renderer) in renderers.iter_mut().enumerate() {
+                    times[k].push(renderer.render(&uploaded[k], &s)?.1.render);
+                }
             }
         }
         let [t0, t1] = times.map(median);

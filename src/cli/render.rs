@@ -25,7 +25,8 @@ pub struct RenderArgs {
     /// device has shaderFloat64) or f32, or the device's varyings (docs/accuracy.md compares them).
     #[arg(long, value_name = "f64|f32|device")]
     pub interpolation: Option<Interpolation>,
-    /// Print the device and the time of each phase (instance, shader compile, upload, render, readback, encode).
+    /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
+    /// encode).
     #[arg(short, long)]
     pub verbose: bool,
     /// Also render the CPU reference (with the device's sub-pixel bits) and compare: exit 1 outside tolerance.
@@ -78,6 +79,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             ("instance", setup.instance),
             ("shader compile", setup.shader_compile),
             ("upload", upload_time),
+            ("pipelines", frame.pipelines),
             ("render", frame.render),
             ("readback", frame.readback),
             ("encode", encode_time),

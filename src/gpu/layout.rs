@@ -10,10 +10,49 @@ pub const BRDF_LAMBERT: u32 = 0;
 pub const BRDF_PHONG: u32 = 1;
 pub const BRDF_BLINN_PHONG: u32 = 2;
 pub const BRDF_WARD: u32 = 3;
-pub const SUN_MODEL_DISK: u32 = 0;
-pub const SUN_MODEL_DELTA: u32 = 1;
-pub const DISK_MODEL_EXACT: u32 = 0;
-pub const DISK_MODEL_SMALL_SOURCE: u32 = 1;
+pub const LIGHT_ABSENT: u32 = 0;
+pub const SUN_DISK: u32 = 1;
+pub const SUN_DELTA: u32 = 2;
+pub const DISKS_EXACT: u32 = 1;
+pub const DISKS_SMALL_SOURCE: u32 = 2;
+pub const SKY_PRESENT: u32 = 1;
+
+/// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
+/// `shaders/bindings.glsl`, constant ids 0 to 3). The shader keeps only the code these select.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ShaderVariant {
+    /// `BRDF_*` of the draw's material.
+    pub brdf: u32,
+    /// `LIGHT_ABSENT`, `SUN_DISK` or `SUN_DELTA`.
+    pub sun: u32,
+    /// `LIGHT_ABSENT`, `DISKS_EXACT` or `DISKS_SMALL_SOURCE`.
+    pub disks: u32,
+    /// `LIGHT_ABSENT` or `SKY_PRESENT`.
+    pub sky: u32,
+}
+
+impl ShaderVariant {
+    /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights.
+    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions) -> Self {
+        let sun = match (&lights.sun, shading.sun) {
+            (None, _) => LIGHT_ABSENT,
+            (Some(_), SunModel::Disk) => SUN_DISK,
+            (Some(_), SunModel::Delta) => SUN_DELTA,
+        };
+        let disks = match (lights.disks.is_empty(), shading.disk) {
+            (true, _) => LIGHT_ABSENT,
+            (false, DiskModel::Exact) => DISKS_EXACT,
+            (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
+        };
+        let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
+        Self { brdf, sun, disks, sky }
+    }
+
+    /// The constants in `constant_id` order.
+    pub fn constants(&self) -> [u32; 4] {
+        [self.brdf, self.sun, self.disks, self.sky]
+    }
+}
 
 /// One vertex: world position [m], unit normal, unit tangent and handedness, interleaved
 /// (`FLOATS_PER_VERTEX` = 10 floats in the shaders).
@@ -55,7 +94,7 @@ pub struct DiskGpu {
 pub struct LightsHeader {
     pub sun: SunGpu,
     pub sky: [f32; 4],
-    /// Disk count, sun model, disk model, samples per axis for disks and the sky.
+    /// Disk count, unused, unused, samples per axis for disks and the sky.
     pub counts: [u32; 4],
     /// Samples per axis over the sun's disk; the rest unused.
     pub sampling: [u32; 4],
@@ -102,18 +141,10 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
         Some(l) => [l[0], l[1], l[2], 1.0],
         None => [0.0; 4],
     };
-    let sun_model = match shading.sun {
-        SunModel::Disk => SUN_MODEL_DISK,
-        SunModel::Delta => SUN_MODEL_DELTA,
-    };
-    let disk_model = match shading.disk {
-        DiskModel::Exact => DISK_MODEL_EXACT,
-        DiskModel::SmallSource => DISK_MODEL_SMALL_SOURCE,
-    };
     let header = LightsHeader {
         sun,
         sky,
-        counts: [lights.disks.len() as u32, sun_model, disk_model, shading.samples_per_axis],
+        counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
         sampling: [shading.sun_samples_per_axis, 0, 0, 0],
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();

@@ -1,18 +1,20 @@
-//! The scene pipeline: descriptor layout (materials, lights), push constants, and the graphics pipeline for
-//! dynamic rendering into RGBA32F colour + D32 depth.
+//! The scene pipeline: descriptor layout (materials, lights), push constants, and the graphics pipelines for
+//! dynamic rendering into RGBA32F colour + D32 depth, one per [`ShaderVariant`] in use, created at first use from
+//! the same SPIR-V with different specialization constants and kept.
 //!
 //! Fixed state: triangle lists, fill, counter-clockwise front faces, depth test LESS with writes, no blending,
 //! one sample. The fragment shader reads materials, lights, and the scene's indices and vertices (to interpolate
 //! with its own barycentrics), all as storage buffers. Dynamic state: viewport, scissor and cull mode (back for single-sided materials, none for
 //! double-sided ones).
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use ash::vk;
 
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::layout::{PushConstants, Vertex};
+use super::layout::{PushConstants, ShaderVariant, Vertex};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -21,9 +23,12 @@ pub(crate) struct ScenePipeline {
     dev: Arc<Device>,
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
-    pub pipeline: vk::Pipeline,
     pub descriptor_pool: vk::DescriptorPool,
     pub descriptor_set: vk::DescriptorSet,
+    vertex_module: vk::ShaderModule,
+    fragment_module: vk::ShaderModule,
+    with_normals: bool,
+    variants: HashMap<ShaderVariant, vk::Pipeline>,
 }
 
 impl ScenePipeline {
@@ -39,9 +44,12 @@ impl ScenePipeline {
             dev: dev.clone(),
             set_layout: vk::DescriptorSetLayout::null(),
             layout: vk::PipelineLayout::null(),
-            pipeline: vk::Pipeline::null(),
             descriptor_pool: vk::DescriptorPool::null(),
             descriptor_set: vk::DescriptorSet::null(),
+            vertex_module: vk::ShaderModule::null(),
+            fragment_module: vk::ShaderModule::null(),
+            with_normals,
+            variants: HashMap::new(),
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
@@ -81,34 +89,60 @@ impl ScenePipeline {
                         .set_layouts(&set_layouts),
                 )
                 .vk("vkAllocateDescriptorSets")?[0];
-            out.pipeline = create_pipeline(d, out.layout, vertex_spirv, fragment_spirv, with_normals)?;
+            out.vertex_module = d
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(vertex_spirv), None)
+                .vk("vkCreateShaderModule")?;
+            out.fragment_module = d
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None)
+                .vk("vkCreateShaderModule")?;
         }
         Ok(out)
+    }
+
+    /// The pipeline of a variant, created on first use. Returns it and whether it was created now.
+    pub fn variant(&mut self, variant: ShaderVariant) -> Result<(vk::Pipeline, bool), GpuError> {
+        if let Some(&p) = self.variants.get(&variant) {
+            return Ok((p, false));
+        }
+        // SAFETY: valid device, layout and modules owned by self.
+        let p = unsafe {
+            create_pipeline(
+                &self.dev.device,
+                self.layout,
+                self.vertex_module,
+                self.fragment_module,
+                self.with_normals,
+                variant,
+            )?
+        };
+        self.variants.insert(variant, p);
+        Ok((p, true))
     }
 }
 
 unsafe fn create_pipeline(
     d: &ash::Device,
     layout: vk::PipelineLayout,
-    vertex_spirv: &[u32],
-    fragment_spirv: &[u32],
+    vs: vk::ShaderModule,
+    fs: vk::ShaderModule,
     with_normals: bool,
+    variant: ShaderVariant,
 ) -> Result<vk::Pipeline, GpuError> {
-    // SAFETY (whole function): valid device; shader modules are destroyed before returning.
+    // SAFETY (whole function): valid device and modules.
     unsafe {
-        let vs = d
-            .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(vertex_spirv), None)
-            .vk("vkCreateShaderModule")?;
-        let fs = match d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None) {
-            Ok(m) => m,
-            Err(result) => {
-                d.destroy_shader_module(vs, None);
-                return Err(GpuError::Vulkan { what: "vkCreateShaderModule", result });
-            }
-        };
+        let constants = variant.constants();
+        let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(&constants));
         let stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(fs)
+                .name(c"main")
+                .specialization_info(&specialization),
         ];
         let vertex_bindings = [vk::VertexInputBindingDescription {
             binding: 0,
@@ -164,8 +198,6 @@ unsafe fn create_pipeline(
             .layout(layout)
             .push_next(&mut rendering);
         let result = d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None);
-        d.destroy_shader_module(vs, None);
-        d.destroy_shader_module(fs, None);
         result.map(|p| p[0]).map_err(|(_, result)| GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result })
     }
 }
@@ -176,7 +208,11 @@ impl Drop for ScenePipeline {
         // SAFETY: the device is idle with respect to these objects (renders wait on a fence); null handles are
         // ignored by the destroy calls.
         unsafe {
-            d.destroy_pipeline(self.pipeline, None);
+            for (_, p) in self.variants.drain() {
+                d.destroy_pipeline(p, None);
+            }
+            d.destroy_shader_module(self.vertex_module, None);
+            d.destroy_shader_module(self.fragment_module, None);
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

@@ -9,7 +9,7 @@ use gpu_allocator::MemoryLocation;
 use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::{GpuError, VkContext};
-use super::layout::{lights_bytes, material_gpu, push_constants, Vertex};
+use super::layout::{lights_bytes, material_gpu, push_constants, ShaderVariant, Vertex};
 use super::memory::{subresource_range, Buffer, Image2d};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
@@ -22,13 +22,16 @@ use crate::settings::RenderSettings;
 pub struct SetupTimings {
     /// Loader, instance, device and allocator creation.
     pub instance: Duration,
-    /// GLSL → SPIR-V (shaderc) and pipeline creation.
+    /// GLSL → SPIR-V (shaderc) and shader modules; pipelines are created per variant at first use.
     pub shader_compile: Duration,
 }
 
 /// Wall-clock time of the phases of one frame.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameTimings {
+    /// Creating the pipeline variants this frame needs that no earlier frame created (the device compiles the
+    /// specialized shaders here; zero once they exist).
+    pub pipelines: Duration,
     /// Recording, submitting and waiting for the draw (the frame time).
     pub render: Duration,
     /// Copying the colour target to host memory and into the [`Image`].
@@ -48,6 +51,8 @@ struct Draw {
     index_count: u32,
     vertex_offset: i32,
     material: u32,
+    /// The material's `BRDF_*` kind: which pipeline variant draws it.
+    brdf: u32,
     double_sided: bool,
 }
 
@@ -170,6 +175,7 @@ impl Renderer {
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
         let mut draws = Vec::new();
+        let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
         for mesh in &scene.meshes {
             let vertex_offset = i32::try_from(vertices.len())
                 .map_err(|_| GpuError::TooLarge("the scene has more than 2^31 vertices".into()))?;
@@ -178,6 +184,7 @@ impl Renderer {
                 index_count: mesh.indices.len() as u32,
                 vertex_offset,
                 material: mesh.material as u32,
+                brdf: materials[mesh.material].kind[0],
                 double_sided: scene.materials[mesh.material].double_sided,
             });
             vertices.extend((0..mesh.positions.len()).map(|i| Vertex {
@@ -187,7 +194,6 @@ impl Renderer {
             }));
             indices.extend_from_slice(&mesh.indices);
         }
-        let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
         let materials_bytes: &[u8] = if materials.is_empty() { &[0; 64] } else { bytemuck::cast_slice(&materials) };
         Ok(GpuScene {
             vertices: (!vertices.is_empty())
@@ -271,6 +277,14 @@ impl Renderer {
             vk::BufferUsageFlags::STORAGE_BUFFER,
             "lights",
         )?;
+        // The pipeline variant of each draw, created now if this is its first frame.
+        let t_pipelines = Instant::now();
+        let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
+        for draw in &scene.draws {
+            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading);
+            draw_pipelines.push(self.pipeline.variant(variant)?.0);
+        }
+        let pipelines = t_pipelines.elapsed();
         let target = self.target.as_ref().expect("created above");
         let d = &self.dev.device;
 
@@ -353,7 +367,6 @@ impl Renderer {
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[area]);
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipeline.pipeline);
                 d.cmd_bind_descriptor_sets(
                     cb,
                     vk::PipelineBindPoint::GRAPHICS,
@@ -364,7 +377,12 @@ impl Renderer {
                 );
                 d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
                 d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
-                for draw in &scene.draws {
+                let mut bound = vk::Pipeline::null();
+                for (draw, &pipeline) in scene.draws.iter().zip(&draw_pipelines) {
+                    if pipeline != bound {
+                        d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                        bound = pipeline;
+                    }
                     let pc = push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
                     d.cmd_push_constants(
                         cb,
@@ -436,7 +454,7 @@ impl Renderer {
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.check_validation()?;
-        Ok((image, FrameTimings { render, readback }))
+        Ok((image, FrameTimings { pipelines, render, readback }))
     }
 
     fn check_validation(&self) -> Result<(), GpuError> {
