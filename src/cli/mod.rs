@@ -148,8 +148,8 @@ fn check_output_path(path: &std::path::Path) -> Result<(), CliError> {
 }
 
 /// Prints phase timings as a small table on stderr.
-fn print_phases(phases: &[(&str, Duration)]) {
-    let total: Duration = phases.iter().map(|(_, d)| *d).sum();
+/// Prints each phase's time and `total`, the wall-clock time of the whole command (phases may overlap).
+fn print_phases(phases: &[(&str, Duration)], total: Duration) {
     for (name, d) in phases.iter().chain(std::iter::once(&("total", total))) {
         eprintln!("  {name:<15} {:>9.2} ms", d.as_secs_f64() * 1e3);
     }

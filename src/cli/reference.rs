@@ -44,6 +44,7 @@ pub struct ReferenceCommand {
 }
 
 pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
+    let started = Instant::now();
     check_output_path(&a.output.output)?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
@@ -60,7 +61,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
-        print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())]);
+        print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())], started.elapsed());
     }
     Ok(())
 }

@@ -42,6 +42,7 @@ pub struct RenderArgs {
 }
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
+    let started = Instant::now();
     check_output_path(&a.output.output)?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
     let options =
@@ -74,16 +75,19 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             image.covered_count()
         );
         let setup = renderer.setup_timings();
-        print_phases(&[
-            ("load", load_time),
-            ("instance", setup.instance),
-            ("shader compile", setup.shader_compile),
-            ("upload", upload_time),
-            ("pipelines", frame.pipelines),
-            ("render", frame.render),
-            ("readback", frame.readback),
-            ("encode", encode_time),
-        ]);
+        print_phases(
+            &[
+                ("load", load_time),
+                ("instance", setup.instance),
+                ("shader compile", setup.shader_compile), // on other threads, during "instance"
+                ("upload", upload_time),
+                ("pipelines", frame.pipelines),
+                ("render", frame.render),
+                ("readback", frame.readback),
+                ("encode", encode_time),
+            ],
+            started.elapsed(),
+        );
     }
     if a.check {
         let options = ReferenceOptions {

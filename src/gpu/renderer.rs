@@ -22,7 +22,8 @@ use crate::settings::RenderSettings;
 pub struct SetupTimings {
     /// Loader, instance, device and allocator creation.
     pub instance: Duration,
-    /// GLSL → SPIR-V (shaderc) and shader modules; pipelines are created per variant at first use.
+    /// GLSL → SPIR-V (shaderc) and shader modules; pipelines are created per variant at first use. Runs on other
+    /// threads at the same time as `instance`: the two overlap.
     pub shader_compile: Duration,
 }
 
@@ -75,11 +76,24 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Creates the device and compiles the shaders.
+    /// Creates the device and compiles the shaders. The two run at once: shaderc's fixed cost (~75 ms per stage
+    /// here) overlaps device creation, the two stages compile on two threads, and the interpolation mode is
+    /// guessed (f64 unless asked otherwise) and compiled again only when the device turns out to lack f64.
     pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
-        let t0 = Instant::now();
-        let dev = Device::new(options)?;
-        let instance = t0.elapsed();
+        let guess = options.interpolation.unwrap_or(Interpolation::BarycentricF64);
+        let (dev, instance, compiled, compile_time) = std::thread::scope(|s| {
+            let compiling = s.spawn(|| {
+                let t = Instant::now();
+                let stages = compile_stages(guess, options.naive_math);
+                (stages, t.elapsed())
+            });
+            let t = Instant::now();
+            let dev = Device::new(options);
+            let instance = t.elapsed();
+            let (stages, elapsed) = compiling.join().expect("the shader compiler thread panicked");
+            (dev, instance, stages, elapsed)
+        });
+        let dev = dev?;
         let t1 = Instant::now();
         let interpolation = match options.interpolation {
             Some(Interpolation::BarycentricF64) if !dev.info.shader_float64 => {
@@ -92,18 +106,10 @@ impl Renderer {
             None if dev.info.shader_float64 => Interpolation::BarycentricF64,
             None => Interpolation::BarycentricF32,
         };
-        let mut defines = vec![match interpolation {
-            Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
-            Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
-            Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
-        }];
-        if options.naive_math {
-            defines.push("SUNSHADE_NAIVE_MATH");
-        }
-        let vs = shaders::compile("scene.vert", shaders::SOURCES, &defines).map_err(GpuError::ShaderCompile)?;
-        let fs = shaders::compile("scene.frag", shaders::SOURCES, &defines).map_err(GpuError::ShaderCompile)?;
+        let (vs, fs) =
+            if interpolation == guess { compiled? } else { compile_stages(interpolation, options.naive_math)? };
         let pipeline = ScenePipeline::new(&dev, &vs, &fs, interpolation == Interpolation::Device)?;
-        let shader_compile = t1.elapsed();
+        let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
         let renderer = Self {
             target: None,
@@ -465,6 +471,24 @@ impl Renderer {
             Err(GpuError::Validation(messages))
         }
     }
+}
+
+/// SPIR-V of the vertex and fragment stages for an interpolation mode, compiled on two threads.
+fn compile_stages(interpolation: Interpolation, naive_math: bool) -> Result<(Vec<u32>, Vec<u32>), GpuError> {
+    let mut defines = vec![match interpolation {
+        Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
+        Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
+        Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
+    }];
+    if naive_math {
+        defines.push("SUNSHADE_NAIVE_MATH");
+    }
+    let (vs, fs) = std::thread::scope(|s| {
+        let vs = s.spawn(|| shaders::compile("scene.vert", shaders::SOURCES, &defines));
+        let fs = shaders::compile("scene.frag", shaders::SOURCES, &defines);
+        (vs.join().expect("the shader compiler thread panicked"), fs)
+    });
+    Ok((vs.map_err(GpuError::ShaderCompile)?, fs.map_err(GpuError::ShaderCompile)?))
 }
 
 fn image_barrier(
