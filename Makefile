@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models bench images clean
+.PHONY: setup build render test lint models bench docs images clean
 
 setup:
 	@./scripts/setup.sh
@@ -26,13 +26,23 @@ lint:
 bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
+	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
 
-# Regenerates the pictures in README.md: one scene per kind of light.
+# Regenerates the BRDF tables in docs/brdf.md (directional albedo, convergence of the sampled light integrals).
+docs: build
+	$(SUNSHADE) albedo --update docs/brdf.md
+
+# Regenerates the pictures in README.md: one scene per kind of light, and the BRDF spheres under each light.
 images: build
 	mkdir -p docs/images
 	for m in teapot.glb room.gltf overcast.glb sunset.glb; do \
 		$(SUNSHADE) render models/$$m -o docs/images/$${m%.*}.png --width 640 --height 480 || exit 1; \
 	done
+	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sun.png --width 640 --height 300 \
+		--sun-elevation 35 --sun-azimuth 20
+	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-disk.png --width 640 --height 300 \
+		--disk-light 0,3,2:0,-1,0:0.8:2000
+	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sky.png --width 640 --height 300 --sky-radiance 300
 
 # Regenerates the generated scenes in models/.
 models:
