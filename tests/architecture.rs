@@ -68,3 +68,45 @@ fn every_glsl_shading_function_has_a_rust_twin() {
     }
     assert!(checked >= 4, "only {checked} GLSL functions found");
 }
+
+/// The shaders do not call the built-ins that lose digits on lavapipe (docs/platform.md): `acos`, `asin` (4e-4),
+/// `atan` (2.5e-6), `pow` (`exp2(y log2 x)`: 6e-4 at `pow(0.999, 1e4)`) and `log` (2e-3 near 1). Their accurate
+/// replacements live in shaders/math.glsl; only the diagnostic `SUNSHADE_NAIVE_MATH` branches may use them.
+#[test]
+fn shaders_avoid_inaccurate_builtins() {
+    let mut checked = 0;
+    for (path, text) in sources("shaders") {
+        // Drop comments and the diagnostic branches (from `#ifdef SUNSHADE_NAIVE_MATH` to its own `#else`/`#endif`,
+        // nested conditionals counted).
+        let mut code = String::new();
+        let mut conditionals: Vec<bool> = Vec::new(); // per open `#if`: is this the naive branch?
+        for line in text.lines() {
+            let line = line.split("//").next().unwrap();
+            let directive = line.trim();
+            if directive.starts_with("#if") {
+                conditionals.push(directive == "#ifdef SUNSHADE_NAIVE_MATH");
+            } else if directive.starts_with("#else") || directive.starts_with("#elif") {
+                if let Some(naive) = conditionals.last_mut() {
+                    *naive = false;
+                }
+            } else if directive.starts_with("#endif") {
+                conditionals.pop();
+            } else if !conditionals.iter().any(|&naive| naive) {
+                code.push_str(line);
+                code.push('\n');
+            }
+        }
+        for builtin in ["acos", "asin", "atan", "pow", "log", "log2"] {
+            let pattern = format!("{builtin}(");
+            for (i, _) in code.match_indices(&pattern) {
+                let before = code[..i].chars().next_back().unwrap_or(' ');
+                assert!(
+                    before.is_alphanumeric() || before == '_',
+                    "{path}: calls `{builtin}`, which loses digits on lavapipe (use shaders/math.glsl)"
+                );
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked >= 6, "only {checked} shader files");
+}
