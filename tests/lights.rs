@@ -54,6 +54,19 @@ fn mesh_node(b: &mut GltfBuilder, mesh: &MeshData, flat: bool, transform: Transf
 }
 
 /// Orthographic camera looking straight down at the floor, image right = +X, image up = −Z.
+/// A one-sided 2 m × 2 m floor at y = 0 facing +Y, alone in its scene.
+fn unit_floor(dir: &TempDir) -> Scene {
+    let mut b = GltfBuilder::new();
+    let floor = mesh_node(
+        &mut b,
+        &quad(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
+        false,
+        Transform::Identity,
+    );
+    b.add_scene(&[floor], None);
+    load(&dir.write("floor.glb", &b))
+}
+
 fn looking_down(ymag: f64) -> Camera {
     Camera::looking(
         DVec3::new(0.0, 10.0, 0.0),
@@ -375,15 +388,7 @@ fn overcast_sky_on_tilted_planes_and_a_sphere() {
 #[test]
 fn the_setting_sun_dims_continuously_and_monotonically() {
     let dir = TempDir::new("sunset");
-    let mut b = GltfBuilder::new();
-    let floor = mesh_node(
-        &mut b,
-        &quad(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
-        false,
-        Transform::Identity,
-    );
-    b.add_scene(&[floor], None);
-    let scene = load(&dir.write("floor.glb", &b));
+    let scene = unit_floor(&dir);
     let delta = 0.53f64.to_radians();
     let sigma = 0.5 * delta;
     let e_perp = 1000.0f32;
@@ -423,15 +428,7 @@ fn the_setting_sun_dims_continuously_and_monotonically() {
 #[test]
 fn delta_sun_model_is_the_plain_cosine() {
     let dir = TempDir::new("delta");
-    let mut b = GltfBuilder::new();
-    let floor = mesh_node(
-        &mut b,
-        &quad(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -1.0)),
-        false,
-        Transform::Identity,
-    );
-    b.add_scene(&[floor], None);
-    let scene = load(&dir.write("floor.glb", &b));
+    let scene = unit_floor(&dir);
     // Half set: the disk model gives about 2σ/(3π) E⊥, the delta model exactly 0 (n·l = 0).
     let lights = Lights {
         sun: Some(Sun { direction: Vec3::Z, irradiance: [1000.0; 3], angular_diameter: 0.53f32.to_radians() }),

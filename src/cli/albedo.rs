@@ -90,14 +90,20 @@ pub fn run(a: &AlbedoArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn incidence_header(first: &str) -> String {
-    let mut s = format!("| {first} |");
-    for d in INCIDENCES_DEGREES {
-        s += &format!(" {d}° |");
+/// A Markdown table header: the leading column titles, then one right-aligned column per label.
+fn table_header(leading: &[&str], columns: impl ExactSizeIterator<Item = String>) -> String {
+    let count = columns.len();
+    let mut s = format!("| {} |", leading.join(" | "));
+    for c in columns {
+        s += &format!(" {c} |");
     }
     s += "\n|---|";
-    s += &"---:|".repeat(INCIDENCES_DEGREES.len());
+    s += &"---:|".repeat(leading.len() - 1 + count);
     s + "\n"
+}
+
+fn incidence_header(first: &str) -> String {
+    table_header(&[first], INCIDENCES_DEGREES.iter().map(|d| format!("{d}°")))
 }
 
 /// Directional albedo of each lobe; anisotropic lobes at two view azimuths (along t, and 45° from it).
@@ -166,13 +172,7 @@ impl Lcg {
 }
 
 fn header(first: &str, second: &str) -> String {
-    let mut s = format!("| {first} | {second} |");
-    for k in GRIDS {
-        s += &format!(" {k}×{k} |");
-    }
-    s += "\n|---|---:|";
-    s += &"---:|".repeat(GRIDS.len());
-    s + "\n"
+    table_header(&[first, second], GRIDS.iter().map(|k| format!("{k}×{k}")))
 }
 
 /// A row of "median / max" relative errors over configurations, each given as the integral as a function of the
