@@ -25,14 +25,24 @@ fn sun(direction: DVec3) -> Lights {
     }
 }
 
-fn ortho_front(ymag: f64) -> Camera {
+/// An orthographic camera 5 m out on the z axis, looking at the origin along −z (`front`) or +z (back).
+fn ortho_along_z(ymag: f64, front: bool) -> Camera {
+    let side = if front { 1.0 } else { -1.0 };
     Camera::looking(
-        DVec3::new(0.0, 0.0, 5.0),
-        -DVec3::Z,
+        DVec3::new(0.0, 0.0, 5.0 * side),
+        -side * DVec3::Z,
         DVec3::Y,
         Projection::Orthographic { ymag, znear: 1.0, zfar: 10.0 },
     )
     .unwrap()
+}
+
+fn ortho_front(ymag: f64) -> Camera {
+    ortho_along_z(ymag, true)
+}
+
+fn ortho_back(ymag: f64) -> Camera {
+    ortho_along_z(ymag, false)
 }
 
 fn settings(width: u32, height: u32, camera: Camera, lights: Lights) -> RenderSettings {
@@ -454,13 +464,7 @@ fn mirrored_node_keeps_its_front_face_and_normal() {
     let mz = load(&dir.write("mz.glb", &single_mesh_scene(&square, albedo, false, scaled([1.0, 1.0, -1.0]))));
     let lights = sun(DVec3::new(0.2, 0.3, 1.0));
     let front = settings(200, 200, ortho_front(1.0), lights.clone());
-    let back_cam = Camera::looking(
-        DVec3::new(0.0, 0.0, -5.0),
-        DVec3::Z,
-        DVec3::Y,
-        Projection::Orthographic { ymag: 1.0, znear: 1.0, zfar: 10.0 },
-    )
-    .unwrap();
+    let back_cam = ortho_back(1.0);
     let back = settings(200, 200, back_cam, sun(DVec3::new(0.2, 0.3, -1.0)));
     let mut gpu = CheckedRenderer::new();
     let img = gpu.render(&mx, &front);
@@ -512,13 +516,7 @@ fn double_sided_materials_show_back_faces_with_reversed_normals() {
     let square = quad(Vec3::ZERO, Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.5, 0.0)); // faces +Z
     let single = load(&dir.write("single.glb", &single_mesh_scene(&square, [0.5; 3], false, Transform::Identity)));
     let double = load(&dir.write("double.glb", &single_mesh_scene(&square, [0.5; 3], true, Transform::Identity)));
-    let back_cam = Camera::looking(
-        DVec3::new(0.0, 0.0, -5.0),
-        DVec3::Z,
-        DVec3::Y,
-        Projection::Orthographic { ymag: 1.0, znear: 1.0, zfar: 10.0 },
-    )
-    .unwrap();
+    let back_cam = ortho_back(1.0);
     let lit_back = settings(200, 200, back_cam, sun(DVec3::new(0.3, 0.2, -1.0)));
     let lit_front = settings(200, 200, back_cam, sun(DVec3::new(0.3, 0.2, 1.0)));
     let mut gpu = CheckedRenderer::new();
