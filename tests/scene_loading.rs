@@ -45,6 +45,44 @@ fn reads_materials_and_default_material() {
 }
 
 #[test]
+fn unmodelled_material_features_and_extensions_are_named_in_warnings() {
+    let dir = TempDir::new("unmodelled");
+    let b = square_scene();
+    let mut doc = b.document(Some("u.bin"));
+    std::fs::write(dir.path("u.bin"), b.bin()).unwrap();
+    std::fs::write(dir.path("plain.gltf"), doc.to_string()).unwrap();
+    let plain = scene::load(&dir.path("plain.gltf")).unwrap();
+    assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
+
+    // The image is never read: sunshade does not decode textures.
+    doc["images"] = json!([{ "uri": "never-read.png" }]);
+    doc["textures"] = json!([{ "source": 0 }]);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+    doc["materials"][0]["normalTexture"] = json!({ "index": 0 });
+    doc["materials"][0]["emissiveFactor"] = json!([1.0, 0.5, 0.0]);
+    doc["materials"][0]["alphaMode"] = json!("BLEND");
+    doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+    doc["materials"][0]["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": 5.0 } });
+    std::fs::write(dir.path("u.gltf"), doc.to_string()).unwrap();
+    let s = scene::load(&dir.path("u.gltf")).unwrap();
+    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("KHR_materials_emissive_strength"), "{:?}", s.warnings);
+    let w = &s.warnings[1];
+    for named in ["material 'grey'", "baseColorTexture", "normalTexture", "emissiveFactor", "alphaMode BLEND"] {
+        assert!(w.contains(named), "{named} missing from {w}");
+    }
+    assert!(!w.contains("occlusionTexture") && !w.contains("metallicRoughnessTexture"), "{w}");
+    // The factors are still read.
+    assert_eq!(s.materials[0].brdf, Brdf::Lambert { albedo: [0.5, 0.4, 0.3] });
+
+    // An extension the file requires cannot be ignored: the file is refused, naming it.
+    doc["extensionsRequired"] = json!(["KHR_materials_emissive_strength"]);
+    std::fs::write(dir.path("required.gltf"), doc.to_string()).unwrap();
+    let e = load_err(&dir.path("required.gltf"));
+    assert!(e.contains("required.gltf") && e.contains("KHR_materials_emissive_strength"), "{e}");
+}
+
+#[test]
 fn skips_non_triangle_modes_and_non_sun_lights_with_warnings() {
     let dir = TempDir::new("modes");
     let mut b = GltfBuilder::new();

@@ -120,8 +120,20 @@ impl<'a> Loader<'a> {
                 .or_else(|| self.doc.scenes().next())
                 .ok_or("the file has no scene to render")?,
         };
+        let unmodelled: Vec<&str> = self.doc.extensions_used().filter(|e| *e != "KHR_lights_punctual").collect();
+        if !unmodelled.is_empty() {
+            self.scene.warnings.push(format!("extensions not modelled, ignored: {}", unmodelled.join(", ")));
+        }
         for material in self.doc.materials() {
             let m = read_material(&material)?;
+            let ignored = ignored_material_features(&material);
+            if !ignored.is_empty() {
+                self.scene.warnings.push(format!(
+                    "{}: {} not modelled; ignored (the surface is opaque, untextured and not emissive)",
+                    m.name,
+                    ignored.join(", ")
+                ));
+            }
             self.scene.materials.push(m);
         }
         if let Some(sky) = sunshade_extras(gscene.extras()).map_err(|e| format!("scene {}: {e}", gscene.index()))? {
@@ -450,6 +462,28 @@ fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {
         return Err(format!("node {} has a non-finite or zero-length transform", node.index()));
     }
     Ok(m)
+}
+
+/// The parts of a glTF material that sunshade does not model, by their glTF names: textures (the factors alone
+/// are used), emission and alpha modes other than OPAQUE.
+fn ignored_material_features(material: &gltf::Material) -> Vec<String> {
+    let pbr = material.pbr_metallic_roughness();
+    let mut ignored = Vec::new();
+    let textures = [
+        ("baseColorTexture", pbr.base_color_texture().is_some()),
+        ("metallicRoughnessTexture", pbr.metallic_roughness_texture().is_some()),
+        ("normalTexture", material.normal_texture().is_some()),
+        ("occlusionTexture", material.occlusion_texture().is_some()),
+        ("emissiveTexture", material.emissive_texture().is_some()),
+        ("emissiveFactor", material.emissive_factor() != [0.0; 3]),
+    ];
+    ignored.extend(textures.iter().filter(|(_, present)| *present).map(|(name, _)| name.to_string()));
+    match material.alpha_mode() {
+        gltf::material::AlphaMode::Opaque => {}
+        gltf::material::AlphaMode::Mask => ignored.push("alphaMode MASK".into()),
+        gltf::material::AlphaMode::Blend => ignored.push("alphaMode BLEND".into()),
+    }
+    ignored
 }
 
 fn read_material(material: &gltf::Material) -> Result<Material, String> {
