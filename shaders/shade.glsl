@@ -76,12 +76,16 @@ float lobe_width(MaterialGpu m) {
 }
 
 // The point for u in (0, 1) of a grid on [a, b] graded about c with width w, x = c + w sinh(z), and its density
-// dx/du: (x, dx/du). sinh and asinh without cancellation near 0 (math.glsl).
-vec2 sinh_warp(float a, float b, float c, float w, float u) {
-    float za = asinh_accurate((a - c) / w);
-    float zb = asinh_accurate((b - c) / w);
-    float z = za + u * (zb - za);
-    return vec2(clamp(c + w * sinh_accurate(z), a, b), w * (zb - za) * cosh(z));
+// dx/du: (x, dx/du); `ends` = (za, zb) from sinh_warp_ends, once per grid. sinh and asinh without cancellation
+// near 0 (math.glsl).
+vec2 sinh_warp(float a, float b, float c, float w, vec2 ends, float u) {
+    float z = ends.x + u * (ends.y - ends.x);
+    return vec2(clamp(c + w * sinh_accurate(z), a, b), w * (ends.y - ends.x) * cosh(z));
+}
+
+// The ends (za, zb) = (asinh((a - c)/w), asinh((b - c)/w)) of sinh_warp's z range.
+vec2 sinh_warp_ends(float a, float b, float c, float w) {
+    return vec2(asinh_accurate((a - c) / w), asinh_accurate((b - c) / w));
 }
 
 // integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance, for the disk of radius
@@ -130,12 +134,14 @@ float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius
     float width_s = min(footprint / max(radius * sbc, 1e-30), 32.0);
     float k = float(per_axis);
     float sum = 0.0;
+    vec2 beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
+    vec2 s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
     for (uint i = 0u; i < per_axis; ++i) {
-        vec2 bw = sinh_warp(0.0, alpha, beta_c, width_beta, (float(i) + 0.5) / k);
+        vec2 bw = sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, (float(i) + 0.5) / k);
         float sb = sin(bw.x);
         float cb = cos(bw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            vec2 sw = sinh_warp(-1.0, 1.0, s_c, width_s, (float(j) + 0.5) / k);
+            vec2 sw = sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, (float(j) + 0.5) / k);
             vec3 y = q + radius * cb * w + radius * sb * sw.x * v;
             float dist2 = dot(y, y);
             float dist = sqrt(dist2);
@@ -160,12 +166,26 @@ float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_di
     return segment_lobe_integral(m, p, direction, -direction, tan(0.5 * angular_diameter), per_axis);
 }
 
+// A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
+// (t, b) about it: the inverse CDF of the pdf (e+1)/(2 pi) cos^e a. 1 - cos a as -expm1(log1p(-xi1)/(e+1)), which
+// keeps its digits for large e (see the Rust).
+vec3 cos_power_direction(vec3 axis, vec3 t, vec3 b, float exponent, float xi1, float phi) {
+    float one_minus_cos = -exp_minus_one(log1p_accurate(-xi1) / (exponent + 1.0));
+    float cos_a = 1.0 - one_minus_cos;
+    float sin_a = sqrt(one_minus_cos * (1.0 + cos_a));
+    return cos_a * axis + sin_a * (cos(phi) * t + sin(phi) * b);
+}
+
 // integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
 // inverse CDF, each sample weighted by lobe/pdf (see the Rust).
 float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
     vec3 n = p.normal;
     vec3 v = p.to_viewer;
     uint kind = VARIANT_BRDF;
+    // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
+    vec3 axis = kind == BRDF_PHONG ? mirror(v, n) : n;
+    vec3 t = orthonormal_to(axis);
+    vec3 b = cross(axis, t);
     float k = float(per_axis);
     float sum = 0.0;
     for (uint i = 0u; i < per_axis; ++i) {
@@ -175,24 +195,11 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
             float phi = 2.0 * PI * xi2;
             if (kind == BRDF_PHONG) {
                 float e = m.ks.w;
-                vec3 r = mirror(v, n);
-                vec3 t = orthonormal_to(r);
-                vec3 b = cross(r, t);
-                float x = log1p_accurate(-xi1) / (e + 1.0);
-                float one_minus_cos = -exp_minus_one(x);
-                float cos_a = 1.0 - one_minus_cos;
-                float sin_a = sqrt(one_minus_cos * (1.0 + cos_a));
-                vec3 omega = cos_a * r + sin_a * (cos(phi) * t + sin(phi) * b);
+                vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
                 sum += (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
             } else if (kind == BRDF_BLINN_PHONG) {
                 float e = m.ks.w;
-                vec3 t = orthonormal_to(n);
-                vec3 b = cross(n, t);
-                float x = log1p_accurate(-xi1) / (e + 1.0);
-                float one_minus_cos = -exp_minus_one(x);
-                float cos_h = 1.0 - one_minus_cos;
-                float sin_h = sqrt(one_minus_cos * (1.0 + cos_h));
-                vec3 h = cos_h * n + sin_h * (cos(phi) * t + sin(phi) * b);
+                vec3 h = cos_power_direction(axis, t, b, e, xi1, phi);
                 float vh = dot(v, h);
                 if (vh > 0.0) {
                     vec3 omega = 2.0 * vh * h - v;

@@ -204,10 +204,16 @@ pub fn lobe_width(brdf: &Brdf) -> f64 {
 /// proportion to the distance beyond; returns x and its density `dx/du = w (zb − za) cosh z`. For w ≥ 16 (b − a)
 /// it is uniform to 0.2%. (A Cauchy quantile `c + w tan θ` grades as well, but in f32 its θ near ±π/2 is
 /// rounded to ~30 ulp of tan, and the GPU lost 1.8e-5 against the reference; sinh is conditioned by |z| ≤ 70.)
-pub fn sinh_warp(a: f64, b: f64, c: f64, w: f64, u: f64) -> (f64, f64) {
-    let (za, zb) = (((a - c) / w).asinh(), ((b - c) / w).asinh());
+/// The ends `(za, zb)` come from [`sinh_warp_ends`], once per grid.
+pub fn sinh_warp(a: f64, b: f64, c: f64, w: f64, (za, zb): (f64, f64), u: f64) -> (f64, f64) {
     let z = za + u * (zb - za);
     ((c + w * z.sinh()).clamp(a, b), w * (zb - za) * z.cosh())
+}
+
+/// The ends of [`sinh_warp`]'s z range for the grid on `[a, b]` graded about c with width w:
+/// `(asinh((a − c)/w), asinh((b − c)/w))`.
+pub fn sinh_warp_ends(a: f64, b: f64, c: f64, w: f64) -> (f64, f64) {
+    (((a - c) / w).asinh(), ((b - c) / w).asinh())
 }
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the part of a disk light above the horizon, per unit radiance.
@@ -277,11 +283,13 @@ pub fn segment_lobe_integral(brdf: &Brdf, p: &SurfacePoint, q: DVec3, d: DVec3, 
     let width_s = (footprint / (radius * sbc).max(1e-30)).min(32.0);
     let k = per_axis as f64;
     let mut sum = 0.0;
+    let beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
+    let s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
     for i in 0..per_axis {
-        let (beta, d_beta) = sinh_warp(0.0, alpha, beta_c, width_beta, (i as f64 + 0.5) / k);
+        let (beta, d_beta) = sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, (i as f64 + 0.5) / k);
         let (sb, cb) = beta.sin_cos();
         for j in 0..per_axis {
-            let (s, d_s) = sinh_warp(-1.0, 1.0, s_c, width_s, (j as f64 + 0.5) / k);
+            let (s, d_s) = sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, (j as f64 + 0.5) / k);
             let y = q + radius * cb * w + radius * sb * s * v;
             let dist2 = y.length_squared();
             let dist = dist2.sqrt();
@@ -309,10 +317,24 @@ pub fn exp_minus_one(x: f64) -> f64 {
     um1 * x / u.ln()
 }
 
+/// A direction at angle a from the unit `axis` with `cos a = (1 − ξ1)^{1/(e+1)}` and azimuth φ in the frame
+/// (t, b) about it: the inverse CDF of the pdf `(e+1)/(2π) cosᵉa`. `1 − cos a` is formed as
+/// `−expm1(ln(1 − ξ1)/(e+1))`: for large e the exponent is tiny and `1 − (1 − ξ1)^{1/(e+1)}` would cancel.
+pub fn cos_power_direction(axis: DVec3, t: DVec3, b: DVec3, exponent: f64, xi1: f64, phi: f64) -> DVec3 {
+    let one_minus_cos = -exp_minus_one((-xi1).ln_1p() / (exponent + 1.0));
+    let cos_a = 1.0 - one_minus_cos;
+    let sin_a = (one_minus_cos * (1.0 + cos_a)).sqrt();
+    cos_a * axis + sin_a * (phi.cos() * t + phi.sin() * b)
+}
+
 /// `∫ lobe(ω) (n·ω)+ dω` over the hemisphere (the sky, per unit radiance), by a stratified grid of `per_axis²`
 /// cells through the lobe's inverse CDF, each sample weighted by lobe/pdf.
 pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
     let (n, v) = (p.normal, p.to_viewer);
+    // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
+    let axis = if matches!(brdf, Brdf::Phong { .. }) { mirror(v, n) } else { n };
+    let t = orthonormal_to(axis);
+    let b = axis.cross(t);
     let k = per_axis as f64;
     let mut sum = 0.0;
     for i in 0..per_axis {
@@ -325,26 +347,13 @@ pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
                 Brdf::Phong { exponent, .. } => {
                     // cos α = (1 − ξ1)^{1/(e+1)} about r = mirror of v: pdf = (e+1)/(2π) cosᵉα, lobe/pdf = (e+2)/(e+1).
                     let e = exponent as f64;
-                    let r = mirror(v, n);
-                    let t = orthonormal_to(r);
-                    let b = r.cross(t);
-                    let x = (-xi1).ln_1p() / (e + 1.0);
-                    let one_minus_cos = -exp_minus_one(x);
-                    let cos_a = 1.0 - one_minus_cos;
-                    let sin_a = (one_minus_cos * (1.0 + cos_a)).sqrt();
-                    let omega = cos_a * r + sin_a * (phi.cos() * t + phi.sin() * b);
+                    let omega = cos_power_direction(axis, t, b, e, xi1, phi);
                     (e + 2.0) / (e + 1.0) * n.dot(omega).max(0.0)
                 }
                 Brdf::BlinnPhong { exponent, .. } => {
                     // cos θh = (1 − ξ1)^{1/(e+1)} about n: pdf_h = (e+1)/(2π)(n·h)^e, dω = 4 (v·h) dh.
                     let e = exponent as f64;
-                    let t = orthonormal_to(n);
-                    let b = n.cross(t);
-                    let x = (-xi1).ln_1p() / (e + 1.0);
-                    let one_minus_cos = -exp_minus_one(x);
-                    let cos_h = 1.0 - one_minus_cos;
-                    let sin_h = (one_minus_cos * (1.0 + cos_h)).sqrt();
-                    let h = cos_h * n + sin_h * (phi.cos() * t + phi.sin() * b);
+                    let h = cos_power_direction(axis, t, b, e, xi1, phi);
                     let vh = v.dot(h);
                     if vh <= 0.0 {
                         0.0
@@ -542,8 +551,9 @@ mod tests {
                 let k = 64;
                 let mut last = a;
                 let (mut length, mut gauss) = (0.0, 0.0);
+                let ends = sinh_warp_ends(a, b, c, w);
                 for i in 0..k {
-                    let (x, dx) = sinh_warp(a, b, c, w, (i as f64 + 0.5) / k as f64);
+                    let (x, dx) = sinh_warp(a, b, c, w, ends, (i as f64 + 0.5) / k as f64);
                     assert!(x >= last && x <= b && dx > 0.0, "{a} {b} {c} {w}: {x} after {last}");
                     last = x;
                     length += dx / k as f64;
