@@ -97,8 +97,8 @@ fn skips_non_triangle_modes_and_non_sun_lights_with_warnings() {
     let s = scene::load(&dir.write("modes.glb", &b)).unwrap();
     assert_eq!(s.meshes.len(), 1, "only the TRIANGLES primitive is kept");
     assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("Lines") && s.warnings[0].contains("skipped"), "{:?}", s.warnings);
-    assert!(s.warnings[1].contains("TriangleStrip"), "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("LINES") && s.warnings[0].contains("skipped"), "{:?}", s.warnings);
+    assert!(s.warnings[1].contains("TRIANGLE_STRIP"), "{:?}", s.warnings);
     assert!(s.warnings[2].contains("point light ignored"), "{:?}", s.warnings);
     assert!(s.lights.sun.is_none());
 }
@@ -185,9 +185,10 @@ fn scene_index_selects_the_scene() {
     let path = dir.write("two.glb", &b);
     let first = scene::load(&path).unwrap();
     assert_eq!(first.meshes[0].name, "mesh 'square' primitive 0");
-    let second = scene::load_with_options(&path, &LoadOptions { scene: Some(1) }).unwrap();
+    let second = scene::load_with_options(&path, &LoadOptions { scene: Some(1), ..Default::default() }).unwrap();
     assert_eq!(second.meshes[0].name, "mesh 'cube' primitive 0");
-    let err = scene::load_with_options(&path, &LoadOptions { scene: Some(5) }).unwrap_err().to_string();
+    let err =
+        scene::load_with_options(&path, &LoadOptions { scene: Some(5), ..Default::default() }).unwrap_err().to_string();
     assert!(err.contains("scene 5 does not exist"), "{err}");
 }
 
@@ -268,7 +269,7 @@ fn bad_files_are_refused_with_a_message_naming_file_and_problem() {
 
     let dangling = edited(&dir, "dangling", |d| d["meshes"][0]["primitives"][0]["material"] = json!(7));
     let e = load_err(&dangling);
-    assert!(e.contains("dangling.gltf") && e.contains("invalid glTF"), "{e}");
+    assert!(e.contains("dangling.gltf") && e.contains("material 7 does not exist"), "{e}");
 
     let cycle = edited(&dir, "cycle", |d| d["nodes"][0]["children"] = json!([0]));
     let e = load_err(&cycle);

@@ -6,7 +6,7 @@ use clap::Args;
 use glam::DVec3;
 
 use crate::film::Exposure;
-use crate::scene::{BrdfKind, DiskLight};
+use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{DiskModel, ShadingOptions, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS};
 
@@ -98,6 +98,15 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = DEFAULT_HEIGHT, value_parser = clap::value_parser!(u32).range(1..))]
     pub height: u32,
 
+    /// Buffer and image files must lie inside DIR (symbolic links resolved); default: the scene file's folder.
+    #[arg(long, value_name = "DIR", conflicts_with = "allow_outside_uris")]
+    pub asset_root: Option<PathBuf>,
+
+    /// Read buffer and image files wherever their URIs point, absolute paths and `..` included (only for files
+    /// you trust).
+    #[arg(long)]
+    pub allow_outside_uris: bool,
+
     /// Which glTF scene of the file to render (default: the file's default scene).
     #[arg(long = "scene", value_name = "N")]
     pub scene_index: Option<usize>,
@@ -188,6 +197,15 @@ pub fn per_axis(samples: u32) -> u32 {
 }
 
 impl SceneArgs {
+    pub fn load_options(&self) -> LoadOptions {
+        let uris = match (&self.asset_root, self.allow_outside_uris) {
+            (_, true) => UriScope::Anywhere,
+            (Some(dir), false) => UriScope::Folder(dir.clone()),
+            (None, false) => UriScope::SceneFolder,
+        };
+        LoadOptions { scene: self.scene_index, uris }
+    }
+
     pub fn camera_options(&self) -> CameraOptions {
         CameraOptions { camera: self.camera, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
     }

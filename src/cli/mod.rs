@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 
-use crate::scene::{self, LoadOptions, Scene};
+use crate::scene::{self, Scene};
 use crate::settings::{self, RenderSettings};
 
 #[derive(Parser, Debug)]
@@ -123,7 +123,7 @@ fn one_line(e: &anyhow::Error) -> String {
 /// Loads the scene and resolves the render settings; prints the loader's warnings.
 fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
     let t = Instant::now();
-    let mut scene = scene::load_with_options(&a.scene, &LoadOptions { scene: a.scene_index })?;
+    let mut scene = scene::load_with_options(&a.scene, &a.load_options())?;
     if let Some(kind) = a.brdf {
         scene.map_brdfs(kind);
     }

@@ -1,26 +1,31 @@
 //! glTF 2.0 → [`Scene`]: `.gltf` with external `.bin` or data URIs, and `.glb`.
 //!
-//! What is read: the chosen scene's node hierarchy (matrix or TRS transforms), every TRIANGLES primitive (other
-//! modes are skipped with a warning), u8/u16/u32 or no indices, POSITION and NORMAL (flat normals where a
-//! primitive has none, as the glTF spec requires), TANGENT or TEXCOORD_0 (for tangents), materials
-//! (`baseColorFactor` as the Lambertian albedo, or the BRDF of the material's
-//! `{"sunshade": {"brdf": …}}` extras),
-//! cameras, KHR_lights_punctual directional lights (the sun), disk skylights from node `extras`
-//! (`{"sunshade": {"light": "disk", "radius": R, "radiance": [r, g, b]}}`: a disk in the node's local XY plane at its
-//! origin, emitting towards local −Z) and the overcast sky from the scene's `extras`
-//! (`{"sunshade": {"sky_radiance": [r, g, b]}}`). Every problem is an error naming the file and the glTF object;
-//! nothing here panics on bad input.
+//! What is read: the chosen scene's node hierarchy (matrix or TRS transforms; without any scene, the file's root
+//! nodes), every TRIANGLES primitive (other modes are skipped with a warning), u8/u16/u32 or no indices, POSITION
+//! and NORMAL (flat normals where a primitive has none, as the glTF spec requires), TANGENT or TEXCOORD_0 (for
+//! tangents), float or KHR_mesh_quantization integer attributes, sparse accessors and accessors without a buffer
+//! view (zeros), materials (`baseColorFactor` as the Lambertian albedo, or the BRDF of the material's
+//! `{"sunshade": {"brdf": …}}` extras), cameras, KHR_lights_punctual directional lights (the sun), disk skylights
+//! from node `extras` (`{"sunshade": {"light": "disk", "radius": R, "radiance": [r, g, b]}}`: a disk in the node's
+//! local XY plane at its origin, emitting towards local −Z) and the overcast sky from the scene's `extras`
+//! (`{"sunshade": {"sky_radiance": [r, g, b]}}`).
+//!
+//! Every problem is an error naming the file and the glTF object; nothing here panics or recurses on bad input:
+//! the hierarchy is walked with an explicit stack, each node at most once.
 
 use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec3, Vec4};
+use serde_json::Value;
 
-use super::accessor::AccessorReader;
 use super::camera::{Camera, Projection};
+use super::gltf::accessor::AccessorReader;
+use super::gltf::document::{self, lookup, CameraDef, LightDef, MaterialDef, NodeDef, PrimitiveDef, Root};
+use super::gltf::files::UriScope;
+use super::gltf::{self, SUPPORTED_EXTENSIONS};
 use super::light::{DiskLight, Sun};
 use super::material::{Brdf, Material, MetallicRoughness};
 use super::tangent::{default_tangent, orthonormal_tangent, tangents_from_uv, triangle_tangent};
-use super::uri::{self, UriTarget};
 use super::{Mesh, Scene};
 use crate::shading::radiometry::{degrees_to_radians, SUN_ANGULAR_DIAMETER_DEGREES};
 
@@ -32,11 +37,18 @@ pub struct LoadError {
     pub message: String,
 }
 
+/// The most vertices a loaded scene may have, after instancing and flat-normal un-indexing: 2^26 (67 M). At the
+/// 40 bytes a vertex takes on the device this is over 2.5 GiB, past lavapipe's largest allocation; the bound stops
+/// a file that instances one mesh from many nodes from exhausting memory while it loads.
+pub const MAX_SCENE_VERTICES: usize = 1 << 26;
+
 /// Choices made while loading.
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
-    /// Which glTF scene to load; `None` = the file's default scene (or its first).
+    /// Which glTF scene to load; `None` = the file's default scene (or its first, or its root nodes).
     pub scene: Option<usize>,
+    /// Where buffer and image files may be (default: inside the scene's folder).
+    pub uris: UriScope,
 }
 
 /// Loads the default scene of a glTF file.
@@ -47,86 +59,55 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 /// Loads a glTF file.
 pub fn load_with_options(path: &Path, options: &LoadOptions) -> Result<Scene, LoadError> {
     let fail = |message: String| LoadError { path: path.to_path_buf(), message };
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read file: {e}")))?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| fail(describe_gltf_error(&e)))?;
-    let buffers = load_buffers(path, &gltf).map_err(fail)?;
-    Loader::new(&gltf.document, &buffers).load(options).map_err(fail)
-}
-
-fn describe_gltf_error(e: &gltf::Error) -> String {
-    match e {
-        gltf::Error::Deserialize(e) => format!("invalid glTF JSON: {e}"),
-        gltf::Error::Binary(e) => format!("invalid GLB container: {e}"),
-        gltf::Error::Validation(errors) => {
-            let list: Vec<String> = errors.iter().take(3).map(|(path, err)| format!("{path}: {err}")).collect();
-            let more = if errors.len() > 3 { format!(" (and {} more)", errors.len() - 3) } else { String::new() };
-            format!("invalid glTF: {}{more}", list.join("; "))
-        }
-        other => format!("invalid glTF: {other}"),
-    }
-}
-
-/// The bytes of every buffer: the GLB binary chunk, a data URI, or a file relative to the glTF file.
-fn load_buffers(path: &Path, gltf: &gltf::Gltf) -> Result<Vec<Vec<u8>>, String> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut out = Vec::new();
-    for buffer in gltf.document.buffers() {
-        let i = buffer.index();
-        let data = match buffer.source() {
-            gltf::buffer::Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or_else(|| format!("buffer {i} refers to the GLB binary chunk, which the file does not have"))?,
-            gltf::buffer::Source::Uri(u) => match uri::resolve(u).map_err(|e| format!("buffer {i}: {e}"))? {
-                UriTarget::Data(bytes) => bytes,
-                UriTarget::File(rel) => {
-                    let file = dir.join(&rel);
-                    std::fs::read(&file).map_err(|e| format!("buffer {i}: cannot read '{}': {e}", file.display()))?
-                }
-            },
-        };
-        if data.len() < buffer.length() {
-            return Err(format!("buffer {i} holds {} bytes but declares byteLength {}", data.len(), buffer.length()));
-        }
-        out.push(data);
-    }
-    Ok(out)
+    let file = gltf::read(path, &options.uris).map_err(fail)?;
+    Loader::new(&file.root, &file.buffers).load(options).map_err(fail)
 }
 
 struct Loader<'a> {
-    doc: &'a gltf::Document,
+    root: &'a Root,
     reader: AccessorReader<'a>,
     scene: Scene,
     /// Index of glTF's default material in `scene.materials`, once a primitive needs it.
     default_material: Option<usize>,
+    vertex_count: usize,
+}
+
+/// glTF's names of the primitive modes.
+fn mode_name(mode: u64) -> String {
+    match mode {
+        0 => "POINTS".into(),
+        1 => "LINES".into(),
+        2 => "LINE_LOOP".into(),
+        3 => "LINE_STRIP".into(),
+        4 => "TRIANGLES".into(),
+        5 => "TRIANGLE_STRIP".into(),
+        6 => "TRIANGLE_FAN".into(),
+        other => format!("{other} (not a glTF mode)"),
+    }
 }
 
 impl<'a> Loader<'a> {
-    fn new(doc: &'a gltf::Document, buffers: &'a [Vec<u8>]) -> Self {
-        Self { doc, reader: AccessorReader { buffers }, scene: Scene::default(), default_material: None }
+    fn new(root: &'a Root, buffers: &'a [Vec<u8>]) -> Self {
+        Self {
+            root,
+            reader: AccessorReader { root, buffers },
+            scene: Scene::default(),
+            default_material: None,
+            vertex_count: 0,
+        }
     }
 
     fn load(mut self, options: &LoadOptions) -> Result<Scene, String> {
-        let scene_count = self.doc.scenes().len();
-        let gscene = match options.scene {
-            Some(n) => self
-                .doc
-                .scenes()
-                .nth(n)
-                .ok_or_else(|| format!("scene {n} does not exist (the file has {scene_count})"))?,
-            None => self
-                .doc
-                .default_scene()
-                .or_else(|| self.doc.scenes().next())
-                .ok_or("the file has no scene to render")?,
-        };
-        let unmodelled: Vec<&str> = self.doc.extensions_used().filter(|e| *e != "KHR_lights_punctual").collect();
+        let root = self.root;
+        let roots = self.root_nodes(options)?;
+        let unmodelled: Vec<&str> =
+            root.extensions_used.iter().map(String::as_str).filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
         if !unmodelled.is_empty() {
             self.scene.warnings.push(format!("extensions not modelled, ignored: {}", unmodelled.join(", ")));
         }
-        for material in self.doc.materials() {
-            let m = read_material(&material)?;
-            let ignored = ignored_material_features(&material);
+        for (index, material) in root.materials.iter().enumerate() {
+            let m = read_material(index, material)?;
+            let ignored = ignored_material_features(material);
             if !ignored.is_empty() {
                 self.scene.warnings.push(format!(
                     "{}: {} not modelled; ignored (the surface is opaque, untextured and not emissive)",
@@ -136,81 +117,136 @@ impl<'a> Loader<'a> {
             }
             self.scene.materials.push(m);
         }
-        if let Some(sky) = sunshade_extras(gscene.extras()).map_err(|e| format!("scene {}: {e}", gscene.index()))? {
-            if let Some(v) = sky.get("sky_radiance") {
-                let radiance = rgb(v).map_err(|e| format!("scene {} extras: sky_radiance {e}", gscene.index()))?;
-                self.scene.lights.sky = Some(radiance);
-            }
-        }
-        let mut path = Vec::new();
-        for node in gscene.nodes() {
-            self.visit(&node, DMat4::IDENTITY, &mut path)?;
-        }
+        self.walk(&roots)?;
         Ok(self.scene)
     }
 
-    fn visit(&mut self, node: &gltf::Node, parent: DMat4, path: &mut Vec<usize>) -> Result<(), String> {
-        if path.contains(&node.index()) {
-            return Err(format!("node {} is its own ancestor (the node hierarchy has a cycle)", node.index()));
-        }
-        let world = parent * local_transform(node)?;
-        if let Some(mesh) = node.mesh() {
-            for primitive in mesh.primitives() {
-                self.add_primitive(node, &mesh, &primitive, &world)?;
+    /// The nodes to draw: the chosen scene's, the default scene's, the first scene's, or (in a file without
+    /// scenes) every node that is no other node's child.
+    fn root_nodes(&mut self, options: &LoadOptions) -> Result<Vec<u64>, String> {
+        let root = self.root;
+        let count = root.scenes.len();
+        let chosen = match (options.scene, root.scene) {
+            (Some(n), _) => Some(
+                root.scenes
+                    .get(n)
+                    .map(|s| (n, s))
+                    .ok_or_else(|| format!("scene {n} does not exist (the file has {count})"))?,
+            ),
+            (None, Some(n)) => Some((n as usize, lookup(&root.scenes, n, "the file's default 'scene'", "scene")?)),
+            (None, None) => root.scenes.first().map(|s| (0, s)),
+        };
+        let Some((index, gscene)) = chosen else {
+            if root.nodes.is_empty() {
+                return Err("nothing to draw: the file has no scenes and no nodes".into());
+            }
+            let mut is_child = vec![false; root.nodes.len()];
+            for (i, node) in root.nodes.iter().enumerate() {
+                for &c in &node.children {
+                    lookup(&root.nodes, c, &format!("node {i}"), "child node")?;
+                    is_child[c as usize] = true;
+                }
+            }
+            let roots: Vec<u64> = (0..root.nodes.len() as u64).filter(|&i| !is_child[i as usize]).collect();
+            self.scene.warnings.push(format!(
+                "the file has no scene; drawing its {} root node(s) (nodes that are no node's child)",
+                roots.len()
+            ));
+            return Ok(roots);
+        };
+        let owner = format!("scene {index}");
+        if let Some(sky) = sunshade_extras(&gscene.extras).map_err(|e| format!("{owner}: {e}"))? {
+            if let Some(v) = sky.get("sky_radiance") {
+                let radiance = rgb(v).map_err(|e| format!("{owner} extras: sky_radiance {e}"))?;
+                self.scene.lights.sky = Some(radiance);
             }
         }
-        if let Some(camera) = node.camera() {
-            let c = read_camera(&camera, &world).map_err(|e| format!("node {}: {e}", node.index()))?;
-            self.scene.cameras.push((camera.index(), c));
+        for &n in &gscene.nodes {
+            lookup(&root.nodes, n, &owner, "node")?;
         }
-        if let Some(light) = node.light() {
-            self.add_light(node, &light, &world);
+        Ok(gscene.nodes.clone())
+    }
+
+    /// Visits the hierarchy depth first, parents before children and children in order, with an explicit stack
+    /// (a chain of 10⁵ nodes must not overflow the call stack). A node reached a second time means a cycle or a node
+    /// with two parents; glTF requires the hierarchy to be a set of disjoint trees.
+    fn walk(&mut self, roots: &[u64]) -> Result<(), String> {
+        let root = self.root;
+        let mut visited = vec![false; root.nodes.len()];
+        let mut stack: Vec<(u64, DMat4)> = roots.iter().rev().map(|&n| (n, DMat4::IDENTITY)).collect();
+        while let Some((index, parent)) = stack.pop() {
+            let node = lookup(&root.nodes, index, "the hierarchy", "node")?;
+            let seen = &mut visited[index as usize];
+            if *seen {
+                return Err(format!(
+                    "node {index} is reached twice: the node hierarchy has a cycle or a node with two parents"
+                ));
+            }
+            *seen = true;
+            let world = parent * local_transform(index, node)?;
+            self.visit(index, node, &world)?;
+            for &child in node.children.iter().rev() {
+                lookup(&root.nodes, child, &format!("node {index}"), "child node")?;
+                stack.push((child, world));
+            }
         }
-        if let Some(extras) = sunshade_extras(node.extras()).map_err(|e| format!("node {}: {e}", node.index()))? {
-            self.add_extras_light(node, &extras, &world)?;
-        }
-        path.push(node.index());
-        for child in node.children() {
-            self.visit(&child, world, path)?;
-        }
-        path.pop();
         Ok(())
     }
 
-    fn add_primitive(
-        &mut self,
-        node: &gltf::Node,
-        mesh: &gltf::Mesh,
-        primitive: &gltf::Primitive,
-        world: &DMat4,
-    ) -> Result<(), String> {
-        let name = match mesh.name() {
-            Some(n) => format!("mesh '{n}' primitive {}", primitive.index()),
-            None => format!("mesh {} primitive {}", mesh.index(), primitive.index()),
-        };
-        if primitive.mode() != gltf::mesh::Mode::Triangles {
-            self.scene
-                .warnings
-                .push(format!("{name}: mode {:?} skipped (only TRIANGLES is rendered)", primitive.mode()));
+    /// What one node holds: a mesh, a camera, a KHR_lights_punctual light, a disk light in its extras.
+    fn visit(&mut self, index: u64, node: &NodeDef, world: &DMat4) -> Result<(), String> {
+        let root = self.root;
+        let owner = format!("node {index}");
+        if let Some(m) = node.mesh {
+            let mesh = lookup(&root.meshes, m, &owner, "mesh")?;
+            let mesh_name = match &mesh.name {
+                Some(n) => format!("mesh '{n}'"),
+                None => format!("mesh {m}"),
+            };
+            for (p, primitive) in mesh.primitives.iter().enumerate() {
+                self.add_primitive(index, &format!("{mesh_name} primitive {p}"), primitive, world)?;
+            }
+        }
+        if let Some(c) = node.camera {
+            let camera = lookup(&root.cameras, c, &owner, "camera")?;
+            let placed = read_camera(c, camera, world).map_err(|e| format!("{owner}: {e}"))?;
+            self.scene.cameras.push((c as usize, placed));
+        }
+        if let Some(l) = &node.extensions.lights_punctual {
+            let lights = root.extensions.lights_punctual.as_ref().map_or(&[][..], |x| &x.lights[..]);
+            let light = lookup(lights, l.light, &format!("{owner} KHR_lights_punctual"), "light")?;
+            self.add_light(index, l.light, light, world)?;
+        }
+        if let Some(extras) = sunshade_extras(&node.extras).map_err(|e| format!("{owner}: {e}"))? {
+            self.add_extras_light(index, &extras, world)?;
+        }
+        Ok(())
+    }
+
+    fn add_primitive(&mut self, node: u64, name: &str, primitive: &PrimitiveDef, world: &DMat4) -> Result<(), String> {
+        let mode = primitive.mode.unwrap_or(document::MODE_TRIANGLES);
+        if mode != document::MODE_TRIANGLES {
+            self.scene.warnings.push(format!("{name}: mode {} skipped (only TRIANGLES is rendered)", mode_name(mode)));
             return Ok(());
         }
         let linear = DMat3::from_mat4(*world);
         let det = linear.determinant();
         if !det.is_finite() || det == 0.0 {
-            self.scene.warnings.push(format!("{name}: node {} has a singular transform; skipped", node.index()));
+            self.scene.warnings.push(format!("{name}: node {node} has a singular transform; skipped"));
             return Ok(());
         }
-        let pos_acc = primitive.get(&gltf::Semantic::Positions).ok_or_else(|| format!("{name}: no POSITION"))?;
-        let local_positions = self.reader.read_vec3_f32(&pos_acc).map_err(|e| format!("{name}: POSITION: {e}"))?;
-        if let Some(i) = local_positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!(
-                "{name}: POSITION accessor {} holds a non-finite value at vertex {i}",
-                pos_acc.index()
-            ));
+        let attribute = |semantic: &str| primitive.attributes.get(semantic).copied();
+        let Some(pos_acc) = attribute("POSITION") else {
+            self.scene.warnings.push(format!("{name}: no POSITION; skipped (the glTF spec asks for that)"));
+            return Ok(());
+        };
+        let local_positions = self.reader.read(pos_acc, &format!("{name} POSITION"), "VEC3")?.values;
+        if let Some(i) = local_positions.iter().position(|c| !c.is_finite()) {
+            return Err(format!("{name}: POSITION accessor {pos_acc} holds a non-finite value at vertex {}", i / 3));
         }
-        let vertex_count = local_positions.len();
-        let mut indices = match primitive.indices() {
-            Some(acc) => self.reader.read_indices(&acc).map_err(|e| format!("{name}: indices: {e}"))?,
+        let vertex_count = local_positions.len() / 3;
+        let mut indices = match primitive.indices {
+            Some(acc) => self.reader.read_indices(acc, &format!("{name} indices"))?,
             None => (0..vertex_count as u32).collect(),
         };
         if indices.len() % 3 != 0 {
@@ -219,6 +255,14 @@ impl<'a> Loader<'a> {
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
             return Err(format!("{name}: index {bad} is out of range ({vertex_count} vertices)"));
         }
+        // Flat normals un-index: three vertices a triangle.
+        let added = if attribute("NORMAL").is_some() { vertex_count } else { indices.len() };
+        self.vertex_count = self.vertex_count.saturating_add(added);
+        if self.vertex_count > MAX_SCENE_VERTICES {
+            return Err(format!(
+                "{name} (node {node}): the scene has more than {MAX_SCENE_VERTICES} vertices, the most sunshade loads"
+            ));
+        }
         // Mirrored node: the winding flips with the determinant's sign; swap two corners to keep CCW = front.
         if det < 0.0 {
             for tri in indices.chunks_exact_mut(3) {
@@ -226,59 +270,44 @@ impl<'a> Loader<'a> {
             }
         }
         let positions: Vec<Vec3> = local_positions
-            .iter()
-            .map(|p| world.transform_point3(DVec3::from_array(p.map(f64::from))).as_vec3())
+            .chunks_exact(3)
+            .map(|p| world.transform_point3(DVec3::new(p[0], p[1], p[2])).as_vec3())
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{name}: vertex {i} is not finite after the node transform"));
         }
 
-        let mut out = Mesh { name, material: self.material_index(primitive), ..Default::default() };
+        let mut out =
+            Mesh { name: name.to_string(), material: self.material_index(name, primitive)?, ..Default::default() };
+        let per_vertex = |semantic: &str, kind: &str| -> Result<Option<Vec<f64>>, String> {
+            let Some(acc) = attribute(semantic) else { return Ok(None) };
+            let e = self.reader.read(acc, &format!("{name} {semantic}"), kind)?;
+            if e.count() != vertex_count {
+                return Err(format!("{name}: {semantic} has {} elements, POSITION {vertex_count}", e.count()));
+            }
+            Ok(Some(e.values))
+        };
         // Tangent sources: TANGENT (transformed as a direction, handedness flipped by a mirroring node), else
         // TEXCOORD_0.
-        let file_tangents = match primitive.get(&gltf::Semantic::Tangents) {
-            Some(acc) => {
-                let t = self.reader.read_vec4_f32(&acc).map_err(|e| format!("{}: TANGENT: {e}", out.name))?;
-                if t.len() != vertex_count {
-                    return Err(format!("{}: TANGENT has {} elements, POSITION {vertex_count}", out.name, t.len()));
-                }
-                let w_sign = det.signum();
-                Some(
-                    t.iter()
-                        .map(|t| {
-                            (linear * DVec3::new(t[0] as f64, t[1] as f64, t[2] as f64), w_sign * t[3].signum() as f64)
-                        })
-                        .collect::<Vec<_>>(),
-                )
-            }
-            None => None,
+        let file_tangents = per_vertex("TANGENT", "VEC4")?.map(|t| {
+            let w_sign = det.signum();
+            t.chunks_exact(4)
+                .map(|t| (linear * DVec3::new(t[0], t[1], t[2]), w_sign * t[3].signum()))
+                .collect::<Vec<_>>()
+        });
+        let uvs = match file_tangents {
+            None => per_vertex("TEXCOORD_0", "VEC2")?
+                .map(|uv| uv.chunks_exact(2).map(|c| [c[0] as f32, c[1] as f32]).collect::<Vec<_>>()),
+            Some(_) => None,
         };
-        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
-            Some(acc) if file_tangents.is_none() => {
-                let uv = self.reader.read_texcoords(&acc).map_err(|e| format!("{}: TEXCOORD_0: {e}", out.name))?;
-                if uv.len() != vertex_count {
-                    return Err(format!("{}: TEXCOORD_0 has {} elements, POSITION {vertex_count}", out.name, uv.len()));
-                }
-                Some(uv)
-            }
-            _ => None,
-        };
-        match primitive.get(&gltf::Semantic::Normals) {
-            Some(acc) => {
-                let normals = self.reader.read_vec3_f32(&acc).map_err(|e| format!("{}: NORMAL: {e}", out.name))?;
-                if normals.len() != vertex_count {
-                    return Err(format!(
-                        "{}: NORMAL has {} elements, POSITION {vertex_count}",
-                        out.name,
-                        normals.len()
-                    ));
-                }
+        match per_vertex("NORMAL", "VEC3")? {
+            Some(normals) => {
                 // Normals transform by the inverse transpose of the linear part.
                 let normal_matrix = linear.inverse().transpose();
                 out.normals = normals
-                    .iter()
+                    .chunks_exact(3)
                     .map(|n| {
-                        let w = normal_matrix * DVec3::from_array(n.map(f64::from));
+                        let w = normal_matrix * DVec3::new(n[0], n[1], n[2]);
                         w.try_normalize().unwrap_or(DVec3::ZERO).as_vec3()
                     })
                     .collect();
@@ -338,51 +367,61 @@ impl<'a> Loader<'a> {
         Ok(())
     }
 
-    fn material_index(&mut self, primitive: &gltf::Primitive) -> usize {
-        match primitive.material().index() {
-            Some(i) => i,
-            None => *self.default_material.get_or_insert_with(|| {
+    fn material_index(&mut self, name: &str, primitive: &PrimitiveDef) -> Result<usize, String> {
+        match primitive.material {
+            Some(i) => lookup(&self.root.materials, i, name, "material").map(|_| i as usize),
+            None => Ok(*self.default_material.get_or_insert_with(|| {
                 self.scene.materials.push(Material::default_material());
                 self.scene.materials.len() - 1
-            }),
+            })),
         }
     }
 
-    fn add_light(&mut self, node: &gltf::Node, light: &gltf::khr_lights_punctual::Light, world: &DMat4) {
-        let label = light.name().map_or_else(|| format!("light {}", light.index()), |n| format!("light '{n}'"));
-        match light.kind() {
-            gltf::khr_lights_punctual::Kind::Directional => {
+    fn add_light(&mut self, node: u64, index: u64, light: &LightDef, world: &DMat4) -> Result<(), String> {
+        let label = light.name.as_ref().map_or_else(|| format!("light {index}"), |n| format!("light '{n}'"));
+        match light.kind.as_str() {
+            "directional" => {
                 if self.scene.lights.sun.is_some() {
                     self.scene.warnings.push(format!("{label}: a second directional light is ignored (one sun)"));
-                    return;
+                    return Ok(());
+                }
+                // glTF's color and intensity are single-precision floats, as the gltf crate read them.
+                let e = light.intensity as f32;
+                let color = light.color.map(|c| c as f32);
+                let irradiance = color.map(|c| c * e);
+                let valid = |v: f32| v.is_finite() && v >= 0.0;
+                if !valid(e) || !color.iter().all(|&c| valid(c)) || !irradiance.iter().all(|&v| valid(v)) {
+                    return Err(format!(
+                        "{label} (node {node}): intensity {} × color {:?} must be finite and non-negative \
+                         (the sun's E⊥ in W/m²)",
+                        light.intensity, light.color
+                    ));
                 }
                 // The light shines along its node's −Z, so the direction towards the sun is the node's +Z.
                 let Some(direction) = world.transform_vector3(DVec3::Z).try_normalize() else {
-                    self.scene.warnings.push(format!("{label}: node {} has no direction; ignored", node.index()));
-                    return;
+                    self.scene.warnings.push(format!("{label}: node {node} has no direction; ignored"));
+                    return Ok(());
                 };
-                let e = light.intensity();
                 self.scene.lights.sun = Some(Sun {
                     direction: direction.as_vec3(),
-                    irradiance: light.color().map(|c| c * e),
+                    irradiance,
                     angular_diameter: degrees_to_radians(SUN_ANGULAR_DIAMETER_DEGREES) as f32,
                 });
             }
-            other => self.scene.warnings.push(format!(
+            "point" | "spot" => self.scene.warnings.push(format!(
                 "{label}: {} light ignored (sunshade renders the sun, disk skylights and the sky)",
-                match other {
-                    gltf::khr_lights_punctual::Kind::Point => "point",
-                    _ => "spot",
-                }
+                light.kind
             )),
+            other => {
+                self.scene.warnings.push(format!("{label}: type '{other}' is not a KHR_lights_punctual type; ignored"))
+            }
         }
+        Ok(())
     }
-}
 
-impl Loader<'_> {
     /// A disk light given by a node's `extras`.
-    fn add_extras_light(&mut self, node: &gltf::Node, extras: &serde_json::Value, world: &DMat4) -> Result<(), String> {
-        let at = |what: &str| format!("node {} extras: {what}", node.index());
+    fn add_extras_light(&mut self, node: u64, extras: &Value, world: &DMat4) -> Result<(), String> {
+        let at = |what: &str| format!("node {node} extras: {what}");
         match extras.get("light").and_then(|v| v.as_str()) {
             Some("disk") => {}
             Some(other) => {
@@ -415,10 +454,14 @@ impl Loader<'_> {
                 .push(at("disk light under a non-uniform scale or shear: drawn as the disk of equal area"));
         }
         let scale = normal.length().sqrt();
+        let radius = (radius * scale) as f32;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(at(&format!("the disk's radius {radius} m in world space is not a positive f32")));
+        }
         self.scene.lights.disks.push(DiskLight {
             center: world.transform_point3(DVec3::ZERO).as_vec3(),
             direction: direction.as_vec3(),
-            radius: (radius * scale) as f32,
+            radius,
             radiance,
         });
         Ok(())
@@ -426,17 +469,19 @@ impl Loader<'_> {
 }
 
 /// The `"sunshade"` object of an `extras` value, if any.
-fn sunshade_extras(extras: &gltf::json::Extras) -> Result<Option<serde_json::Value>, String> {
-    let Some(raw) = extras else { return Ok(None) };
-    let value: serde_json::Value = serde_json::from_str(raw.get()).map_err(|e| format!("extras are not JSON: {e}"))?;
-    Ok(value.get("sunshade").cloned())
+fn sunshade_extras(extras: &Option<Value>) -> Result<Option<Value>, String> {
+    match extras {
+        None => Ok(None),
+        Some(v @ Value::Object(_)) => Ok(v.get("sunshade").cloned()),
+        Some(_) => Ok(None),
+    }
 }
 
 /// A radiance: `[r, g, b]` or one number for all three, finite and non-negative [W/(m²·sr)].
-fn rgb(v: &serde_json::Value) -> Result<[f32; 3], String> {
+fn rgb(v: &Value) -> Result<[f32; 3], String> {
     let values: Vec<f64> = match v {
-        serde_json::Value::Number(n) => vec![n.as_f64().unwrap_or(f64::NAN); 3],
-        serde_json::Value::Array(a) if a.len() == 3 => a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
+        Value::Number(n) => vec![n.as_f64().unwrap_or(f64::NAN); 3],
+        Value::Array(a) if a.len() == 3 => a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
         _ => return Err("must be a number or [r, g, b]".into()),
     };
     if values.iter().any(|x| !(x.is_finite() && *x >= 0.0 && *x <= f32::MAX as f64)) {
@@ -445,72 +490,79 @@ fn rgb(v: &serde_json::Value) -> Result<[f32; 3], String> {
     Ok([values[0] as f32, values[1] as f32, values[2] as f32])
 }
 
-fn local_transform(node: &gltf::Node) -> Result<DMat4, String> {
-    let m = match node.transform() {
-        gltf::scene::Transform::Matrix { matrix } => DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from))),
-        gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
-            let q = DQuat::from_array(rotation.map(f64::from));
+/// glTF's matrix and TRS are single-precision floats: each is rounded to f32 (as the gltf crate and viewers read
+/// them), then composed in f64 and rounded to f32 once per vertex.
+fn f32s<const N: usize>(v: [f64; N]) -> [f64; N] {
+    v.map(|x| x as f32 as f64)
+}
+
+fn local_transform(index: u64, node: &NodeDef) -> Result<DMat4, String> {
+    let m = match node.matrix {
+        Some(matrix) => DMat4::from_cols_array(&f32s(matrix)),
+        None => {
+            let q = DQuat::from_array(f32s(node.rotation.unwrap_or([0.0, 0.0, 0.0, 1.0])));
             let q = if q.length_squared() > 0.0 { q.normalize() } else { DQuat::NAN };
             DMat4::from_scale_rotation_translation(
-                DVec3::from_array(scale.map(f64::from)),
+                DVec3::from_array(f32s(node.scale.unwrap_or([1.0; 3]))),
                 q,
-                DVec3::from_array(translation.map(f64::from)),
+                DVec3::from_array(f32s(node.translation.unwrap_or([0.0; 3]))),
             )
         }
     };
     if !m.is_finite() {
-        return Err(format!("node {} has a non-finite or zero-length transform", node.index()));
+        return Err(format!("node {index} has a non-finite or zero-length transform"));
     }
     Ok(m)
 }
 
 /// The parts of a glTF material that sunshade does not model, by their glTF names: textures (the factors alone
-/// are used), emission and alpha modes other than OPAQUE.
-fn ignored_material_features(material: &gltf::Material) -> Vec<String> {
-    let pbr = material.pbr_metallic_roughness();
+/// are used), emission, alpha modes other than OPAQUE, and material extensions (KHR_materials_*).
+fn ignored_material_features(material: &MaterialDef) -> Vec<String> {
+    let pbr = &material.pbr_metallic_roughness;
     let mut ignored = Vec::new();
     let textures = [
-        ("baseColorTexture", pbr.base_color_texture().is_some()),
-        ("metallicRoughnessTexture", pbr.metallic_roughness_texture().is_some()),
-        ("normalTexture", material.normal_texture().is_some()),
-        ("occlusionTexture", material.occlusion_texture().is_some()),
-        ("emissiveTexture", material.emissive_texture().is_some()),
-        ("emissiveFactor", material.emissive_factor() != [0.0; 3]),
+        ("baseColorTexture", pbr.base_color_texture.is_some()),
+        ("metallicRoughnessTexture", pbr.metallic_roughness_texture.is_some()),
+        ("normalTexture", material.normal_texture.is_some()),
+        ("occlusionTexture", material.occlusion_texture.is_some()),
+        ("emissiveTexture", material.emissive_texture.is_some()),
+        ("emissiveFactor", material.emissive_factor != [0.0; 3]),
     ];
     ignored.extend(textures.iter().filter(|(_, present)| *present).map(|(name, _)| name.to_string()));
-    match material.alpha_mode() {
-        gltf::material::AlphaMode::Opaque => {}
-        gltf::material::AlphaMode::Mask => ignored.push("alphaMode MASK".into()),
-        gltf::material::AlphaMode::Blend => ignored.push("alphaMode BLEND".into()),
+    match material.alpha_mode.as_str() {
+        "OPAQUE" => {}
+        "MASK" | "BLEND" => ignored.push(format!("alphaMode {}", material.alpha_mode)),
+        other => ignored.push(format!("alphaMode '{other}' (not a glTF alpha mode)")),
     }
+    ignored.extend(material.extensions.keys().map(|e| format!("extension {e}")));
     ignored
 }
 
-fn read_material(material: &gltf::Material) -> Result<Material, String> {
-    let index = material.index().unwrap_or(0);
-    let name = material.name().map_or_else(|| format!("material {index}"), |n| format!("material '{n}'"));
-    let pbr = material.pbr_metallic_roughness();
-    let [r, g, b, _] = pbr.base_color_factor();
+fn read_material(index: usize, material: &MaterialDef) -> Result<Material, String> {
+    let name = material.name.as_ref().map_or_else(|| format!("material {index}"), |n| format!("material '{n}'"));
+    let pbr = &material.pbr_metallic_roughness;
+    let [r, g, b, _] = pbr.base_color_factor.map(|c| c as f32);
     let albedo = [r, g, b];
     if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Err(format!("{name}: baseColorFactor {albedo:?} is outside [0, 1]"));
     }
-    let metallic_roughness =
-        MetallicRoughness { base_color: albedo, metallic: pbr.metallic_factor(), roughness: pbr.roughness_factor() };
-    let extras = sunshade_extras(material.extras()).map_err(|e| format!("{name}: {e}"))?;
-    let brdf = match extras.as_ref().and_then(|x| x.get("brdf")) {
-        Some(_) => {
-            brdf_from_extras(extras.as_ref().expect("checked"), albedo).map_err(|e| format!("{name} extras: {e}"))?
-        }
+    let metallic_roughness = MetallicRoughness {
+        base_color: albedo,
+        metallic: pbr.metallic_factor as f32,
+        roughness: pbr.roughness_factor as f32,
+    };
+    let extras = sunshade_extras(&material.extras).map_err(|e| format!("{name}: {e}"))?;
+    let brdf = match extras.as_ref().filter(|x| x.get("brdf").is_some()) {
+        Some(x) => brdf_from_extras(x, albedo).map_err(|e| format!("{name} extras: {e}"))?,
         None => Brdf::Lambert { albedo },
     };
     brdf.validate().map_err(|e| format!("{name}: {e}"))?;
-    Ok(Material { name, double_sided: material.double_sided(), brdf, pbr: metallic_roughness })
+    Ok(Material { name, double_sided: material.double_sided, brdf, pbr: metallic_roughness })
 }
 
 /// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
 /// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor).
-fn brdf_from_extras(x: &serde_json::Value, base_color: [f32; 3]) -> Result<Brdf, String> {
+fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
     let kind = x.get("brdf").and_then(|v| v.as_str()).ok_or("\"brdf\" must be a string")?;
     let color = |key: &str| -> Result<[f32; 3], String> {
         rgb(x.get(key).ok_or_else(|| format!("{kind} needs \"{key}\""))?).map_err(|e| format!("{key} {e}"))
@@ -539,11 +591,13 @@ fn brdf_from_extras(x: &serde_json::Value, base_color: [f32; 3]) -> Result<Brdf,
     })
 }
 
-fn read_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
-    let label = camera.name().map_or_else(|| format!("camera {}", camera.index()), |n| format!("camera '{n}'"));
-    let projection = match camera.projection() {
-        gltf::camera::Projection::Perspective(p) => {
-            let (yfov, znear, zfar) = (p.yfov() as f64, p.znear() as f64, p.zfar().map(f64::from));
+fn read_camera(index: u64, camera: &CameraDef, world: &DMat4) -> Result<Camera, String> {
+    let label = camera.name.as_ref().map_or_else(|| format!("camera {index}"), |n| format!("camera '{n}'"));
+    // Camera properties are single-precision floats in glTF (see `f32s`).
+    let f = |v: f64| v as f32 as f64;
+    let projection = match (camera.kind.as_str(), &camera.perspective, &camera.orthographic) {
+        ("perspective", Some(p), _) => {
+            let (yfov, znear, zfar) = (f(p.yfov), f(p.znear), p.zfar.map(f));
             if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
                 return Err(format!("{label}: yfov {yfov} rad is not in (0, π)"));
             }
@@ -554,13 +608,16 @@ fn read_camera(camera: &gltf::Camera, world: &DMat4) -> Result<Camera, String> {
             }
             Projection::Perspective { yfov, znear, zfar }
         }
-        gltf::camera::Projection::Orthographic(o) => {
-            let (ymag, znear, zfar) = (o.ymag().abs() as f64, o.znear() as f64, o.zfar() as f64);
-            let valid = ymag > 0.0 && znear >= 0.0 && zfar > znear;
+        ("orthographic", _, Some(o)) => {
+            let (ymag, znear, zfar) = (f(o.ymag).abs(), f(o.znear), f(o.zfar));
+            let valid = ymag > 0.0 && znear >= 0.0 && zfar > znear && ymag.is_finite() && zfar.is_finite();
             if !valid {
-                return Err(format!("{label}: needs ymag ≠ 0 and 0 ≤ znear < zfar"));
+                return Err(format!("{label}: needs ymag ≠ 0 and 0 ≤ znear < zfar, all finite"));
             }
             Projection::Orthographic { ymag, znear, zfar }
+        }
+        (kind, _, _) => {
+            return Err(format!("{label}: type '{kind}' needs its 'perspective' or 'orthographic' object"));
         }
     };
     let eye = world.transform_point3(DVec3::ZERO);

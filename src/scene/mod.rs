@@ -1,25 +1,25 @@
 //! The scene in world units: triangle meshes in metres, materials, cameras and lights in radiometric units.
 //!
-//! This is the only module that knows glTF ([`load`]). Geometry is flattened once while loading: node transforms
+//! This is the only module that knows glTF ([`load`], reading files through `gltf`, which treats them as untrusted). Geometry is flattened once while loading: node transforms
 //! are applied (in f64, rounded once to f32), normals are carried by the inverse transpose, triangles of mirrored
 //! nodes are re-wound so that counter-clockwise is the front face everywhere, and flat normals are generated where
 //! the file has none. Both renderers therefore consume exactly the same `f32` triangles.
 //!
 //! Axes are glTF's: right-handed, +Y up, metres.
 
-mod accessor;
 pub mod camera;
+mod gltf;
 pub mod light;
 mod load;
 pub mod material;
 pub mod tangent;
-mod uri;
 
 use glam::{DVec3, Vec3, Vec4};
 
 pub use camera::{Camera, Projection};
+pub use gltf::files::UriScope;
 pub use light::{DiskLight, Lights, Sun};
-pub use load::{load, load_with_options, LoadError, LoadOptions};
+pub use load::{load, load_with_options, LoadError, LoadOptions, MAX_SCENE_VERTICES};
 pub use material::{Brdf, BrdfKind, Material, MetallicRoughness};
 
 /// A loaded scene: everything both renderers need apart from the per-render settings.
