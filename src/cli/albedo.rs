@@ -14,7 +14,7 @@ use clap::Args;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::generated::{machine, today, update_region};
+use super::generated::{check_region, machine, today, update_region};
 use super::CliError;
 use crate::scene::{self, Brdf, LoadOptions};
 use crate::shading::albedo::lobe_albedo;
@@ -63,6 +63,12 @@ fn standard_lobes() -> Vec<(String, Brdf)> {
 }
 
 pub fn run(a: &AlbedoArgs) -> Result<(), CliError> {
+    for doc in &a.update {
+        check_region(doc, "albedo")?;
+        if a.scene.is_none() {
+            check_region(doc, "convergence")?;
+        }
+    }
     let header = format!("Computed by `sunshade albedo` on {} ({}).\n\n", today(), machine());
     let albedo = match &a.scene {
         Some(path) => {

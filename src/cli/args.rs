@@ -74,6 +74,25 @@ pub fn parse_finite(s: &str) -> Result<f64, String> {
     }
 }
 
+/// An image side: a whole number of pixels ≥ 1.
+pub fn parse_pixels(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<i64>() {
+        Ok(v) if (1..=u32::MAX as i64).contains(&v) => Ok(v as u32),
+        Ok(v) => Err(format!("{v} pixels: the size must be at least 1")),
+        Err(_) => Err(format!("'{s}' is not a whole number of pixels")),
+    }
+}
+
+/// A finite number ≥ 0.
+pub fn parse_non_negative(s: &str) -> Result<f64, String> {
+    let v = parse_finite(s)?;
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("'{s}' must not be negative"))
+    }
+}
+
 /// A finite number > 0.
 pub fn parse_positive(s: &str) -> Result<f64, String> {
     let v = parse_finite(s)?;
@@ -91,11 +110,11 @@ pub struct SceneArgs {
     pub scene: PathBuf,
 
     /// Image width [pixels].
-    #[arg(long, default_value_t = DEFAULT_WIDTH, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = DEFAULT_WIDTH, value_parser = parse_pixels)]
     pub width: u32,
 
     /// Image height [pixels].
-    #[arg(long, default_value_t = DEFAULT_HEIGHT, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = DEFAULT_HEIGHT, value_parser = parse_pixels)]
     pub height: u32,
 
     /// Buffer and image files must lie inside DIR (symbolic links resolved); default: the scene file's folder.

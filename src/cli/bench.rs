@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::args::parse_positive;
-use super::generated::{machine, today, update_region};
+use super::generated::{check_region, machine, today, update_region};
 use super::CliError;
 use crate::authoring::chart;
 use crate::compare::{self, DiffOptions};
@@ -71,6 +71,10 @@ fn ms(d: Duration) -> f64 {
 }
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
+    let region = if a.brdf_chart { "brdf-chart" } else { "" };
+    for doc in &a.update {
+        check_region(doc, region)?;
+    }
     if a.brdf_chart {
         return brdf_chart(a);
     }
@@ -228,7 +232,7 @@ fn bench_scenes(
 ) -> Result<Vec<String>, CliError> {
     let options =
         ReferenceOptions { sub_pixel_bits: renderer.device_info().sub_pixel_precision_bits, ..Default::default() };
-    let diff_options = DiffOptions { fail_rel: Some(a.fail_rel), ..Default::default() };
+    let diff_options = DiffOptions { fail_rel: Some(a.fail_rel), fail_peak: None, ..Default::default() };
     let mut rows = Vec::new();
     for path in scenes {
         let scene = scene::load_with_options(path, &LoadOptions::default())?;

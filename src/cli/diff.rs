@@ -4,51 +4,72 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::args::parse_finite;
+use super::args::parse_non_negative;
 use super::CliError;
 use crate::compare::{self, DiffOptions, DiffReport, PixelDiff};
-use crate::film::{read_image, Image};
+use crate::film::{read_image, Image, ImageFormat};
 
-/// Tolerances and floor of a comparison (shared with `render --check`).
-#[derive(Args, Clone, Debug)]
+/// Tolerances and floor of a comparison (shared with `render --check`). Every field is optional so that a command
+/// can tell which were given (`render` refuses them without `--check`).
+#[derive(Args, Clone, Debug, Default)]
 pub struct ToleranceArgs {
-    /// Relative tolerance per pixel: |a−b| / max(|a|, |b|, floor), largest over RGB (default 1e-5 when neither
-    /// --fail-rel nor --fail-abs is given).
-    #[arg(long, value_parser = parse_finite)]
+    /// Relative tolerance per pixel: |a−b| / max(|a|, |b|, floor), largest over RGB. Default, when none of
+    /// --fail-rel, --fail-abs, --fail-peak is given: 1e-5 relative or 4.8e-7 of the peak absolute (the f32
+    /// rounding of n·l, docs/accuracy.md), whichever is larger.
+    #[arg(long, value_parser = parse_non_negative, value_name = "REL")]
     pub fail_rel: Option<f64>,
-    /// Absolute tolerance per pixel [W/(m²·sr)]. With --fail-rel, a pixel fails only when over both.
-    #[arg(long, value_parser = parse_finite)]
+    /// Absolute tolerance per pixel [W/(m²·sr)]. With other tolerances, a pixel fails only when over all of them.
+    #[arg(long, value_parser = parse_non_negative, value_name = "ABS")]
     pub fail_abs: Option<f64>,
-    /// Pixels allowed over tolerance.
-    #[arg(long, default_value_t = 0)]
-    pub fail_count: usize,
-    /// Pixels allowed to differ in coverage (alpha).
-    #[arg(long, default_value_t = 0)]
-    pub fail_coverage: usize,
-    /// Absolute floor of the relative error's denominator [W/(m²·sr)].
-    #[arg(long, default_value_t = 0.0, value_parser = parse_finite)]
-    pub floor: f64,
-    /// Floor as a fraction of the larger image peak (the effective floor is the larger of the two). The default
-    /// 1e-2: f32 rendering carries an absolute error of a few 1e-8 of the peak, so below 1% of the peak a relative
-    /// tolerance of 1e-5 would measure rounding, not rendering (docs/accuracy.md).
-    #[arg(long, default_value_t = 1e-2, value_parser = parse_finite)]
-    pub floor_fraction: f64,
+    /// Absolute tolerance per pixel as a fraction of the larger image peak.
+    #[arg(long, value_parser = parse_non_negative, value_name = "FRACTION")]
+    pub fail_peak: Option<f64>,
+    /// Pixels allowed over tolerance [default: 0].
+    #[arg(long, value_name = "N")]
+    pub fail_count: Option<usize>,
+    /// Pixels allowed to differ in coverage (alpha) [default: 0].
+    #[arg(long, value_name = "N")]
+    pub fail_coverage: Option<usize>,
+    /// Absolute floor of the relative error's denominator [W/(m²·sr)] [default: 0].
+    #[arg(long, value_parser = parse_non_negative, value_name = "W/(M2·SR)")]
+    pub floor: Option<f64>,
+    /// Floor as a fraction of the larger image peak (the effective floor is the larger of the two) [default: 1e-2]:
+    /// below 1% of the peak a relative tolerance of 1e-5 would measure f32 rounding, not rendering.
+    #[arg(long, value_parser = parse_non_negative, value_name = "FRACTION")]
+    pub floor_fraction: Option<f64>,
 }
 
 impl ToleranceArgs {
     pub fn options(&self) -> DiffOptions {
-        let fail_rel = match (self.fail_rel, self.fail_abs) {
-            (None, None) => Some(1e-5),
-            (r, _) => r,
-        };
+        let defaults = DiffOptions::default();
+        let none_given = self.fail_rel.is_none() && self.fail_abs.is_none() && self.fail_peak.is_none();
+        let (fail_rel, fail_peak) =
+            if none_given { (defaults.fail_rel, defaults.fail_peak) } else { (self.fail_rel, self.fail_peak) };
         DiffOptions {
-            floor: self.floor,
-            floor_fraction: self.floor_fraction,
+            floor: self.floor.unwrap_or(defaults.floor),
+            floor_fraction: self.floor_fraction.unwrap_or(defaults.floor_fraction),
             fail_rel,
             fail_abs: self.fail_abs,
-            fail_count: self.fail_count,
-            fail_coverage: self.fail_coverage,
+            fail_peak,
+            fail_count: self.fail_count.unwrap_or(defaults.fail_count),
+            fail_coverage: self.fail_coverage.unwrap_or(defaults.fail_coverage),
         }
+    }
+
+    /// The long names of the flags given, for refusing them where they mean nothing.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            ("--fail-rel", self.fail_rel.is_some()),
+            ("--fail-abs", self.fail_abs.is_some()),
+            ("--fail-peak", self.fail_peak.is_some()),
+            ("--fail-count", self.fail_count.is_some()),
+            ("--fail-coverage", self.fail_coverage.is_some()),
+            ("--floor", self.floor.is_some()),
+            ("--floor-fraction", self.floor_fraction.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(name, given)| given.then_some(name))
+        .collect()
     }
 }
 
@@ -92,8 +113,32 @@ pub fn compare_and_report(
 }
 
 pub fn run(a: &DiffCommand) -> Result<(), CliError> {
+    let format = |p: &PathBuf| {
+        ImageFormat::from_path(p).ok_or_else(|| {
+            CliError::Usage(format!("{}: unsupported image extension (use .exr, .pfm or .png)", p.display()))
+        })
+    };
+    let (fa, fb) = (format(&a.a)?, format(&a.b)?);
+    if (fa == ImageFormat::Png) != (fb == ImageFormat::Png) {
+        return Err(CliError::Usage(format!(
+            "{} and {}: a PNG holds 8-bit display codes, an EXR or PFM radiance; compare two of a kind",
+            a.a.display(),
+            a.b.display()
+        )));
+    }
+    if let Some(h) = &a.heatmap {
+        super::check_heatmap_path(h)?;
+    }
     let read = |p: &PathBuf| read_image(p).map_err(|e| CliError::Usage(e.to_string()));
-    let (ia, ib) = (read(&a.a)?, read(&a.b)?);
+    let (mut ia, mut ib) = (read(&a.a)?, read(&a.b)?);
+    if fa == ImageFormat::Pfm || fb == ImageFormat::Pfm {
+        // A PFM has no alpha: comparing its all-covered pixels with the other image's coverage would report every
+        // background pixel as a coverage mismatch. Compare every pixel instead, and say so.
+        for img in [&mut ia, &mut ib] {
+            img.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
+        }
+        eprintln!("sunshade diff: note: a PFM has no alpha; every pixel is compared, without coverage");
+    }
     let names = (a.a.display().to_string(), a.b.display().to_string());
     let report =
         compare_and_report(&ia, &ib, (&names.0, &names.1), &a.tolerances.options(), a.heatmap.as_deref(), a.json)?;

@@ -11,8 +11,8 @@ pub fn markers(name: &str) -> (String, String) {
     (format!("<!-- {tag}: begin (generated; do not edit by hand) -->"), format!("<!-- {tag}: end -->"))
 }
 
-/// Replaces the text between the markers of region `name` in `doc` with `content` (atomically).
-pub fn update_region(doc: &Path, name: &str, content: &str) -> Result<(), CliError> {
+/// The document's text and the byte offsets of region `name`'s begin and end markers.
+fn find_region(doc: &Path, name: &str) -> Result<(String, usize, usize), CliError> {
     let (begin, end) = markers(name);
     let text = std::fs::read_to_string(doc).map_err(|e| CliError::Usage(format!("{}: {e}", doc.display())))?;
     let (Some(b), Some(e)) = (text.find(&begin), text.find(&end)) else {
@@ -21,6 +21,18 @@ pub fn update_region(doc: &Path, name: &str, content: &str) -> Result<(), CliErr
     if e < b {
         return Err(CliError::Usage(format!("{}: the markers of '{name}' are out of order", doc.display())));
     }
+    Ok((text, b, e))
+}
+
+/// Checks, before a long computation, that `doc` can be read and has region `name` (usage error otherwise).
+pub fn check_region(doc: &Path, name: &str) -> Result<(), CliError> {
+    find_region(doc, name).map(|_| ())
+}
+
+/// Replaces the text between the markers of region `name` in `doc` with `content` (atomically).
+pub fn update_region(doc: &Path, name: &str, content: &str) -> Result<(), CliError> {
+    let (begin, _) = markers(name);
+    let (text, b, e) = find_region(doc, name)?;
     let new = format!("{}{begin}\n{content}{}", &text[..b], &text[e..]);
     crate::film::write_atomically(doc, |w| std::io::Write::write_all(w, new.as_bytes()))?;
     Ok(())

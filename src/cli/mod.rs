@@ -34,14 +34,18 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a glTF scene on the GPU (Vulkan) to an image of radiance.
+    #[command(allow_negative_numbers = true)]
     Render(Box<render::RenderArgs>),
     /// Render the same image on the CPU (f64 shading, no Vulkan needed): the reference to check against.
+    #[command(allow_negative_numbers = true)]
     Reference(Box<reference::ReferenceCommand>),
     /// Compare two images (.exr, .pfm, .png): coverage, errors, worst pixel; exit 1 when outside tolerance.
+    #[command(allow_negative_numbers = true)]
     Diff(Box<diff::DiffCommand>),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
+    #[command(allow_negative_numbers = true)]
     Bench(Box<bench::BenchArgs>),
     /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
     /// light integrals per sample count; with a scene, the albedo of its materials.
@@ -136,7 +140,8 @@ fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), 
     Ok((scene, settings, load_time))
 }
 
-/// Refuses an output path whose extension names no supported format, before any work is done.
+/// Refuses an output path whose extension names no supported format, or whose folder does not exist, before any
+/// work is done.
 fn check_output_path(path: &std::path::Path) -> Result<(), CliError> {
     if crate::film::ImageFormat::from_path(path).is_none() {
         return Err(CliError::Usage(format!(
@@ -144,7 +149,44 @@ fn check_output_path(path: &std::path::Path) -> Result<(), CliError> {
             path.display()
         )));
     }
+    check_folder_exists(path)
+}
+
+/// A heatmap is a PNG; its folder must exist.
+fn check_heatmap_path(path: &std::path::Path) -> Result<(), CliError> {
+    if crate::film::ImageFormat::from_path(path) != Some(crate::film::ImageFormat::Png) {
+        return Err(CliError::Usage(format!("{}: the heatmap is a PNG (use .png)", path.display())));
+    }
+    check_folder_exists(path)
+}
+
+fn check_folder_exists(path: &std::path::Path) -> Result<(), CliError> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => std::path::Path::new("."),
+    };
+    if !folder.is_dir() {
+        return Err(CliError::Usage(format!("{}: the folder '{}' does not exist", path.display(), folder.display())));
+    }
     Ok(())
+}
+
+/// An image in which no pixel is covered is almost always a mistake (a camera looking away, geometry at ±3e38):
+/// say so, naming the scene.
+fn warn_if_nothing_covered(image: &crate::film::Image, scene: &std::path::Path) {
+    if image.covered_count() == 0 {
+        eprintln!(
+            "sunshade: warning: {}: no pixel is covered: the image is empty (is the camera looking at the scene?)",
+            scene.display()
+        );
+    }
+}
+
+/// `-v`: the exposure a PNG was written with.
+fn print_exposure(ev: Option<f64>) {
+    if let Some(ev) = ev {
+        eprintln!("sunshade: PNG exposure EV {ev:+.3} (display value = radiance × 2^EV)");
+    }
 }
 
 /// Prints phase timings as a small table on stderr.

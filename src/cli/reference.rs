@@ -5,7 +5,7 @@ use std::time::Instant;
 use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
-use super::{check_output_path, load_scene, print_phases, CliError};
+use super::{check_output_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
 
@@ -38,6 +38,10 @@ pub struct ReferenceCommand {
     pub output: OutputArgs,
     #[command(flatten)]
     pub reference: ReferenceArgs,
+    /// The largest image the reference renders [pixels] (default: 2^27, the most lavapipe's largest allocation
+    /// holds in RGBA32F, so that the reference has the GPU's limits). Each side is at most 16384, as on the GPU.
+    #[arg(long, value_name = "N", default_value_t = cpu::DEFAULT_MAX_PIXELS, value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_pixels: u64,
     /// Print the time of each phase.
     #[arg(short, long)]
     pub verbose: bool,
@@ -46,12 +50,14 @@ pub struct ReferenceCommand {
 pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let started = Instant::now();
     check_output_path(&a.output.output)?;
+    cpu::check_size(a.scene.width, a.scene.height, a.max_pixels).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
     let image = cpu::render(&scene, &settings, &a.reference.options());
     let render_time = t.elapsed();
+    warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    write_image(&image, &a.output.output, a.output.exposure)?;
+    let ev = write_image(&image, &a.output.output, a.output.exposure)?;
     if a.verbose {
         eprintln!(
             "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",
@@ -61,6 +67,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
+        print_exposure(ev);
         print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())], started.elapsed());
     }
     Ok(())

@@ -6,8 +6,9 @@ use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
 use super::diff::{compare_and_report, ToleranceArgs};
-use super::reference::ReferenceArgs;
-use super::{check_output_path, load_scene, print_phases, CliError};
+use super::{
+    check_heatmap_path, check_output_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError,
+};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
 use crate::gpu::{ContextOptions, Interpolation, Renderer};
@@ -35,15 +36,26 @@ pub struct RenderArgs {
     /// With --check: write the comparison heatmap here.
     #[arg(long, value_name = "PNG", requires = "check")]
     pub heatmap: Option<std::path::PathBuf>,
+    /// With --check: the tolerances of the comparison (as `diff`'s).
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    #[command(flatten)]
-    pub reference: ReferenceArgs,
+    /// With --check: whether the device fuses the viewport multiply-add for unclipped vertices (default: whether
+    /// this CPU has FMA, which is what lavapipe does). The reference takes the device's sub-pixel bits.
+    #[arg(long, action = clap::ArgAction::Set, value_name = "true|false", requires = "check")]
+    pub fused_viewport: Option<bool>,
 }
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
     check_output_path(&a.output.output)?;
+    if !a.check {
+        if let Some(flag) = a.tolerances.given().first() {
+            return Err(CliError::Usage(format!("{flag} applies only with --check")));
+        }
+    }
+    if let Some(h) = &a.heatmap {
+        check_heatmap_path(h)?;
+    }
     let (scene, settings, load_time) = load_scene(&a.scene)?;
     let options =
         ContextOptions { device: a.device.clone(), interpolation: a.interpolation, ..ContextOptions::from_env() };
@@ -53,8 +65,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let gpu_scene = renderer.upload(&scene)?;
     let upload_time = t_upload.elapsed();
     let (image, frame) = renderer.render(&gpu_scene, &settings)?;
+    warn_if_nothing_covered(&image, &a.scene.scene);
     let t_encode = Instant::now();
-    write_image(&image, &a.output.output, a.output.exposure)?;
+    let ev = write_image(&image, &a.output.output, a.output.exposure)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let info = renderer.device_info();
@@ -74,6 +87,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
+        print_exposure(ev);
         let setup = renderer.setup_timings();
         print_phases(
             &[
@@ -92,7 +106,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if a.check {
         let options = ReferenceOptions {
             sub_pixel_bits: renderer.device_info().sub_pixel_precision_bits,
-            ..a.reference.options()
+            fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
         };
         let t = Instant::now();
         let reference = cpu::render(&scene, &settings, &options);

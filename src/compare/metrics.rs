@@ -10,13 +10,31 @@
 //! Coverage mismatches (alpha differs) are counted apart. A mismatching pixel is an *edge* pixel when its 3×3
 //! neighbourhood holds a coverage boundary in either image, else *interior*.
 //!
-//! A pixel is over tolerance when it exceeds every tolerance given (`--fail-rel`, `--fail-abs`): each grants
-//! leeway, as `numpy.isclose` does. The comparison fails when more than `--fail-count` pixels are over tolerance
+//! A pixel is over tolerance when it exceeds every tolerance given (`--fail-rel`, `--fail-abs`, `--fail-peak`):
+//! each grants leeway, as `numpy.isclose` does.
+//!
+//! The default tolerance (neither of those flags given) is relative 1e-5, or an absolute error of
+//! [`F32_SHADING_PEAK_FRACTION`] of the peak, whichever is larger: a renderer that shades in f32 cannot do better
+//! than that absolute error, however exact its formulas, because `n·l` is formed in f32 (see the constant). The comparison fails when more than `--fail-count` pixels are over tolerance
 //! or more than `--fail-coverage` pixels differ in coverage.
 
 use serde_json::json;
 
 use crate::film::Image;
+
+/// The absolute error a renderer shading in f32 can carry, as a fraction of the peak radiance: 8u, u = 2⁻²⁴
+/// (f32's unit roundoff), about 4.8e-7.
+///
+/// Derivation. Both renderers take the same f32 vertex normals; the GPU interpolates and normalizes the normal
+/// and forms `n·l` in f32, the reference in f64. Normalizing costs at most 3 roundings per component (the dot
+/// product for the length, the square root, the division), the dot product `n·l` of two unit vectors at most 3
+/// (two additions and a product, each ≤ u of a value ≤ 1), and the interpolation at most 2 more. These errors are
+/// *absolute* in `n·l` (≤ 8u, whatever `n·l` is), so the radiance `ρ E⊥ (n·l)` carries an absolute error of up to
+/// 8u × `ρ E⊥`, the radiance of a surface facing the light: about the image's peak. Near a terminator, where
+/// `n·l` → 0, that absolute error is a large relative one (a pixel at 1% of the peak can be 5e-5 off). The
+/// products after `n·l` round relatively and are covered by the relative part. Measured on lavapipe (UV spheres
+/// of 4k and 64k triangles under the sun, tests/gpu_vs_reference.rs): at most 3.0u of the peak.
+pub const F32_SHADING_PEAK_FRACTION: f64 = 8.0 / (1u64 << 24) as f64;
 
 /// Thresholds of a comparison.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +47,8 @@ pub struct DiffOptions {
     pub fail_rel: Option<f64>,
     /// Absolute tolerance per pixel [W/(m²·sr)].
     pub fail_abs: Option<f64>,
+    /// Absolute tolerance per pixel as a fraction of the images' peak (dimensionless).
+    pub fail_peak: Option<f64>,
     /// Pixels allowed over tolerance.
     pub fail_count: usize,
     /// Pixels allowed to differ in coverage.
@@ -37,7 +57,15 @@ pub struct DiffOptions {
 
 impl Default for DiffOptions {
     fn default() -> Self {
-        Self { floor: 0.0, floor_fraction: 1e-2, fail_rel: Some(1e-5), fail_abs: None, fail_count: 0, fail_coverage: 0 }
+        Self {
+            floor: 0.0,
+            floor_fraction: 1e-2,
+            fail_rel: Some(1e-5),
+            fail_abs: None,
+            fail_peak: Some(F32_SHADING_PEAK_FRACTION),
+            fail_count: 0,
+            fail_coverage: 0,
+        }
     }
 }
 
@@ -195,14 +223,13 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
             if report.worst.is_none_or(|wp| rel > wp.rel) {
                 report.worst = Some(WorstPixel { x, y, a: pa, b: pb, rel, abs });
             }
-            let over_rel = options.fail_rel.map(|t| rel > t);
-            let over_abs = options.fail_abs.map(|t| abs > t);
-            let over = match (over_rel, over_abs) {
-                (Some(r), Some(a)) => r && a,
-                (Some(r), None) => r,
-                (None, Some(a)) => a,
-                (None, None) => false,
-            };
+            let checks = [
+                options.fail_rel.map(|t| rel > t),
+                options.fail_abs.map(|t| abs > t),
+                options.fail_peak.map(|t| abs > t * peak),
+            ];
+            let mut given = checks.iter().flatten().peekable();
+            let over = given.peek().is_some() && given.all(|&over| over);
             if over {
                 report.over_tolerance.add(edge);
             }
@@ -222,12 +249,16 @@ impl DiffReport {
     /// A short human-readable report.
     pub fn text(&self, name_a: &str, name_b: &str) -> String {
         let mut s = String::new();
-        let tol = match (self.options.fail_rel, self.options.fail_abs) {
-            (Some(r), Some(a)) => format!("rel > {r:e} and abs > {a:e}"),
-            (Some(r), None) => format!("rel > {r:e}"),
-            (None, Some(a)) => format!("abs > {a:e}"),
-            (None, None) => "no tolerance".into(),
-        };
+        let o = &self.options;
+        let parts: Vec<String> = [
+            o.fail_rel.map(|r| format!("rel > {r:e}")),
+            o.fail_abs.map(|a| format!("abs > {a:e}")),
+            o.fail_peak.map(|p| format!("abs > {p:.3e} × peak")),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let tol = if parts.is_empty() { "no tolerance".to_string() } else { parts.join(" and ") };
         s += &format!("A: {name_a} ({}x{}, {} covered)\n", self.width, self.height, self.covered_a);
         s += &format!("B: {name_b} ({}x{}, {} covered)\n", self.width, self.height, self.covered_b);
         s += &format!(
@@ -271,7 +302,7 @@ impl DiffReport {
             "rmse": finite(self.rmse), "psnr_db": finite(self.psnr_db), "peak": finite(self.peak), "floor": finite(self.floor),
             "over_tolerance": { "total": self.over_tolerance.total, "edge": self.over_tolerance.edge, "interior": self.over_tolerance.interior },
             "worst": self.worst.map(|w| json!({ "x": w.x, "y": w.y, "a": w.a, "b": w.b, "rel": finite(w.rel), "abs": finite(w.abs) })),
-            "tolerances": { "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_count": self.options.fail_count, "fail_coverage": self.options.fail_coverage },
+            "tolerances": { "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_peak": self.options.fail_peak, "fail_count": self.options.fail_count, "fail_coverage": self.options.fail_coverage },
             "pass": self.pass,
         })
     }
@@ -334,6 +365,27 @@ mod tests {
         assert!(!run(None, Some(1e-3)));
         assert!(run(Some(1e-3), Some(0.1)), "within the absolute tolerance");
         assert!(run(Some(0.1), Some(1e-3)), "within the relative tolerance");
+    }
+
+    #[test]
+    fn default_tolerance_allows_f32_rounding_of_the_peak_and_no_more() {
+        // A pixel at 2% of the peak, 5u of the peak off: 1.5e-5 relative, within 8u of the peak.
+        let u = 1.0 / (1u64 << 24) as f64;
+        let a = img(2, 1, |x, _| if x == 0 { [100.0, 100.0, 100.0, 1.0] } else { [2.0, 2.0, 2.0, 1.0] });
+        let off = |k: f64| {
+            let mut b = a.clone();
+            b.set(1, 0, [(2.0 + k * u * 100.0) as f32, 2.0, 2.0, 1.0]);
+            diff(&a, &b, &DiffOptions::default()).unwrap().0
+        };
+        let r = off(5.0);
+        assert!(r.max_rel > 1.4e-5 && r.pass, "{r:?}");
+        let r = off(12.0);
+        assert!(!r.pass && r.over_tolerance.total == 1, "{r:?}");
+        // Without the peak part the relative tolerance alone decides.
+        let strict = DiffOptions { fail_peak: None, ..Default::default() };
+        let mut b = a.clone();
+        b.set(1, 0, [(2.0 + 5.0 * u * 100.0) as f32, 2.0, 2.0, 1.0]);
+        assert!(!diff(&a, &b, &strict).unwrap().0.pass);
     }
 
     #[test]

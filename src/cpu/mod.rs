@@ -54,6 +54,31 @@ impl Default for ReferenceOptions {
     }
 }
 
+/// The longest side the reference renders [pixels]: lavapipe's `maxImageDimension2D`, so that the reference has
+/// the GPU's limits.
+pub const MAX_DIMENSION: u32 = 16384;
+
+/// The default pixel budget of the reference: 2^27 pixels, the most that lavapipe's largest allocation (2 GiB) holds
+/// in RGBA32F. The reference needs 16 bytes a pixel for the image and about 12 more per pixel of a band in flight.
+pub const DEFAULT_MAX_PIXELS: u64 = 1 << 27;
+
+/// Refuses an image size the reference would not render (each side ≤ [`MAX_DIMENSION`], `width × height ≤
+/// max_pixels`), before anything is allocated.
+pub fn check_size(width: u32, height: u32, max_pixels: u64) -> Result<(), String> {
+    if width > MAX_DIMENSION || height > MAX_DIMENSION {
+        return Err(format!(
+            "a {width}x{height} image exceeds the reference's largest side ({MAX_DIMENSION} pixels, as on the GPU)"
+        ));
+    }
+    let pixels = width as u64 * height as u64;
+    if pixels > max_pixels {
+        return Err(format!(
+            "a {width}x{height} image has {pixels} pixels, more than the budget of {max_pixels} (--max-pixels)"
+        ));
+    }
+    Ok(())
+}
+
 /// Whether this CPU has fused multiply-add (what lavapipe's JIT uses when it does).
 pub fn host_has_fma() -> bool {
     #[cfg(target_arch = "x86_64")]

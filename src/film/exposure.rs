@@ -1,8 +1,10 @@
 //! Mapping radiance to display values for 8-bit output.
 //!
 //! The displayed value of a channel is `clamp(L · 2^EV, 0, 1)`, sRGB-encoded: `EV` is a plain scale in stops, not
-//! a camera exposure value (there is no 1/1.2 or ISO factor). `auto` picks `EV = −log2(p99)`, `p99` being the 99th
-//! percentile over covered pixels of each pixel's brightest channel, so that 1% of the covered pixels clip.
+//! a camera exposure value (there is no 1/1.2 or ISO factor). `auto` picks `EV = log2(0.8 / p99)`, `p99` being the
+//! 99th percentile over covered pixels of each pixel's brightest channel: 99% of the covered pixels display at or
+//! below 80% of white (sRGB code 231), so highlights keep headroom below clipping and a uniformly lit surface is
+//! a light grey, not a saturated 255; mid-tones (half the p99) display at 40% (code 170).
 
 use super::Image;
 
@@ -16,11 +18,11 @@ pub enum Exposure {
 }
 
 impl Exposure {
-    /// The scale factor `2^EV` for this image.
-    pub fn scale_for(&self, image: &Image) -> f64 {
+    /// The EV applied to this image.
+    pub fn ev_for(&self, image: &Image) -> f64 {
         match *self {
-            Exposure::Ev(ev) => ev.exp2(),
-            Exposure::Auto => auto_exposure_ev(image).exp2(),
+            Exposure::Ev(ev) => ev,
+            Exposure::Auto => auto_exposure_ev(image),
         }
     }
 }
@@ -38,8 +40,11 @@ impl std::str::FromStr for Exposure {
     }
 }
 
-/// `−log2` of the 99th percentile of the brightest channel over covered pixels with positive radiance; 0 when there
-/// are none.
+/// The display value that the 99th percentile maps to under `auto` exposure.
+pub const AUTO_EXPOSURE_P99_DISPLAY: f64 = 0.8;
+
+/// `log2(0.8 / p99)`, p99 the 99th percentile of the brightest channel over covered pixels with positive radiance;
+/// 0 when there are none.
 pub fn auto_exposure_ev(image: &Image) -> f64 {
     let mut peaks: Vec<f32> = image
         .pixels()
@@ -53,7 +58,7 @@ pub fn auto_exposure_ev(image: &Image) -> f64 {
     }
     let k = ((peaks.len() - 1) as f64 * 0.99).round() as usize;
     let (_, p99, _) = peaks.select_nth_unstable_by(k, f32::total_cmp);
-    -(*p99 as f64).log2()
+    (AUTO_EXPOSURE_P99_DISPLAY / *p99 as f64).log2()
 }
 
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1], to an 8-bit code.
@@ -85,10 +90,15 @@ mod tests {
         for (i, p) in img.pixels_mut().iter_mut().enumerate() {
             *p = [(i + 1) as f32, 0.0, 0.0, 1.0];
         }
-        // 100 covered pixels valued 1..=100: the 99th percentile (index 98) is 99.
+        // 100 covered pixels valued 1..=100: the 99th percentile (index 98) is 99, displayed at 0.8.
         let ev = auto_exposure_ev(&img);
-        assert!((ev.exp2() * 99.0 - 1.0).abs() < 1e-12);
+        assert!((ev.exp2() * 99.0 - 0.8).abs() < 1e-12);
         assert_eq!(auto_exposure_ev(&Image::new(3, 3)), 0.0);
+        // A uniformly lit surface is not saturated: every pixel at code 231 of 255.
+        let mut flat = Image::new(4, 4);
+        flat.pixels_mut().iter_mut().for_each(|p| *p = [37.5, 37.5, 37.5, 1.0]);
+        let code = srgb_encode(37.5 * auto_exposure_ev(&flat).exp2());
+        assert_eq!(code, 231);
     }
 
     #[test]

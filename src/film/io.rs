@@ -39,8 +39,10 @@ impl ImageFormat {
 pub enum ImageIoError {
     #[error("{path}: unsupported image extension (use .exr, .pfm or .png)")]
     UnsupportedExtension { path: PathBuf },
-    #[error("{path}: {source}")]
-    Io { path: PathBuf, source: io::Error },
+    /// The OS error is part of the message and deliberately not a `source`: a chain printer (anyhow's `{:#}`)
+    /// would print it twice.
+    #[error("{path}: {error}")]
+    Io { path: PathBuf, error: io::Error },
     #[error("{path}: {message}")]
     Invalid { path: PathBuf, message: String },
 }
@@ -51,11 +53,12 @@ impl ImageIoError {
     }
 }
 
-/// Writes `image` to `path` in the format its extension names. `exposure` applies to PNG only.
-pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(), ImageIoError> {
+/// Writes `image` to `path` in the format its extension names. `exposure` applies to PNG only; for a PNG the EV
+/// applied is returned (and recorded in the file's `sunshade exposure EV` tEXt chunk).
+pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<Option<f64>, ImageIoError> {
     let format =
         ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_path_buf() })?;
-    let io_err = |source| ImageIoError::Io { path: path.to_path_buf(), source };
+    let io_err = |error| ImageIoError::Io { path: path.to_path_buf(), error };
     match format {
         ImageFormat::Exr => {
             let data: Vec<f32> = image.pixels().iter().flatten().copied().collect();
@@ -66,11 +69,16 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(),
                     .write_to(w, ::image::ImageFormat::OpenExr)
                     .map_err(io::Error::other)
             })
-            .map_err(io_err)
+            .map_err(io_err)?;
+            Ok(None)
         }
-        ImageFormat::Pfm => write_atomically(path, |w| write_pfm(image, w)).map_err(io_err),
+        ImageFormat::Pfm => {
+            write_atomically(path, |w| write_pfm(image, w)).map_err(io_err)?;
+            Ok(None)
+        }
         ImageFormat::Png => {
-            let scale = exposure.scale_for(image);
+            let ev = exposure.ev_for(image);
+            let scale = ev.exp2();
             let mut data = Vec::with_capacity(image.pixels().len() * 4);
             for p in image.pixels() {
                 for c in &p[..3] {
@@ -78,27 +86,41 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<(),
                 }
                 data.push((p[3].clamp(0.0, 1.0) * 255.0).round() as u8);
             }
-            let buf = ::image::RgbaImage::from_raw(image.width(), image.height(), data)
-                .ok_or_else(|| ImageIoError::invalid(path, "pixel buffer does not match the image size"))?;
-            write_atomically(path, |w| {
-                ::image::DynamicImage::ImageRgba8(buf).write_to(w, ::image::ImageFormat::Png).map_err(io::Error::other)
-            })
-            .map_err(io_err)
+            write_atomically(path, |w| write_png(w, image.width(), image.height(), &data, ev)).map_err(io_err)?;
+            Ok(Some(ev))
         }
     }
+}
+
+/// The tEXt keyword under which a PNG records its exposure.
+pub const PNG_EXPOSURE_KEYWORD: &str = "sunshade exposure EV";
+
+/// 8-bit RGBA with an sRGB chunk (the values are sRGB-encoded) and tEXt chunks naming the software and the EV.
+fn write_png(w: &mut impl Write, width: u32, height: u32, rgba: &[u8], ev: f64) -> io::Result<()> {
+    let mut encoder = png::Encoder::new(w, width, height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let text =
+        |e: &mut png::Encoder<_>, k: &str, v: String| e.add_text_chunk(k.to_string(), v).map_err(io::Error::other);
+    text(&mut encoder, "Software", format!("sunshade {}", env!("CARGO_PKG_VERSION")))?;
+    text(&mut encoder, PNG_EXPOSURE_KEYWORD, format!("{ev}"))?;
+    let mut writer = encoder.write_header().map_err(io::Error::other)?;
+    writer.write_image_data(rgba).map_err(io::Error::other)?;
+    writer.finish().map_err(io::Error::other)
 }
 
 /// Reads an image in the format its extension names.
 pub fn read_image(path: &Path) -> Result<Image, ImageIoError> {
     let format =
         ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_path_buf() })?;
-    let io_err = |source| ImageIoError::Io { path: path.to_path_buf(), source };
+    let io_err = |error| ImageIoError::Io { path: path.to_path_buf(), error };
     match format {
         ImageFormat::Pfm => {
             let file = std::fs::File::open(path).map_err(io_err)?;
             read_pfm(&mut io::BufReader::new(file)).map_err(|e| match e.kind() {
                 io::ErrorKind::InvalidData | io::ErrorKind::UnexpectedEof => ImageIoError::invalid(path, e.to_string()),
-                _ => ImageIoError::Io { path: path.to_path_buf(), source: e },
+                _ => ImageIoError::Io { path: path.to_path_buf(), error: e },
             })
         }
         ImageFormat::Exr | ImageFormat::Png => {
