@@ -268,6 +268,24 @@ mod tests {
     }
 
     #[test]
+    fn png_records_its_exposure_and_srgb() {
+        let path = tmp("ev.png");
+        let mut img = Image::new(2, 2);
+        img.pixels_mut().iter_mut().for_each(|p| *p = [40.0, 40.0, 40.0, 1.0]);
+        let ev = write_image(&img, &path, Exposure::Auto).unwrap().expect("a PNG has an EV");
+        assert!((ev - (0.8f64 / 40.0).log2()).abs() < 1e-12);
+        let decoder = png::Decoder::new(io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let reader = decoder.read_info().unwrap();
+        let info = reader.info();
+        assert!(info.srgb.is_some(), "no sRGB chunk");
+        let text = info.uncompressed_latin1_text.iter().find(|t| t.keyword == PNG_EXPOSURE_KEYWORD).expect("EV chunk");
+        assert_eq!(text.text.parse::<f64>().unwrap(), ev);
+        assert_eq!(write_image(&img, &tmp("ev.exr"), Exposure::Auto).unwrap(), None);
+        std::fs::remove_file(path).unwrap();
+        std::fs::remove_file(tmp("ev.exr")).unwrap();
+    }
+
+    #[test]
     fn truncated_pfm_is_an_error_naming_the_file() {
         let path = tmp("short.pfm");
         std::fs::write(&path, b"PF\n4 4\n-1.0\n\0\0\0\0").unwrap();
