@@ -297,6 +297,26 @@ fn non_finite_values_and_degenerate_transforms_are_refused() {
     c.doc["scenes"][0]["nodes"] = json!([0, 1, 2]);
     c.refused(&["camera 0", "no view direction"]);
 
+    // Camera matrices out of f32 range (JSON has no inf or NaN: 1e39 rounds to inf as a glTF float).
+    let mut c = Case::new("camera-matrix-inf");
+    c.doc["cameras"] = json!([{ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1 } }]);
+    c.doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "camera": 0, "matrix": [1e39, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1] }));
+    c.doc["scenes"][0]["nodes"] = json!([0, 1, 2]);
+    c.refused(&["node 2", "non-finite"]);
+    let mut c = Case::new("camera-matrix-huge");
+    c.doc["cameras"] = json!([{ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1 } }]);
+    c.doc["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "camera": 0, "matrix": [3e38, 0, 0, 0, 0, 3e38, 0, 0, 0, 0, 3e38, 0, 3e38, 3e38, 3e38, 1] }));
+    c.doc["scenes"][0]["nodes"] = json!([0, 1, 2]);
+    // Finite in f64: placed, and rendered (empty) without a panic.
+    let s = c.loads();
+    assert_eq!(s.cameras.len(), 1);
+
     let mut c = Case::new("camera-type");
     c.doc["cameras"] = json!([{ "type": "perspective" }]);
     c.doc["nodes"].as_array_mut().unwrap().push(json!({ "camera": 0 }));
@@ -442,6 +462,8 @@ fn cli_refusals_are_one_line_with_the_documented_exit_code() {
         (vec!["reference", g, "-o", o, "--width", "100000", "--height", "100000"], 1, "largest side"),
         (vec!["reference", g, "-o", o, "--width", "16000", "--height", "16000"], 1, "--max-pixels"),
         (vec!["diff", g, g, "--fail-rel=-1"], 2, "must not be negative"),
+        (vec!["render", g, "-o", "x.exr", "--exposure", "-3"], 2, "--exposure applies to PNG output only"),
+        (vec!["reference", g, "-o", o, "--sun-model", "delta", "--sun-samples", "16"], 2, "--sun-samples"),
         // Checked before the long computation, not after it.
         (vec!["albedo", "--update", "no-such-doc.md"], 2, "no-such-doc.md"),
         (vec!["bench", g, "--update", "no-such-doc.md"], 2, "no-such-doc.md"),
@@ -455,6 +477,18 @@ fn cli_refusals_are_one_line_with_the_documented_exit_code() {
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: not one line: {err}");
         assert!(!err.contains("tip: to pass"), "{args:?}: {err}");
         assert!(!out.exists());
+    }
+    // A chain of 10⁵ nested nodes through both renderers (this aborted with a stack overflow before).
+    let mut c = Case::new("cli-chain");
+    let mut nodes: Vec<Value> = (0..100_000).map(|i| json!({ "children": [i + 1] })).collect();
+    nodes.push(json!({ "mesh": 0 }));
+    c.doc["nodes"] = Value::Array(nodes);
+    c.doc["scenes"][0]["nodes"] = json!([0]);
+    let p = c.write();
+    for cmd in ["render", "reference"] {
+        let r = sunshade(&[cmd, p.to_str().unwrap(), "-o", o, "--width", "32", "--height", "32"]);
+        assert!(r.status.success(), "{cmd}: {}", String::from_utf8_lossy(&r.stderr));
+        std::fs::remove_file(&out).unwrap();
     }
     // An unsupported required extension is a bad file: exit 1, naming the file.
     let mut c = Case::new("cli-ext");

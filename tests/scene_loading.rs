@@ -75,11 +75,23 @@ fn unmodelled_material_features_and_extensions_are_named_in_warnings() {
     // The factors are still read.
     assert_eq!(s.materials[0].brdf, Brdf::Lambert { albedo: [0.5, 0.4, 0.3] });
 
-    // An extension the file requires cannot be ignored: the file is refused, naming it.
+    // A required extension that only changes appearance sunshade does not draw yet is drawn, and the warning says
+    // the file requires it; one that changes geometry is refused, naming it.
     doc["extensionsRequired"] = json!(["KHR_materials_emissive_strength"]);
     std::fs::write(dir.path("required.gltf"), doc.to_string()).unwrap();
-    let e = load_err(&dir.path("required.gltf"));
-    assert!(e.contains("required.gltf") && e.contains("KHR_materials_emissive_strength"), "{e}");
+    let s = scene::load(&dir.path("required.gltf")).unwrap();
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("requires KHR_materials_emissive_strength") && w.contains("drawn without it")),
+        "{:?}",
+        s.warnings
+    );
+    doc["extensionsRequired"] = json!(["KHR_materials_emissive_strength", "KHR_draco_mesh_compression"]);
+    std::fs::write(dir.path("draco.gltf"), doc.to_string()).unwrap();
+    let e = load_err(&dir.path("draco.gltf"));
+    assert!(e.contains("draco.gltf") && e.contains("KHR_draco_mesh_compression"), "{e}");
+    assert!(!e.contains("emissive_strength"), "an appearance-only extension is named as unsupported: {e}");
 }
 
 #[test]

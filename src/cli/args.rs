@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::DVec3;
 
-use crate::film::Exposure;
+use crate::film::{Exposure, ImageFormat};
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{DiskModel, ShadingOptions, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS};
@@ -205,9 +205,10 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = DEFAULT_SAMPLES_PER_AXIS * DEFAULT_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub samples: u32,
 
-    /// Samples for integrating specular lobes over the sun's disk (--sun-model disk; rounded up to a square).
-    #[arg(long, default_value_t = DEFAULT_SUN_SAMPLES_PER_AXIS * DEFAULT_SUN_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub sun_samples: u32,
+    /// Samples for integrating specular lobes over the sun's disk (--sun-model disk; rounded up to a square)
+    /// [default: 64].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub sun_samples: Option<u32>,
 }
 
 /// The side of the smallest square grid with at least `samples` cells.
@@ -216,6 +217,14 @@ pub fn per_axis(samples: u32) -> u32 {
 }
 
 impl SceneArgs {
+    /// Refuses flags that mean nothing together.
+    pub fn check(&self) -> Result<(), super::CliError> {
+        if self.sun_samples.is_some() && self.sun_model == SunModel::Delta {
+            return Err(super::CliError::Usage("--sun-samples applies to --sun-model disk only".into()));
+        }
+        Ok(())
+    }
+
     pub fn load_options(&self) -> LoadOptions {
         let uris = match (&self.asset_root, self.allow_outside_uris) {
             (_, true) => UriScope::Anywhere,
@@ -237,7 +246,7 @@ impl SceneArgs {
             shading: ShadingOptions {
                 sun: self.sun_model,
                 disk: self.disk_model,
-                sun_samples_per_axis: per_axis(self.sun_samples),
+                sun_samples_per_axis: self.sun_samples.map_or(DEFAULT_SUN_SAMPLES_PER_AXIS, per_axis),
                 samples_per_axis: per_axis(self.samples),
             },
         }
@@ -263,9 +272,29 @@ pub struct OutputArgs {
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
 
-    /// PNG exposure: EV stops (display value = radiance × 2^EV) or 'auto'.
-    #[arg(long, default_value = "auto", allow_hyphen_values = true, value_name = "EV|auto")]
-    pub exposure: Exposure,
+    /// PNG exposure: EV stops (display value = radiance × 2^EV) or 'auto' (the default: the 99th percentile of the
+    /// covered pixels displays at 80% of white).
+    #[arg(long, allow_hyphen_values = true, value_name = "EV|auto")]
+    pub exposure: Option<Exposure>,
+}
+
+impl OutputArgs {
+    /// Refuses, before any work, an output sunshade cannot write (see `check_output_path`) and an `--exposure`
+    /// for a format that has none.
+    pub fn check(&self) -> Result<(), super::CliError> {
+        super::check_output_path(&self.output)?;
+        if self.exposure.is_some() && ImageFormat::from_path(&self.output) != Some(ImageFormat::Png) {
+            return Err(super::CliError::Usage(format!(
+                "--exposure applies to PNG output only ({} stores radiance unscaled)",
+                self.output.display()
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn exposure(&self) -> Exposure {
+        self.exposure.unwrap_or(Exposure::Auto)
+    }
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@ use std::time::Instant;
 use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
-use super::{check_output_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
+use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
 
@@ -49,7 +49,8 @@ pub struct ReferenceCommand {
 
 pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let started = Instant::now();
-    check_output_path(&a.output.output)?;
+    a.output.check()?;
+    a.scene.check()?;
     cpu::check_size(a.scene.width, a.scene.height, a.max_pixels).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
     let (scene, settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
@@ -57,7 +58,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    let ev = write_image(&image, &a.output.output, a.output.exposure)?;
+    let ev = write_image(&image, &a.output.output, a.output.exposure())?;
     if a.verbose {
         eprintln!(
             "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",

@@ -6,9 +6,7 @@ use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
 use super::diff::{compare_and_report, ToleranceArgs};
-use super::{
-    check_heatmap_path, check_output_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError,
-};
+use super::{check_heatmap_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image;
 use crate::gpu::{ContextOptions, Interpolation, Renderer};
@@ -47,7 +45,8 @@ pub struct RenderArgs {
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
-    check_output_path(&a.output.output)?;
+    a.output.check()?;
+    a.scene.check()?;
     if !a.check {
         if let Some(flag) = a.tolerances.given().first() {
             return Err(CliError::Usage(format!("{flag} applies only with --check")));
@@ -67,7 +66,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let (image, frame) = renderer.render(&gpu_scene, &settings)?;
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t_encode = Instant::now();
-    let ev = write_image(&image, &a.output.output, a.output.exposure)?;
+    let ev = write_image(&image, &a.output.output, a.output.exposure())?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let info = renderer.device_info();

@@ -105,6 +105,17 @@ impl<'a> Loader<'a> {
         if !unmodelled.is_empty() {
             self.scene.warnings.push(format!("extensions not modelled, ignored: {}", unmodelled.join(", ")));
         }
+        // Required ones that reach here affect appearance only (`gltf::is_appearance_only`); say that the image
+        // lacks what the file demands.
+        let required: Vec<&str> =
+            root.extensions_required.iter().map(String::as_str).filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
+        if !required.is_empty() {
+            self.scene.warnings.push(format!(
+                "the file requires {}, which sunshade does not implement: drawn without it (materials from their \
+                 factors; see the material warnings)",
+                required.join(", ")
+            ));
+        }
         for (index, material) in root.materials.iter().enumerate() {
             let m = read_material(index, material)?;
             let ignored = ignored_material_features(material);

@@ -18,9 +18,19 @@ use document::Root;
 use files::{AssetFiles, UriScope};
 use uri::UriTarget;
 
-/// Extensions sunshade implements. A file that *requires* any other extension is refused (it cannot be drawn as
-/// its author meant); one that only *uses* another is drawn with a warning naming it.
+/// Extensions sunshade implements.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
+
+/// Extensions whose whole effect is on appearance that sunshade does not draw yet: texture transforms (textures
+/// are not drawn), emission strength (emission is not drawn) and material lobes (KHR_materials_*: materials are
+/// drawn from their glTF factors or sunshade extras). A file that *requires* one is still drawn, with a warning
+/// naming the requirement: its geometry, lights and cameras are exact, and the material warnings say what is
+/// missing. A file that requires any other extension (geometry compression such as Draco or meshopt, GPU
+/// instancing, textures in KTX2 or WebP that could not be decoded, or an extension unknown to sunshade) is refused:
+/// sunshade cannot draw it.
+pub fn is_appearance_only(extension: &str) -> bool {
+    extension == "KHR_texture_transform" || extension.starts_with("KHR_materials_")
+}
 
 /// A parsed glTF file and the bytes of each of its buffers.
 pub struct Gltf {
@@ -56,8 +66,12 @@ fn check_version(root: &Root) -> Result<(), String> {
 }
 
 fn check_required_extensions(root: &Root) -> Result<(), String> {
-    let unsupported: Vec<&str> =
-        root.extensions_required.iter().map(String::as_str).filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
+    let unsupported: Vec<&str> = root
+        .extensions_required
+        .iter()
+        .map(String::as_str)
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e) && !is_appearance_only(e))
+        .collect();
     if unsupported.is_empty() {
         Ok(())
     } else {
