@@ -153,8 +153,8 @@ pub fn resolve_with(
     let mut lights = scene.lights.clone();
     lights.disks.extend(light_options.disks.iter().copied());
     if let Some(sky) = light_options.sky {
-        if sky.iter().any(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(usage("--sky-radiance must be finite and non-negative"));
+        if sky.iter().any(|v| !(v.is_finite() && *v >= 0.0 && *v <= f32::MAX as f64)) {
+            return Err(usage("--sky-radiance must be finite, non-negative and within f32 range"));
         }
         lights.sky = Some(sky.map(|v| v as f32));
     }

@@ -6,6 +6,7 @@ use clap::Args;
 use glam::DVec3;
 
 use crate::film::{Exposure, ImageFormat};
+use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{DiskModel, ShadingOptions, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS};
@@ -35,16 +36,21 @@ pub fn parse_rgb(s: &str) -> Result<[f64; 3], String> {
     Ok(v.to_array())
 }
 
-/// A radiance: one non-negative number for all channels, or `r,g,b`.
+/// A radiance: one non-negative number for all channels, or `r,g,b`; within f32's range (images are f32).
 pub fn parse_radiance(s: &str) -> Result<[f64; 3], String> {
-    if s.contains(',') {
-        return parse_rgb(s);
+    let v = if s.contains(',') {
+        parse_rgb(s)?
+    } else {
+        let v = parse_finite(s)?;
+        if v < 0.0 {
+            return Err(format!("'{s}' must be non-negative"));
+        }
+        [v; 3]
+    };
+    if v.iter().any(|c| *c > f32::MAX as f64) {
+        return Err(format!("'{s}' is beyond f32's range ({:e})", f32::MAX));
     }
-    let v = parse_finite(s)?;
-    if v < 0.0 {
-        return Err(format!("'{s}' must be non-negative"));
-    }
-    Ok([v; 3])
+    Ok(v)
 }
 
 /// `x,y,z:nx,ny,nz:R:L0` → a disk light (centre [m], emission direction, radius [m], radiance, one value or r,g,b).
@@ -58,6 +64,12 @@ pub fn parse_disk_light(s: &str) -> Result<DiskLight, String> {
         parse_vec3(parts[1])?.try_normalize().ok_or_else(|| format!("disk direction '{}' is zero", parts[1]))?;
     let radius = parse_positive(parts[2])?;
     let radiance = parse_radiance(parts[3])?;
+    let extent = center.abs().max_element().max(radius);
+    if extent > MAX_DISK_EXTENT_M || (radius as f32) < f32::MIN_POSITIVE {
+        return Err(format!(
+            "'{s}': the centre and radius must be within {MAX_DISK_EXTENT_M:e} m and the radius a normal f32 (docs: disk lights)"
+        ));
+    }
     Ok(DiskLight {
         center: center.as_vec3(),
         direction: direction.as_vec3(),
@@ -319,5 +331,10 @@ mod tests {
         assert!(parse_disk_light("0,3,0:0,-1,0:-0.5:7").is_err());
         assert!(parse_disk_light("0,3,0:0,-1,0:0.5").is_err());
         assert!(parse_radiance("-1").is_err());
+        assert!(parse_radiance("1e300").is_err() && parse_radiance("1,1e39,1").is_err());
+        assert!(parse_disk_light("0,3,0:0,-1,0:1e300:7").is_err());
+        assert!(parse_disk_light("0,1e20,0:0,-1,0:1:7").is_err());
+        assert!(parse_disk_light("0,3,0:0,-1,0:1e-50:7").is_err());
+        assert!(parse_disk_light("0,3,0:0,-1,0:1:1e300").is_err());
     }
 }

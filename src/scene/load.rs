@@ -23,7 +23,7 @@ use super::gltf::accessor::AccessorReader;
 use super::gltf::document::{self, lookup, CameraDef, LightDef, MaterialDef, NodeDef, PrimitiveDef, Root};
 use super::gltf::files::UriScope;
 use super::gltf::{self, SUPPORTED_EXTENSIONS};
-use super::light::{DiskLight, Sun};
+use super::light::{DiskLight, Sun, MAX_DISK_EXTENT_M};
 use super::material::{Brdf, Material, MetallicRoughness};
 use super::tangent::{default_tangent, orthonormal_tangent, tangents_from_uv, triangle_tangent};
 use super::{Mesh, Scene};
@@ -465,12 +465,16 @@ impl<'a> Loader<'a> {
                 .push(at("disk light under a non-uniform scale or shear: drawn as the disk of equal area"));
         }
         let scale = normal.length().sqrt();
-        let radius = (radius * scale) as f32;
-        if !(radius.is_finite() && radius > 0.0) {
-            return Err(at(&format!("the disk's radius {radius} m in world space is not a positive f32")));
+        let radius = radius * scale;
+        let center = world.transform_point3(DVec3::ZERO);
+        if center.abs().max_element().max(radius) > MAX_DISK_EXTENT_M || (radius as f32) < f32::MIN_POSITIVE {
+            return Err(at(&format!(
+                "the disk (radius {radius:e} m at {center}) must lie within {MAX_DISK_EXTENT_M:e} m, its radius a normal f32"
+            )));
         }
+        let radius = radius as f32;
         self.scene.lights.disks.push(DiskLight {
-            center: world.transform_point3(DVec3::ZERO).as_vec3(),
+            center: center.as_vec3(),
             direction: direction.as_vec3(),
             radius,
             radiance,
