@@ -276,3 +276,42 @@ fn disk_light_and_sky_flags_light_a_floor_as_the_formulas_say() {
     assert_refused(&dir, &input, &["--disk-light", "0,2,0:0,0,0:1:100"], 2, "--disk-light");
     assert_refused(&dir, &input, &["--disk-model", "huge"], 2, "--disk-model");
 }
+
+#[test]
+fn shaders_compile_at_run_time_from_sunshade_shader_dir_and_errors_name_the_line() {
+    let dir = TempDir::new("shader-dir");
+    let input = dir.write("scene.glb", &scene());
+    let shaders = dir.path("shaders");
+    std::fs::create_dir(&shaders).unwrap();
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    for e in std::fs::read_dir(&source).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), shaders.join(e.file_name())).unwrap();
+    }
+    let out = dir.path("out.exr");
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_sunshade"))
+            .args(["render", s(&input), "-o", s(&out), "--width", "32", "--height", "24"])
+            .env("SUNSHADE_VALIDATION", "1")
+            .env("SUNSHADE_SHADER_DIR", &shaders)
+            .output()
+            .unwrap()
+    };
+    let ok = run();
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    // The run-time compilation gives the image of the modules built ahead of time.
+    let built_ahead = dir.path("ahead.exr");
+    let o = sunshade(&["render", s(&input), "-o", s(&built_ahead), "--width", "32", "--height", "24"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&built_ahead).unwrap());
+    std::fs::remove_file(&out).unwrap();
+    let math = shaders.join("math.glsl");
+    let text = std::fs::read_to_string(&math).unwrap();
+    std::fs::write(&math, format!("{text}\nfloat broken = undefined_name;\n")).unwrap();
+    let line = text.lines().count() + 2;
+    let bad = run();
+    let err = stderr(&bad);
+    assert_eq!(bad.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("math.glsl:{line}")), "{err}");
+    assert!(!out.exists());
+}

@@ -76,9 +76,10 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Creates the device and compiles the shaders. The two run at once: shaderc's fixed cost (~75 ms per stage
-    /// here) overlaps device creation, the two stages compile on two threads, and the interpolation mode is
-    /// guessed (f64 unless asked otherwise) and compiled again only when the device turns out to lack f64.
+    /// Creates the device and loads the shaders: SPIR-V built ahead of time (about 0.5 ms), or, with
+    /// `SUNSHADE_SHADER_DIR`, compiled at run time while the device is created (shaderc's fixed cost is ~75 ms per
+    /// stage here, the two stages compile on two threads, and the interpolation mode is guessed, f64 unless asked
+    /// otherwise, and compiled again only when the device turns out to lack f64).
     pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
         let guess = options.interpolation.unwrap_or(Interpolation::BarycentricF64);
         let (dev, instance, compiled, compile_time) = std::thread::scope(|s| {
@@ -473,7 +474,8 @@ impl Renderer {
     }
 }
 
-/// SPIR-V of the vertex and fragment stages for an interpolation mode, compiled on two threads.
+/// SPIR-V of the vertex and fragment stages for an interpolation mode: built ahead of time, or compiled on two
+/// threads from `SUNSHADE_SHADER_DIR`.
 fn compile_stages(interpolation: Interpolation, naive_math: bool) -> Result<(Vec<u32>, Vec<u32>), GpuError> {
     let mut defines = vec![match interpolation {
         Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
@@ -484,8 +486,8 @@ fn compile_stages(interpolation: Interpolation, naive_math: bool) -> Result<(Vec
         defines.push("SUNSHADE_NAIVE_MATH");
     }
     let (vs, fs) = std::thread::scope(|s| {
-        let vs = s.spawn(|| shaders::compile("scene.vert", shaders::SOURCES, &defines));
-        let fs = shaders::compile("scene.frag", shaders::SOURCES, &defines);
+        let vs = s.spawn(|| shaders::stage_spirv("scene.vert", &defines));
+        let fs = shaders::stage_spirv("scene.frag", &defines);
         (vs.join().expect("the shader compiler thread panicked"), fs)
     });
     Ok((vs.map_err(GpuError::ShaderCompile)?, fs.map_err(GpuError::ShaderCompile)?))

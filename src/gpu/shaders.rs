@@ -1,7 +1,9 @@
-//! GLSL sources from `shaders/`, embedded in the binary, compiled to SPIR-V at run time by shaderc.
+//! The shaders: SPIR-V compiled ahead of time by build.rs (every variant the renderer can ask for), embedded in
+//! the binary; and the GLSL sources of `shaders/`, embedded too, for compiling at run time in development
+//! (`SUNSHADE_SHADER_DIR`) and for the tests that check the two agree.
 //!
-//! `#include "name.glsl"` resolves against the embedded files, so the binary runs from any directory.
-//! A compile error reports the file and line (shaderc's `file:line: error: ...`).
+//! `#include "name.glsl"` resolves against the given sources, so the binary runs from any directory.
+//! A compile error reports the file and line (shaderc's `file:line: error: ...`), at build time as at run time.
 
 /// Every file in `shaders/`, by name.
 pub const SOURCES: &[(&str, &str)] = &[
@@ -15,40 +17,43 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("scene.frag", include_str!("../../shaders/scene.frag")),
 ];
 
-/// Compiles `name` from `sources` (with its includes) to SPIR-V words, with these `#define`s.
-pub fn compile(name: &str, sources: &[(&str, &str)], defines: &[&str]) -> Result<Vec<u32>, String> {
-    let lookup = |n: &str| sources.iter().find(|(k, _)| *k == n).map(|(_, s)| *s);
-    let source = lookup(name).ok_or_else(|| format!("no shader named '{name}'"))?;
-    let kind = if name.ends_with(".vert") {
-        shaderc::ShaderKind::Vertex
-    } else if name.ends_with(".frag") {
-        shaderc::ShaderKind::Fragment
-    } else if name.ends_with(".comp") {
-        shaderc::ShaderKind::Compute
-    } else {
-        return Err(format!("{name}: unknown shader stage (expected .vert, .frag or .comp)"));
-    };
-    let compiler = shaderc::Compiler::new().map_err(|e| format!("cannot initialise shaderc: {e}"))?;
-    let mut options = shaderc::CompileOptions::new().map_err(|e| format!("cannot create shaderc options: {e}"))?;
-    options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_3 as u32);
-    // No SPIR-V optimisation: the device compiles anyway, and the arithmetic stays exactly as written.
-    options.set_optimization_level(shaderc::OptimizationLevel::Zero);
-    options.set_warnings_as_errors();
-    for d in defines {
-        options.add_macro_definition(d, None);
-    }
-    options.set_include_callback(|requested, _kind, requester, _depth| {
-        lookup(requested)
-            .map(|content| shaderc::ResolvedInclude {
-                resolved_name: requested.to_string(),
-                content: content.to_string(),
+pub use sunshade_glsl::compile;
+
+/// A shader module compiled by build.rs.
+pub struct EmbeddedModule {
+    pub stage: &'static str,
+    pub defines: &'static [&'static str],
+    /// SPIR-V, little-endian words.
+    pub spirv: &'static [u8],
+}
+
+include!(concat!(env!("OUT_DIR"), "/spirv_modules.rs"));
+
+/// The environment variable naming a folder of GLSL sources to compile at run time instead (development).
+pub const SHADER_DIR_VAR: &str = "SUNSHADE_SHADER_DIR";
+
+/// SPIR-V of `stage` with these `#define`s: compiled at run time from `$SUNSHADE_SHADER_DIR` when that is set
+/// (every file of [`SOURCES`] read from there), else the module built ahead of time.
+pub fn stage_spirv(stage: &str, defines: &[&str]) -> Result<Vec<u32>, String> {
+    if let Some(dir) = std::env::var_os(SHADER_DIR_VAR) {
+        let dir = std::path::PathBuf::from(dir);
+        let files: Vec<(&str, String)> = SOURCES
+            .iter()
+            .map(|(name, _)| {
+                let path = dir.join(name);
+                std::fs::read_to_string(&path).map(|text| (*name, text)).map_err(|e| format!("{}: {e}", path.display()))
             })
-            .ok_or_else(|| format!("{requester}: cannot find include '{requested}'"))
-    });
-    let artifact = compiler
-        .compile_into_spirv(source, kind, name, "main", Some(&options))
-        .map_err(|e| e.to_string().trim().replace('\n', "; "))?;
-    Ok(artifact.as_binary().to_vec())
+            .collect::<Result<_, _>>()?;
+        let refs: Vec<(&str, &str)> = files.iter().map(|(n, t)| (*n, t.as_str())).collect();
+        return compile(stage, &refs, defines);
+    }
+    embedded(stage, defines).ok_or_else(|| format!("no module {stage} with {defines:?} was built ahead of time"))
+}
+
+/// The module build.rs compiled for `stage` with exactly these `#define`s, as words.
+pub fn embedded(stage: &str, defines: &[&str]) -> Option<Vec<u32>> {
+    let m = MODULES.iter().find(|m| m.stage == stage && m.defines == defines)?;
+    Some(m.spirv.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect())
 }
 
 #[cfg(test)]
@@ -67,6 +72,16 @@ mod tests {
                 let words = compile(name, SOURCES, defines).unwrap_or_else(|e| panic!("{e}"));
                 assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
             }
+        }
+    }
+
+    #[test]
+    fn modules_built_ahead_equal_run_time_compilation() {
+        // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
+        assert_eq!(MODULES.len(), 12);
+        for m in MODULES {
+            let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);
         }
     }
 
