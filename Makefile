@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models bench docs images clean
+.PHONY: setup build render test lint models bench bench-batch docs images clean
 
 setup:
 	@./scripts/setup.sh
@@ -27,6 +27,10 @@ bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
+
+# Throughput: 30 renders as processes against one batch, and a whole render process against its frame phases.
+bench-batch: build
+	./scripts/bench-batch.sh 5
 
 # Regenerates the BRDF tables in docs/brdf.md (directional albedo, convergence of the sampled light integrals).
 docs: build

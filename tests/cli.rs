@@ -315,3 +315,59 @@ fn shaders_compile_at_run_time_from_sunshade_shader_dir_and_errors_name_the_line
     assert!(err.contains(&format!("math.glsl:{line}")), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn batch_renders_like_render_goes_on_after_a_failure_and_shards() {
+    let dir = TempDir::new("batch");
+    let input = dir.write("scene.glb", &scene());
+    let out = |name: &str| dir.path(name).display().to_string();
+    let jobs = json!([
+        { "scene": s(&input), "output": out("a.exr"), "width": 40, "height": 30, "sun-elevation": -10, "sun-azimuth": 30 },
+        { "scene": s(&dir.path("missing.glb")), "output": out("b.exr") },
+        { "scene": s(&input), "output": out("c.png"), "width": 40, "height": 30, "brdf": "ward", "exposure": -3 },
+        { "scene": s(&input), "output": out("d.exr"), "width": 40, "height": 30, "no-such-flag": 1 },
+        { "scene": s(&input), "output": out("e.pfm"), "width": 24, "height": 24, "disk-light": ["0,2,0:0,-1,0:0.5:100"] },
+    ]);
+    let manifest = dir.path("jobs.json");
+    std::fs::write(&manifest, jobs.to_string()).unwrap();
+    let o = sunshade(&["batch", s(&manifest), "--jobs", "3"]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("job 1") && err.contains("missing.glb"), "{err}");
+    assert!(err.contains("job 3") && err.contains("no-such-flag"), "{err}");
+    assert!(err.contains("2 of 5 jobs failed"), "{err}");
+    // Bitwise the images of single render calls with the same flags.
+    let single = |name: &str, extra: &[&str]| {
+        let path = dir.path(name);
+        let mut args = vec!["render", s(&input), "-o", s(&path)];
+        args.extend_from_slice(extra);
+        let o = sunshade(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(path).unwrap()
+    };
+    let a = single("ra.exr", &["--width", "40", "--height", "30", "--sun-elevation", "-10", "--sun-azimuth", "30"]);
+    assert_eq!(std::fs::read(dir.path("a.exr")).unwrap(), a);
+    let c = single("rc.png", &["--width", "40", "--height", "30", "--brdf", "ward", "--exposure", "-3"]);
+    assert_eq!(std::fs::read(dir.path("c.png")).unwrap(), c);
+    let e = single("re.pfm", &["--width", "24", "--height", "24", "--disk-light", "0,2,0:0,-1,0:0.5:100"]);
+    assert_eq!(std::fs::read(dir.path("e.pfm")).unwrap(), e);
+    assert!(!dir.path("b.exr").exists() && !dir.path("d.exr").exists());
+
+    // Shards: 1/2 renders jobs 1 and 3 (both fail), 0/2 jobs 0, 2 and 4.
+    for f in ["a.exr", "c.png", "e.pfm"] {
+        std::fs::remove_file(dir.path(f)).unwrap();
+    }
+    let o = sunshade(&["batch", s(&manifest), "--shard", "1/2", "-q"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!dir.path("a.exr").exists());
+    let o = sunshade(&["batch", s(&manifest), "--shard", "0/2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3 of 3 jobs rendered"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(dir.path("a.exr")).unwrap(), a);
+    let o = sunshade(&["batch", s(&manifest), "--shard", "2/2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    std::fs::write(&manifest, "{\"not\": \"an array\"}").unwrap();
+    let o = sunshade(&["batch", s(&manifest)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("jobs.json") && stderr(&o).contains("array"), "{}", stderr(&o));
+}

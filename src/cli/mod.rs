@@ -5,12 +5,14 @@
 
 mod albedo;
 mod args;
+mod batch;
 mod bench;
 mod diff;
 mod generated;
 mod info;
 mod reference;
 mod render;
+mod session;
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -44,6 +46,10 @@ enum Command {
     Diff(Box<diff::DiffCommand>),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
+    /// Render many jobs of a JSON manifest in one process, on one device: scenes loaded and uploaded once while
+    /// they are reused, pipelines created once, images encoded in parallel.
+    #[command(allow_negative_numbers = true)]
+    Batch(batch::BatchArgs),
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     #[command(allow_negative_numbers = true)]
     Bench(Box<bench::BenchArgs>),
@@ -83,6 +89,7 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(a) => render::run(&a),
+        Command::Batch(a) => batch::run(&a),
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
@@ -104,7 +111,7 @@ pub fn main() -> ExitCode {
 }
 
 /// clap's usage error on one line: its text without the "Usage:" block and the "--help" hint.
-fn clap_error_line(e: &clap::Error) -> String {
+pub(crate) fn clap_error_line(e: &clap::Error) -> String {
     let text = e.to_string();
     let mut parts = Vec::new();
     for line in text.lines() {
@@ -120,12 +127,19 @@ fn clap_error_line(e: &clap::Error) -> String {
 }
 
 /// The error and its causes on one line.
-fn one_line(e: &anyhow::Error) -> String {
+pub(crate) fn one_line(e: &anyhow::Error) -> String {
     format!("{e:#}").replace('\n', "; ")
 }
 
 /// Loads the scene and resolves the render settings; prints the loader's warnings.
 fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
+    let (scene, load_time) = load_only(a)?;
+    let settings = resolve_settings(&scene, a)?;
+    Ok((scene, settings, load_time))
+}
+
+/// Loads the scene (with `--brdf` applied) and prints the loader's warnings.
+fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let mut scene = scene::load_with_options(&a.scene, &a.load_options())?;
     if let Some(kind) = a.brdf {
@@ -135,9 +149,13 @@ fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), 
     for w in &scene.warnings {
         eprintln!("sunshade: warning: {}: {w}", a.scene.display());
     }
-    let settings = settings::resolve_with(&scene, a.width, a.height, &a.camera_options(), &a.light_options())
-        .map_err(|e| CliError::Usage(e.to_string()))?;
-    Ok((scene, settings, load_time))
+    Ok((scene, load_time))
+}
+
+/// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
+fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
+    settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options())
+        .map_err(|e| CliError::Usage(e.to_string()))
 }
 
 /// Refuses an output path whose extension names no supported format, or whose folder does not exist, before any

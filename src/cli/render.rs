@@ -1,15 +1,17 @@
 //! `sunshade render`: the GPU image.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
 use super::diff::{compare_and_report, ToleranceArgs};
-use super::{check_heatmap_path, load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
+use super::session::Session;
+use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
-use crate::film::write_image;
-use crate::gpu::{ContextOptions, Interpolation, Renderer};
+use crate::film::{write_image, Image};
+use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
+use crate::settings::RenderSettings;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -24,6 +26,10 @@ pub struct RenderArgs {
     /// device has shaderFloat64) or f32, or the device's varyings (docs/accuracy.md compares them).
     #[arg(long, value_name = "f64|f32|device")]
     pub interpolation: Option<Interpolation>,
+    /// Do not read or write the pipeline cache on disk ($SUNSHADE_CACHE_DIR, else $XDG_CACHE_HOME/sunshade, else
+    /// ~/.cache/sunshade).
+    #[arg(long)]
+    pub no_cache: bool,
     /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
     /// encode).
     #[arg(short, long)]
@@ -43,32 +49,101 @@ pub struct RenderArgs {
     pub fused_viewport: Option<bool>,
 }
 
+impl RenderArgs {
+    /// Refuses, before any work, flags that cannot be honoured or mean nothing together.
+    pub fn check(&self) -> Result<(), CliError> {
+        self.output.check()?;
+        self.scene.check()?;
+        if !self.check {
+            if let Some(flag) = self.tolerances.given().first() {
+                return Err(CliError::Usage(format!("{flag} applies only with --check")));
+            }
+        }
+        if let Some(h) = &self.heatmap {
+            check_heatmap_path(h)?;
+        }
+        Ok(())
+    }
+}
+
+/// A rendered job, not yet written.
+pub struct Rendered {
+    pub image: Image,
+    pub settings: RenderSettings,
+    pub frame: FrameTimings,
+    pub load: Duration,
+    pub upload: Duration,
+    /// The session's scene and renderer it used.
+    pub scene: usize,
+    pub renderer: usize,
+}
+
+/// Renders one job on the session's renderer for its device: the scene loaded (unless the session has it), the
+/// settings resolved, then the device, the upload (once per scene and renderer) and the frame.
+pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, CliError> {
+    a.check()?;
+    let (scene, load) = session.load(&a.scene)?;
+    let settings = resolve_settings(session.scene_ref(scene), &a.scene)?;
+    let renderer = session.renderer(a.device.clone(), a.interpolation)?;
+    session.renderer_mut(renderer).check_size(settings.width, settings.height)?;
+    let upload = session.upload(scene, renderer)?;
+    let (_, gpu_scene, r) = session.parts(scene, renderer);
+    let (image, frame) = r.render(gpu_scene, &settings)?;
+    warn_if_nothing_covered(&image, &a.scene.scene);
+    Ok(Rendered { image, settings, frame, load, upload, scene, renderer })
+}
+
+/// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
+pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose: bool) -> Result<(), CliError> {
+    let sub_pixel_bits = session.renderer_mut(job.renderer).device_info().sub_pixel_precision_bits;
+    let options =
+        ReferenceOptions { sub_pixel_bits, fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma) };
+    let t = Instant::now();
+    let reference = cpu::render(session.scene_ref(job.scene), &job.settings, &options);
+    if verbose {
+        eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
+    }
+    let report = compare_and_report(
+        &job.image,
+        &reference,
+        ("gpu", "cpu reference"),
+        &a.tolerances.options(),
+        a.heatmap.as_deref(),
+        false,
+    )?;
+    if report.pass {
+        Ok(())
+    } else {
+        Err(CliError::Quiet(1))
+    }
+}
+
+/// The pipeline-cache folder the command line uses: the default one unless `--no-cache`.
+pub fn cache_dir(no_cache: bool) -> Option<std::path::PathBuf> {
+    if no_cache {
+        None
+    } else {
+        pipeline_cache::default_dir()
+    }
+}
+
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
-    a.output.check()?;
-    a.scene.check()?;
-    if !a.check {
-        if let Some(flag) = a.tolerances.given().first() {
-            return Err(CliError::Usage(format!("{flag} applies only with --check")));
-        }
+    a.check()?;
+    let mut session = Session::new(cache_dir(a.no_cache));
+    let job = render_job(&mut session, a)?;
+    let t_cache = Instant::now();
+    for w in session.save_pipeline_caches() {
+        eprintln!("sunshade: warning: pipeline cache not saved: {w}");
     }
-    if let Some(h) = &a.heatmap {
-        check_heatmap_path(h)?;
-    }
-    let (scene, settings, load_time) = load_scene(&a.scene)?;
-    let options =
-        ContextOptions { device: a.device.clone(), interpolation: a.interpolation, ..ContextOptions::from_env() };
-    let mut renderer = Renderer::new(&options)?;
-    renderer.check_size(settings.width, settings.height)?;
-    let t_upload = Instant::now();
-    let gpu_scene = renderer.upload(&scene)?;
-    let upload_time = t_upload.elapsed();
-    let (image, frame) = renderer.render(&gpu_scene, &settings)?;
-    warn_if_nothing_covered(&image, &a.scene.scene);
+    let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
-    let ev = write_image(&image, &a.output.output, a.output.exposure())?;
+    let ev = write_image(&job.image, &a.output.output, a.output.exposure())?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
+        let triangles = session.scene_ref(job.scene).triangle_count();
+        let cache_dir = session.pipeline_cache_dir.clone();
+        let renderer = session.renderer_mut(job.renderer);
         let info = renderer.device_info();
         eprintln!(
             "sunshade: device {}: {} ({}, {} {}); interpolation {}",
@@ -80,49 +155,35 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             renderer.interpolation().name()
         );
         eprintln!(
-            "sunshade: {} triangles, {}x{} pixels, {} covered",
-            scene.triangle_count(),
-            settings.width,
-            settings.height,
-            image.covered_count()
+            "sunshade: {triangles} triangles, {}x{} pixels, {} covered",
+            job.settings.width,
+            job.settings.height,
+            job.image.covered_count()
         );
         print_exposure(ev);
+        match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {
+            (None, _) => eprintln!("sunshade: pipeline cache: off"),
+            (Some(d), 0) => eprintln!("sunshade: pipeline cache: none yet in {}", d.display()),
+            (Some(d), n) => eprintln!("sunshade: pipeline cache: {n} bytes from {}", d.display()),
+        }
         let setup = renderer.setup_timings();
         print_phases(
             &[
-                ("load", load_time),
+                ("load", job.load),
                 ("instance", setup.instance),
                 ("shader compile", setup.shader_compile), // on other threads, during "instance"
-                ("upload", upload_time),
-                ("pipelines", frame.pipelines),
-                ("render", frame.render),
-                ("readback", frame.readback),
+                ("upload", job.upload),
+                ("pipelines", job.frame.pipelines),
+                ("cache save", cache_save),
+                ("render", job.frame.render),
+                ("readback", job.frame.readback),
                 ("encode", encode_time),
             ],
             started.elapsed(),
         );
     }
     if a.check {
-        let options = ReferenceOptions {
-            sub_pixel_bits: renderer.device_info().sub_pixel_precision_bits,
-            fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
-        };
-        let t = Instant::now();
-        let reference = cpu::render(&scene, &settings, &options);
-        if a.verbose {
-            eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
-        }
-        let report = compare_and_report(
-            &image,
-            &reference,
-            ("gpu", "cpu reference"),
-            &a.tolerances.options(),
-            a.heatmap.as_deref(),
-            false,
-        )?;
-        if !report.pass {
-            return Err(CliError::Quiet(1));
-        }
+        check_job(&mut session, a, &job, a.verbose)?;
     }
     Ok(())
 }

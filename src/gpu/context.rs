@@ -60,6 +60,9 @@ pub struct ContextOptions {
     /// Diagnostics only: compile the shaders with the textbook formulas (`pow(cos α, e)`, the device's `log`)
     /// instead of the accurate ones, to measure what those gain (`sunshade bench --brdf-chart`).
     pub naive_math: bool,
+    /// Where the pipeline cache is kept on disk (`None`: in memory only; the CLI passes
+    /// [`super::pipeline_cache::default_dir`] unless `--no-cache`).
+    pub pipeline_cache_dir: Option<std::path::PathBuf>,
 }
 
 impl ContextOptions {

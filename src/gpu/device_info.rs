@@ -32,6 +32,11 @@ pub struct DeviceInfo {
     pub graphics_queue_family: Option<u32>,
     /// Why sunshade cannot use this device, if it cannot.
     pub unusable: Option<String>,
+    /// `vendorID`, `deviceID`, `driverVersion` and `pipelineCacheUUID`: what a pipeline cache is valid for.
+    pub vendor_id: u32,
+    pub device_id: u32,
+    pub driver_version: u32,
+    pub pipeline_cache_uuid: [u8; 16],
 }
 
 impl DeviceInfo {
@@ -103,6 +108,10 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
         };
         DeviceInfo {
             index,
+            vendor_id: props.vendor_id,
+            device_id: props.device_id,
+            driver_version: props.driver_version,
+            pipeline_cache_uuid: props.pipeline_cache_uuid,
             name: text(props.device_name_as_c_str()),
             device_type: props.device_type,
             api_version,

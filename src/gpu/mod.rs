@@ -15,6 +15,7 @@ mod error;
 pub mod layout;
 mod memory;
 mod pipeline;
+pub mod pipeline_cache;
 mod renderer;
 pub mod shaders;
 

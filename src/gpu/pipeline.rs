@@ -8,6 +8,7 @@
 //! double-sided ones).
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::Arc;
 
 use ash::vk;
@@ -15,6 +16,7 @@ use ash::vk;
 use super::context::Device;
 use super::error::{GpuError, VkContext};
 use super::layout::{PushConstants, ShaderVariant, Vertex};
+use super::pipeline_cache::{self, DiskPipelineCache};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -29,15 +31,20 @@ pub(crate) struct ScenePipeline {
     fragment_module: vk::ShaderModule,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
+    cache: Option<DiskPipelineCache>,
+    /// Variants created since the cache was last saved.
+    unsaved: bool,
 }
 
 impl ScenePipeline {
-    /// `with_normals`: the vertex shader also reads the normal (for device interpolation).
+    /// `with_normals`: the vertex shader also reads the normal (for device interpolation). `cache_dir`: where the
+    /// pipeline cache lives on disk (`None`: in memory only).
     pub fn new(
         dev: &Arc<Device>,
         vertex_spirv: &[u32],
         fragment_spirv: &[u32],
         with_normals: bool,
+        cache_dir: Option<&Path>,
     ) -> Result<Self, GpuError> {
         let d = &dev.device;
         let mut out = Self {
@@ -50,6 +57,8 @@ impl ScenePipeline {
             fragment_module: vk::ShaderModule::null(),
             with_normals,
             variants: HashMap::new(),
+            cache: None,
+            unsaved: false,
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
@@ -95,8 +104,25 @@ impl ScenePipeline {
             out.fragment_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None)
                 .vk("vkCreateShaderModule")?;
+            let name =
+                pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&[vertex_spirv, fragment_spirv]));
+            out.cache = Some(DiskPipelineCache::open(d, cache_dir, &name)?);
         }
         Ok(out)
+    }
+
+    /// Bytes of pipeline-cache data loaded from disk at creation.
+    pub fn cache_loaded_bytes(&self) -> usize {
+        self.cache.as_ref().map_or(0, |c| c.loaded_bytes)
+    }
+
+    /// Saves the pipeline cache if variants were created since the last save; `Err` is a message for a warning.
+    pub fn save_cache(&mut self) -> Result<(), String> {
+        if !std::mem::take(&mut self.unsaved) {
+            return Ok(());
+        }
+        // SAFETY: the cache belongs to this device.
+        self.cache.as_ref().map_or(Ok(()), |c| unsafe { c.save(&self.dev.device) })
     }
 
     /// The pipeline of a variant, created on first use. Returns it and whether it was created now.
@@ -104,10 +130,12 @@ impl ScenePipeline {
         if let Some(&p) = self.variants.get(&variant) {
             return Ok((p, false));
         }
-        // SAFETY: valid device, layout and modules owned by self.
+        let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
+        // SAFETY: valid device, layout, modules and cache owned by self.
         let p = unsafe {
             create_pipeline(
                 &self.dev.device,
+                cache,
                 self.layout,
                 self.vertex_module,
                 self.fragment_module,
@@ -116,12 +144,14 @@ impl ScenePipeline {
             )?
         };
         self.variants.insert(variant, p);
+        self.unsaved = true;
         Ok((p, true))
     }
 }
 
 unsafe fn create_pipeline(
     d: &ash::Device,
+    cache: vk::PipelineCache,
     layout: vk::PipelineLayout,
     vs: vk::ShaderModule,
     fs: vk::ShaderModule,
@@ -197,7 +227,7 @@ unsafe fn create_pipeline(
             .dynamic_state(&dynamic)
             .layout(layout)
             .push_next(&mut rendering);
-        let result = d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None);
+        let result = d.create_graphics_pipelines(cache, &[info], None);
         result.map(|p| p[0]).map_err(|(_, result)| GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result })
     }
 }
@@ -216,6 +246,9 @@ impl Drop for ScenePipeline {
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);
+            if let Some(c) = &mut self.cache {
+                c.destroy(d);
+            }
         }
     }
 }

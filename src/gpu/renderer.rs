@@ -109,7 +109,13 @@ impl Renderer {
         };
         let (vs, fs) =
             if interpolation == guess { compiled? } else { compile_stages(interpolation, options.naive_math)? };
-        let pipeline = ScenePipeline::new(&dev, &vs, &fs, interpolation == Interpolation::Device)?;
+        let pipeline = ScenePipeline::new(
+            &dev,
+            &vs,
+            &fs,
+            interpolation == Interpolation::Device,
+            options.pipeline_cache_dir.as_deref(),
+        )?;
         let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
         let renderer = Self {
@@ -136,6 +142,17 @@ impl Renderer {
 
     pub fn setup_timings(&self) -> SetupTimings {
         self.setup
+    }
+
+    /// Bytes of pipeline-cache data read from disk when the renderer was created (0: none, or none valid).
+    pub fn pipeline_cache_loaded_bytes(&self) -> usize {
+        self.pipeline.cache_loaded_bytes()
+    }
+
+    /// Writes the pipeline cache to disk if pipelines were created since the last save (and a cache folder was
+    /// given). A failure does not spoil a render: the message is for a warning.
+    pub fn save_pipeline_cache(&mut self) -> Result<(), String> {
+        self.pipeline.save_cache()
     }
 
     /// The validation layer's messages (empty without validation). Outlives the renderer.

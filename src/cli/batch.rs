@@ -1,0 +1,263 @@
+//! `sunshade batch MANIFEST`: many renders in one process, on one device.
+//!
+//! The manifest is a JSON array of jobs. Each job is an object whose keys are `scene`, `output` and the long names
+//! of `render`'s flags (`{"scene": "a.glb", "output": "a.png", "width": 256, "sun-elevation": 30}`); a job
+//! becomes exactly the argument list of a `render` call (numbers and strings as `--key=value`, `true` as `--key`,
+//! `false` and `null` left out, an array as the flag repeated) and is parsed by `render`'s own parser, so that its
+//! image is bitwise the image `sunshade render` gives for the same flags. What the jobs share is made once: the
+//! device and its pipelines, and each scene's load and upload while jobs reuse it ([`super::session`]). Images are
+//! encoded on `--jobs` threads while the next job renders. A failed job is reported and the batch goes on; the
+//! exit code is 1 when any job failed. `--shard K/N` renders jobs K, K+N, K+2N, … (counting from 0), so that N
+//! machines or processes can split one manifest.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+
+use clap::{Args, Parser};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde_json::Value;
+
+use super::render::{cache_dir, check_job, render_job, RenderArgs};
+use super::session::Session;
+use super::{clap_error_line, one_line, CliError};
+use crate::film::{write_image, Exposure, Image};
+
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// The manifest: a JSON array of jobs, each `{"scene": ..., "output": ..., "<render flag>": value, ...}`.
+    pub manifest: PathBuf,
+    /// Threads that encode and write images while the next job renders.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub jobs: u32,
+    /// Render only every N-th job from K (0 ≤ K < N), to split a manifest over N machines or processes.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<(usize, usize)>,
+    /// Do not read or write the pipeline cache on disk.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `K/N` with 0 ≤ K < N.
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (k, n) = s.split_once('/').ok_or_else(|| format!("'{s}' is not K/N"))?;
+    let (k, n): (usize, usize) = (
+        k.trim().parse().map_err(|_| format!("'{k}' is not a count"))?,
+        n.trim().parse().map_err(|_| format!("'{n}' is not a count"))?,
+    );
+    if n == 0 || k >= n {
+        return Err(format!("'{s}': needs 0 ≤ K < N"));
+    }
+    Ok((k, n))
+}
+
+/// `render`'s parser, for one job's argument list.
+#[derive(Parser, Debug)]
+#[command(name = "render", allow_negative_numbers = true, no_binary_name = true)]
+struct Job {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
+/// A job object → `render`'s argument list. Errors name the key.
+pub fn job_arguments(job: &Value) -> Result<Vec<String>, String> {
+    let object = job.as_object().ok_or("a job must be a JSON object")?;
+    let text = |key: &str| -> Result<String, String> {
+        match object.get(key) {
+            Some(Value::String(s)) => Ok(s.clone()),
+            Some(_) => Err(format!("\"{key}\" must be a string")),
+            None => Err(format!("needs \"{key}\"")),
+        }
+    };
+    let mut argv = vec![text("scene")?, "--output".to_string(), text("output")?];
+    for (key, value) in object {
+        if key == "scene" || key == "output" {
+            continue;
+        }
+        let flag = format!("--{key}");
+        let scalar = |v: &Value| match v {
+            Value::String(s) => Ok(Some(format!("{flag}={s}"))),
+            Value::Number(n) => Ok(Some(format!("{flag}={n}"))),
+            Value::Bool(true) => Ok(Some(flag.clone())),
+            Value::Bool(false) | Value::Null => Ok(None),
+            _ => Err(format!("\"{key}\": a value must be a string, number or boolean")),
+        };
+        match value {
+            Value::Array(items) => {
+                for item in items {
+                    argv.extend(scalar(item)?);
+                }
+            }
+            v => argv.extend(scalar(v)?),
+        }
+    }
+    Ok(argv)
+}
+
+/// The jobs of a manifest, each parsed or the reason it cannot be.
+fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliError> {
+    let fail = |m: String| CliError::Failure(anyhow::anyhow!("{}: {m}", path.display()));
+    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let value: Value = serde_json::from_str(&text).map_err(|e| fail(format!("invalid JSON: {e}")))?;
+    let jobs = value.as_array().ok_or_else(|| fail("the manifest must be a JSON array of jobs".into()))?;
+    Ok(jobs
+        .iter()
+        .map(|job| {
+            let argv = job_arguments(job)?;
+            Job::try_parse_from(&argv).map(|j| j.args).map_err(|e| clap_error_line(&e))
+        })
+        .collect())
+}
+
+/// An image to write, and which job it is.
+struct Encode {
+    job: usize,
+    image: Image,
+    output: PathBuf,
+    exposure: Exposure,
+}
+
+pub fn run(a: &BatchArgs) -> Result<(), CliError> {
+    let jobs = read_manifest(&a.manifest)?;
+    let (k, n) = a.shard.unwrap_or((0, 1));
+    let mine: Vec<usize> = (0..jobs.len()).filter(|i| i % n == k).collect();
+    let bar = if a.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::with_draw_target(Some(mine.len() as u64), ProgressDrawTarget::stderr())
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} jobs, {elapsed} ({eta} left) {msg}")
+            .expect("a valid template"),
+    );
+    let report = |bar: &ProgressBar, job: usize, e: &str| {
+        let output = jobs[job].as_ref().map_or_else(|_| String::new(), |j| format!(" ({})", j.output.output.display()));
+        bar.suspend(|| eprintln!("sunshade batch: job {job}{output}: {e}"));
+    };
+    let mut failed = 0usize;
+    let mut session = Session::new(cache_dir(a.no_cache));
+    let (to_encoders, queue) = mpsc::sync_channel::<Encode>(a.jobs as usize);
+    let queue = std::sync::Mutex::new(queue);
+    std::thread::scope(|scope| {
+        let (done_tx, done) = mpsc::channel::<(usize, Result<(), String>)>();
+        for _ in 0..a.jobs {
+            let (queue, done_tx) = (&queue, done_tx.clone());
+            scope.spawn(move || loop {
+                let Ok(item) = queue.lock().expect("encoder queue").recv() else { break };
+                let result =
+                    write_image(&item.image, &item.output, item.exposure).map(|_| ()).map_err(|e| e.to_string());
+                let _ = done_tx.send((item.job, result));
+            });
+        }
+        drop(done_tx);
+        for &i in &mine {
+            let result = match &jobs[i] {
+                Err(e) => Err(e.clone()),
+                Ok(args) => render_job(&mut session, args)
+                    .and_then(|job| {
+                        if args.check {
+                            check_job(&mut session, args, &job, false)?;
+                        }
+                        Ok(job)
+                    })
+                    .map_err(|e| match e {
+                        CliError::Usage(m) => m,
+                        CliError::Failure(e) => one_line(&e),
+                        CliError::Quiet(_) => "outside tolerance (report above)".into(),
+                    }),
+            };
+            match result {
+                Ok(job) => {
+                    let args = jobs[i].as_ref().expect("rendered");
+                    let item = Encode {
+                        job: i,
+                        image: job.image,
+                        output: args.output.output.clone(),
+                        exposure: args.output.exposure(),
+                    };
+                    to_encoders.send(item).expect("encoder threads alive");
+                }
+                Err(e) => {
+                    failed += 1;
+                    report(&bar, i, &e);
+                    bar.inc(1);
+                }
+            }
+            while let Ok((job, r)) = done.try_recv() {
+                if let Err(e) = r {
+                    failed += 1;
+                    report(&bar, job, &e);
+                }
+                bar.inc(1);
+            }
+        }
+        drop(to_encoders);
+        for (job, r) in done.iter() {
+            if let Err(e) = r {
+                failed += 1;
+                report(&bar, job, &e);
+            }
+            bar.inc(1);
+        }
+    });
+    for w in session.save_pipeline_caches() {
+        bar.suspend(|| eprintln!("sunshade batch: warning: pipeline cache not saved: {w}"));
+    }
+    bar.finish_and_clear();
+    if !a.quiet {
+        eprintln!(
+            "sunshade batch: {} of {} jobs rendered, {failed} failed{}",
+            mine.len() - failed,
+            mine.len(),
+            match a.shard {
+                Some((k, n)) => format!(" (shard {k}/{n} of {} jobs)", jobs.len()),
+                None => String::new(),
+            }
+        );
+    }
+    if failed > 0 {
+        return Err(CliError::Failure(anyhow::anyhow!("{failed} of {} jobs failed", mine.len())));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn jobs_become_render_arguments() {
+        let argv = job_arguments(&json!({
+            "scene": "a.glb", "output": "a.png", "width": 256, "sun-elevation": -3.5,
+            "check": true, "no-cache": false, "disk-light": ["0,1,0:0,-1,0:1:5", "0,2,0:0,-1,0:1:5"]
+        }))
+        .unwrap();
+        assert_eq!(&argv[..3], ["a.glb", "--output", "a.png"]);
+        for a in [
+            "--width=256",
+            "--sun-elevation=-3.5",
+            "--check",
+            "--disk-light=0,1,0:0,-1,0:1:5",
+            "--disk-light=0,2,0:0,-1,0:1:5",
+        ] {
+            assert!(argv.contains(&a.to_string()), "{a} missing from {argv:?}");
+        }
+        assert!(!argv.iter().any(|a| a.contains("no-cache")));
+        let parsed = Job::try_parse_from(&argv).unwrap().args;
+        assert_eq!((parsed.scene.width, parsed.scene.sun_elevation, parsed.check), (256, Some(-3.5), true));
+        assert!(job_arguments(&json!({ "output": "a.png" })).unwrap_err().contains("scene"));
+        assert!(job_arguments(&json!({ "scene": "a", "output": "b.png", "width": { "x": 1 } })).is_err());
+        assert!(Job::try_parse_from(job_arguments(&json!({ "scene": "a", "output": "b.png", "nope": 1 })).unwrap())
+            .is_err());
+    }
+
+    #[test]
+    fn shards() {
+        assert_eq!(parse_shard("0/3"), Ok((0, 3)));
+        assert_eq!(parse_shard("2/3"), Ok((2, 3)));
+        assert!(parse_shard("3/3").is_err() && parse_shard("1/0").is_err() && parse_shard("x").is_err());
+    }
+}
