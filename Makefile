@@ -16,11 +16,11 @@ render: build
 
 # Every test (unit, GPU on lavapipe with validation layers, CPU reference, CLI).
 test: setup
-	$(CARGO) test --release
+	$(CARGO) test --release --workspace
 
 lint:
-	$(CARGO) fmt --check
-	$(CARGO) clippy --all-targets -- -D warnings
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
 # Regenerates the measured figures in README.md and docs/accuracy.md (on this machine; the tables name it).
 bench: build

@@ -3,9 +3,13 @@
 //!
 //! Data flows one way: glTF file → [`scene`] (world units) → [`shading`] (radiometry and BRDFs; the GLSL in
 //! `shaders/` mirrors it) → two renderers, [`gpu`] (Vulkan) and `cpu` (the reference), both producing a
-//! [`film::Image`] of radiance in W/(m²·sr) → `compare` → the command line.
+//! [`film::Image`] of radiance in W/(m²·sr) → `compare` → the command line. [`testing`] serves users' own image
+//! tests.
 
 pub mod authoring;
+/// The command line (`sunshade` binary). Not public API: its items may change at any time; use [`testing`] and
+/// the renderers from a program.
+#[doc(hidden)]
 pub mod cli;
 pub mod compare;
 pub mod cpu;
@@ -14,5 +18,6 @@ pub mod gpu;
 pub mod scene;
 pub mod settings;
 pub mod shading;
+pub mod testing;
 
 pub use film::Image;

@@ -11,7 +11,7 @@ mod diff;
 mod generated;
 mod info;
 mod reference;
-mod render;
+pub(crate) mod render;
 mod session;
 
 use std::process::ExitCode;
@@ -139,7 +139,7 @@ fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), 
 }
 
 /// Loads the scene (with `--brdf` applied) and prints the loader's warnings.
-fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
+pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
     let t = Instant::now();
     let mut scene = scene::load_with_options(&a.scene, &a.load_options())?;
     if let Some(kind) = a.brdf {
@@ -153,7 +153,7 @@ fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
 }
 
 /// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
-fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
+pub(crate) fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
     settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options())
         .map_err(|e| CliError::Usage(e.to_string()))
 }

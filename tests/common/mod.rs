@@ -3,12 +3,9 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use sunshade::authoring::GltfBuilder;
-use sunshade::gpu::{ContextOptions, Renderer, ValidationLog};
 use sunshade::scene::Scene;
-use sunshade::settings::RenderSettings;
 use sunshade::Image;
 
 /// A fresh directory under the system temp dir, removed when dropped.
@@ -53,55 +50,8 @@ impl Drop for TempDir {
     }
 }
 
-/// A renderer with the validation layer on. Any validation message fails the test: after each render, and when
-/// the renderer is dropped (messages about objects left alive arrive then).
-pub struct CheckedRenderer {
-    renderer: Option<Renderer>,
-    log: Arc<ValidationLog>,
-}
-
-impl CheckedRenderer {
-    pub fn new() -> Self {
-        let renderer = Renderer::new(&ContextOptions { validation: true, ..Default::default() })
-            .unwrap_or_else(|e| panic!("GPU tests need Vulkan with validation layers (make setup): {e}"));
-        let log = renderer.validation_log();
-        Self { renderer: Some(renderer), log }
-    }
-
-    pub fn renderer(&mut self) -> &mut Renderer {
-        self.renderer.as_mut().expect("alive")
-    }
-
-    pub fn render(&mut self, scene: &Scene, settings: &RenderSettings) -> Image {
-        let (image, _) = self.renderer().render_scene(scene, settings).unwrap_or_else(|e| panic!("render failed: {e}"));
-        assert_no_validation_messages(&self.log);
-        image
-    }
-
-    pub fn sub_pixel_bits(&self) -> u32 {
-        self.renderer.as_ref().expect("alive").device_info().sub_pixel_precision_bits
-    }
-}
-
-impl Default for CheckedRenderer {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Drop for CheckedRenderer {
-    fn drop(&mut self) {
-        drop(self.renderer.take());
-        if !std::thread::panicking() {
-            assert_no_validation_messages(&self.log);
-        }
-    }
-}
-
-pub fn assert_no_validation_messages(log: &ValidationLog) {
-    let messages = log.messages();
-    assert!(messages.is_empty(), "{} validation message(s):\n{}", messages.len(), messages.join("\n"));
-}
+#[allow(unused_imports)]
+pub use sunshade::testing::{assert_no_validation_messages, CheckedRenderer};
 
 /// Relative difference |a − b| / |b| (0 when both are 0).
 pub fn rel(a: f64, b: f64) -> f64 {
