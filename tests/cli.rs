@@ -371,3 +371,63 @@ fn batch_renders_like_render_goes_on_after_a_failure_and_shards() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("jobs.json") && stderr(&o).contains("array"), "{}", stderr(&o));
 }
+
+#[test]
+fn test_suites_fail_on_missing_goldens_update_them_and_report() {
+    let dir = TempDir::new("suite");
+    dir.write("scene.glb", &scene());
+    let suite = dir.path("suite.json");
+    let cases = json!({
+        "tolerances": { "fail-count": 0 },
+        "cases": [
+            { "name": "golden", "scene": "scene.glb", "width": 32, "height": 24, "golden": "goldens/a.exr" },
+            { "name": "ref", "scene": "scene.glb", "width": 32, "height": 24, "sun-elevation": 20, "golden": "reference" },
+            { "name": "strict", "scene": "scene.glb", "width": 32, "height": 24, "golden": "goldens/b.exr",
+              "tolerances": { "fail-rel": 1e-6 } }
+        ]
+    });
+    std::fs::write(&suite, cases.to_string()).unwrap();
+    std::fs::create_dir(dir.path("goldens")).unwrap();
+    // Missing goldens fail (never a silent pass).
+    let o = sunshade(&["test", s(&suite)]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{out}{}", stderr(&o));
+    assert!(out.contains("FAIL golden") && out.contains("missing") && out.contains("PASS ref"), "{out}");
+    assert!(out.contains("1 passed, 2 failed"), "{out}");
+    let o = sunshade(&["test", s(&suite), "--update"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("UPDATED golden"));
+    let o = sunshade(&["test", s(&suite), "--junit", s(&dir.path("j.xml")), "--report", s(&dir.path("report"))]);
+    assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("3 passed, 0 failed"));
+    let xml = std::fs::read_to_string(dir.path("j.xml")).unwrap();
+    assert!(xml.contains("tests=\"3\" failures=\"0\" errors=\"0\"") && xml.contains("name=\"strict\""), "{xml}");
+    let html = std::fs::read_to_string(dir.path("report/index.html")).unwrap();
+    for f in ["golden.expected.png", "golden.actual.png", "golden.heatmap.png", "ref.expected.png"] {
+        assert!(html.contains(f) && dir.path("report").join(f).exists(), "{f}");
+    }
+    // A changed image fails, and leaves the actual image and heatmap in the report folder.
+    let other = dir.path("goldens/a.exr");
+    let o = sunshade(&[
+        "render",
+        s(&dir.path("scene.glb")),
+        "-o",
+        s(&other),
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--sun-elevation",
+        "60",
+    ]);
+    assert!(o.status.success());
+    let o = sunshade(&["test", s(&suite), "--report", s(&dir.path("report")), "--junit", s(&dir.path("j.xml"))]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(out.contains("FAIL golden") && out.contains("px over tolerance"), "{out}");
+    assert!(dir.path("report/golden.actual.exr").exists() && dir.path("report/golden.heatmap.png").exists());
+    assert!(std::fs::read_to_string(dir.path("j.xml")).unwrap().contains("failures=\"1\""));
+    // Shards: 1/3 runs only "ref".
+    let o = sunshade(&["test", s(&suite), "--shard", "1/3"]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success() && out.contains("PASS ref") && !out.contains("golden"), "{out}");
+}

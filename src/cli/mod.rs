@@ -13,6 +13,7 @@ mod info;
 mod reference;
 pub(crate) mod render;
 mod session;
+mod suite;
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -50,6 +51,10 @@ enum Command {
     /// they are reused, pipelines created once, images encoded in parallel.
     #[command(allow_negative_numbers = true)]
     Batch(batch::BatchArgs),
+    /// Golden-image tests from a suite file: each case rendered and compared with its golden or the CPU
+    /// reference; JUnit XML and an HTML report on request; exit 1 when any case fails.
+    #[command(allow_negative_numbers = true)]
+    Test(suite::TestArgs),
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     #[command(allow_negative_numbers = true)]
     Bench(Box<bench::BenchArgs>),
@@ -90,6 +95,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(a) => render::run(&a),
         Command::Batch(a) => batch::run(&a),
+        Command::Test(a) => suite::run(&a),
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
@@ -178,7 +184,7 @@ fn check_heatmap_path(path: &std::path::Path) -> Result<(), CliError> {
     check_folder_exists(path)
 }
 
-fn check_folder_exists(path: &std::path::Path) -> Result<(), CliError> {
+pub(crate) fn check_folder_exists(path: &std::path::Path) -> Result<(), CliError> {
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => std::path::Path::new("."),
