@@ -431,3 +431,42 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(o.status.success() && out.contains("PASS ref") && !out.contains("golden"), "{out}");
 }
+
+#[test]
+fn diff_warns_allows_percentages_hard_fails_and_writes_the_difference_image() {
+    let dir = TempDir::new("diff-levels");
+    let mut a = sunshade::Image::new(10, 10);
+    a.pixels_mut().iter_mut().for_each(|p| *p = [1.0, 1.0, 1.0, 1.0]);
+    let mut b = a.clone();
+    for x in 0..10 {
+        b.set(x, 1, [1.01, 1.0, 1.0, 1.0]);
+    }
+    b.set(0, 0, [1.5, 1.0, 1.0, 1.0]);
+    b.set(9, 9, [0.0, 0.0, 0.0, 0.0]);
+    let (pa, pb) = (dir.path("a.exr"), dir.path("b.exr"));
+    sunshade::film::write_image(&a, &pa, sunshade::film::Exposure::Auto).unwrap();
+    sunshade::film::write_image(&b, &pb, sunshade::film::Exposure::Auto).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["diff", s(&pa), s(&pb), "--fail-coverage", "1"];
+        args.extend_from_slice(extra);
+        let o = sunshade(&args);
+        (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned())
+    };
+    assert_eq!(run(&["--fail-rel", "1e-3"]).0, Some(1));
+    let (code, out) = run(&["--fail-rel", "1e-3", "--fail-percent", "12"]);
+    assert!(code == Some(0) && out.contains("allowed 11"), "{out}");
+    let (code, out) = run(&["--fail-rel", "1e-3", "--fail-percent", "12", "--hard-fail", "0.2"]);
+    assert!(code == Some(1) && out.contains("over hard fail (rel > 2e-1): 1"), "{out}");
+    let (code, out) = run(&["--fail-rel", "0.5", "--warn-rel", "1e-3"]);
+    assert!(
+        code == Some(0) && out.contains("result: WARN") && out.contains("over warn level (rel > 1e-3): 11"),
+        "{out}"
+    );
+    let d = dir.path("d.exr");
+    let (code, _) = run(&["--fail-rel", "0.5", "-o", s(&d)]);
+    assert_eq!(code, Some(0));
+    let diff = sunshade::film::read_image(&d).unwrap();
+    assert_eq!(diff.get(0, 0), [0.5, 0.0, 0.0, 0.0]);
+    assert_eq!(diff.get(9, 9), [1.0, 1.0, 1.0, 1.0], "a coverage mismatch shows in alpha");
+    assert_eq!(run(&["-o", s(&dir.path("d.png"))]).0, Some(2));
+}

@@ -27,6 +27,20 @@ pub struct ToleranceArgs {
     /// Pixels allowed over tolerance [default: 0].
     #[arg(long, value_name = "N")]
     pub fail_count: Option<usize>,
+    /// Pixels allowed over tolerance as a percentage of the compared pixels (the larger of this and
+    /// --fail-count wins).
+    #[arg(long, value_parser = parse_non_negative, value_name = "PERCENT")]
+    pub fail_percent: Option<f64>,
+    /// Fail when any one pixel's relative error exceeds this, whatever --fail-count and --fail-percent allow.
+    #[arg(long, value_parser = parse_non_negative, value_name = "REL")]
+    pub hard_fail: Option<f64>,
+    /// Warn level: count the pixels over this relative error (and --warn-abs, if given); a comparison that passes
+    /// with such pixels reports WARN (exit 0).
+    #[arg(long, value_parser = parse_non_negative, value_name = "REL")]
+    pub warn_rel: Option<f64>,
+    /// Warn level, absolute [W/(m²·sr)].
+    #[arg(long, value_parser = parse_non_negative, value_name = "ABS")]
+    pub warn_abs: Option<f64>,
     /// Pixels allowed to differ in coverage (alpha) [default: 0].
     #[arg(long, value_name = "N")]
     pub fail_coverage: Option<usize>,
@@ -52,7 +66,11 @@ impl ToleranceArgs {
             fail_abs: self.fail_abs,
             fail_peak,
             fail_count: self.fail_count.unwrap_or(defaults.fail_count),
+            fail_percent: self.fail_percent,
             fail_coverage: self.fail_coverage.unwrap_or(defaults.fail_coverage),
+            hard_fail: self.hard_fail,
+            warn_rel: self.warn_rel,
+            warn_abs: self.warn_abs,
         }
     }
 
@@ -63,6 +81,10 @@ impl ToleranceArgs {
             ("--fail-abs", self.fail_abs.is_some()),
             ("--fail-peak", self.fail_peak.is_some()),
             ("--fail-count", self.fail_count.is_some()),
+            ("--fail-percent", self.fail_percent.is_some()),
+            ("--hard-fail", self.hard_fail.is_some()),
+            ("--warn-rel", self.warn_rel.is_some()),
+            ("--warn-abs", self.warn_abs.is_some()),
             ("--fail-coverage", self.fail_coverage.is_some()),
             ("--floor", self.floor.is_some()),
             ("--floor-fraction", self.floor_fraction.is_some()),
@@ -81,9 +103,13 @@ pub struct DiffCommand {
     pub b: PathBuf,
     #[command(flatten)]
     pub tolerances: ToleranceArgs,
-    /// Write a false-colour PNG of log10 relative error (coverage mismatches in magenta), with a legend.
+    /// Write a false-colour PNG of log10 relative error (viridis; coverage mismatches white), with a legend.
     #[arg(long, value_name = "PNG")]
     pub heatmap: Option<PathBuf>,
+    /// Write the difference image: |A − B| per channel, alpha included (so coverage mismatches show as alpha 1),
+    /// the same size, as .exr or .pfm.
+    #[arg(short, long, value_name = "EXR|PFM")]
+    pub output: Option<PathBuf>,
     /// Print the metrics as JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -129,6 +155,12 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     if let Some(h) = &a.heatmap {
         super::check_heatmap_path(h)?;
     }
+    if let Some(o) = &a.output {
+        super::check_output_path(o)?;
+        if ImageFormat::from_path(o) == Some(ImageFormat::Png) {
+            return Err(CliError::Usage(format!("{}: the difference image is float (use .exr or .pfm)", o.display())));
+        }
+    }
     let read = |p: &PathBuf| read_image(p).map_err(|e| CliError::Usage(e.to_string()));
     let (mut ia, mut ib) = (read(&a.a)?, read(&a.b)?);
     if fa == ImageFormat::Pfm || fb == ImageFormat::Pfm {
@@ -138,6 +170,11 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
             img.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
         }
         eprintln!("sunshade diff: note: a PFM has no alpha; every pixel is compared, without coverage");
+    }
+    if let Some(o) = &a.output {
+        let d = compare::difference_image(&ia, &ib)
+            .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", a.a.display(), a.b.display())))?;
+        crate::film::write_image(&d, o, crate::film::Exposure::Ev(0.0))?;
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
     let report =

@@ -1,7 +1,9 @@
 //! A false-colour picture of a comparison, with a legend.
 //!
-//! Each pixel shows `log10` of its relative error on a colour scale from 1e-10 (dark blue) to 1 (dark red);
-//! exact pixels are black, coverage mismatches magenta, pixels covered in neither image dark grey. The legend
+//! Each pixel shows `log10` of its relative error on the viridis scale (van der Walt & Smith, matplotlib 2015:
+//! perceptually uniform, lightness rising monotonically, readable with the common colour-vision deficiencies and
+//! in grey) from 1e-10 (dark purple) to 1 (yellow); exact pixels are black, coverage mismatches white, pixels
+//! covered in neither image dark grey. The legend
 //! below the picture carries the scale, its labels and the three special colours. The text is drawn with a
 //! built-in 3×5 pixel font, so no font file is needed.
 
@@ -12,28 +14,33 @@ pub const LOG_MIN: f64 = -10.0;
 pub const LOG_MAX: f64 = 0.0;
 
 const EXACT: [u8; 3] = [0, 0, 0];
-const MISMATCH: [u8; 3] = [255, 0, 255];
+const MISMATCH: [u8; 3] = [255, 255, 255];
 const EMPTY: [u8; 3] = [40, 40, 40];
 const BACKGROUND: [u8; 3] = [255, 255, 255];
+/// Around the picture, so that white coverage mismatches at its border stay visible.
+const FRAME: [u8; 3] = [128, 128, 128];
 const INK: [u8; 3] = [0, 0, 0];
 const LEGEND_HEIGHT: u32 = 44;
 const MIN_WIDTH: u32 = 360;
 
-/// Colour of a value `t` in [0, 1] on a blue → cyan → green → yellow → red scale.
+/// Colour of a value `t` in [0, 1] on the viridis scale, interpolated linearly between nine of its samples.
 pub fn colour_scale(t: f64) -> [u8; 3] {
-    const STOPS: [[f64; 3]; 6] = [
-        [0.10, 0.05, 0.45],
-        [0.10, 0.45, 0.90],
-        [0.15, 0.80, 0.75],
-        [0.45, 0.85, 0.20],
-        [0.98, 0.85, 0.10],
-        [0.80, 0.05, 0.05],
+    const STOPS: [[f64; 3]; 9] = [
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
     ];
     let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) } * (STOPS.len() - 1) as f64;
     let i = (t.floor() as usize).min(STOPS.len() - 2);
     let f = t - i as f64;
     let c: [f64; 3] = std::array::from_fn(|k| STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f);
-    c.map(|v| (v * 255.0).round() as u8)
+    c.map(|v| v.round() as u8)
 }
 
 fn pixel_colour(d: &PixelDiff) -> [u8; 3] {
@@ -51,6 +58,7 @@ pub fn heatmap(width: u32, height: u32, diffs: &[PixelDiff]) -> (u32, u32, Vec<u
     let out_h = height + LEGEND_HEIGHT;
     let mut canvas = Canvas { w: out_w, h: out_h, px: vec![255; (out_w * out_h * 3) as usize] };
     canvas.fill(0, 0, out_w, height, BACKGROUND);
+    canvas.fill(width, 0, out_w - width, height, FRAME);
     for y in 0..height {
         for x in 0..width {
             canvas.put(x, y, pixel_colour(&diffs[(y * width + x) as usize]));
@@ -74,6 +82,7 @@ pub fn heatmap(width: u32, height: u32, diffs: &[PixelDiff]) -> (u32, u32, Vec<u
     let y2 = top + 24;
     let mut x = bar_x;
     for (colour, name) in [(EXACT, "exact"), (MISMATCH, "coverage"), (EMPTY, "uncovered")] {
+        canvas.fill(x - 1, y2 - 1, 12, 12, INK);
         canvas.fill(x, y2, 10, 10, colour);
         canvas.text(x + 13, y2 + 2, name);
         x += 13 + text_width(name) + 12;
@@ -184,6 +193,27 @@ mod tests {
         assert_ne!(colour_scale(0.0), colour_scale(1.0));
         // The legend draws the colour bar under the picture.
         assert_eq!(at(8, 2 + 4), colour_scale(0.0));
+    }
+
+    #[test]
+    fn the_scale_brightens_monotonically_so_it_reads_without_hue() {
+        // Relative luminance (Rec. 709 weights on sRGB-decoded channels) must rise along the scale: then the
+        // order of errors survives colour-vision deficiencies and greyscale printing.
+        let decode = |c: u8| {
+            let v = c as f64 / 255.0;
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        let luminance = |[r, g, b]: [u8; 3]| 0.2126 * decode(r) + 0.7152 * decode(g) + 0.0722 * decode(b);
+        let samples: Vec<f64> = (0..=64).map(|i| luminance(colour_scale(i as f64 / 64.0))).collect();
+        assert!(samples.windows(2).all(|w| w[1] > w[0]), "{samples:?}");
+        // The special colours stand apart from every colour of the scale.
+        for special in [EXACT, MISMATCH, EMPTY] {
+            assert!((0..=64).all(|i| colour_scale(i as f64 / 64.0) != special));
+        }
     }
 
     #[test]

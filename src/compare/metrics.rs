@@ -51,8 +51,16 @@ pub struct DiffOptions {
     pub fail_peak: Option<f64>,
     /// Pixels allowed over tolerance.
     pub fail_count: usize,
+    /// Pixels allowed over tolerance as a percentage of the compared pixels (the larger allowance wins).
+    pub fail_percent: Option<f64>,
     /// Pixels allowed to differ in coverage.
     pub fail_coverage: usize,
+    /// Any pixel over this relative error fails the comparison, whatever the counts allow.
+    pub hard_fail: Option<f64>,
+    /// Warn level: pixels over this relative error (and `warn_abs`, if given) are counted and reported; a
+    /// comparison that passes with such pixels is a WARN (still a pass).
+    pub warn_rel: Option<f64>,
+    pub warn_abs: Option<f64>,
 }
 
 impl Default for DiffOptions {
@@ -64,7 +72,11 @@ impl Default for DiffOptions {
             fail_abs: None,
             fail_peak: Some(F32_SHADING_PEAK_FRACTION),
             fail_count: 0,
+            fail_percent: None,
             fail_coverage: 0,
+            hard_fail: None,
+            warn_rel: None,
+            warn_abs: None,
         }
     }
 }
@@ -119,9 +131,17 @@ pub struct DiffReport {
     /// The floor used in the relative error [W/(m²·sr)].
     pub floor: f64,
     pub over_tolerance: Split,
+    /// Pixels over the warn level.
+    pub over_warn: Split,
+    /// Pixels over `hard_fail`.
+    pub hard_failures: usize,
+    /// Pixels allowed over tolerance: `fail_count`, or `fail_percent` of the compared pixels if that is more.
+    pub allowed_over: usize,
     pub worst: Option<WorstPixel>,
     pub options: DiffOptions,
     pub pass: bool,
+    /// Passed with pixels over the warn level.
+    pub warn: bool,
 }
 
 /// Per-pixel results, for the heatmap.
@@ -176,9 +196,13 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
         peak,
         floor,
         over_tolerance: Split::default(),
+        over_warn: Split::default(),
+        hard_failures: 0,
+        allowed_over: options.fail_count,
         worst: None,
         options: *options,
         pass: true,
+        warn: false,
     };
     let mut per_pixel = Vec::with_capacity((w * h) as usize);
     let mut sum_sq = 0.0;
@@ -233,6 +257,14 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
             if over {
                 report.over_tolerance.add(edge);
             }
+            let warn_checks = [options.warn_rel.map(|t| rel > t), options.warn_abs.map(|t| abs > t)];
+            let mut warn_given = warn_checks.iter().flatten().peekable();
+            if warn_given.peek().is_some() && warn_given.all(|&over| over) {
+                report.over_warn.add(edge);
+            }
+            if options.hard_fail.is_some_and(|h| rel > h) {
+                report.hard_failures += 1;
+            }
             per_pixel.push(PixelDiff::Relative(rel));
         }
     }
@@ -240,8 +272,14 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
         report.rmse = (sum_sq / (3 * report.compared) as f64).sqrt();
         report.psnr_db = if report.rmse > 0.0 { 20.0 * (peak / report.rmse).log10() } else { f64::INFINITY };
     }
-    report.pass =
-        report.over_tolerance.total <= options.fail_count && report.coverage_mismatches.total <= options.fail_coverage;
+    if let Some(p) = options.fail_percent {
+        // Rounded down: 0.1% of 999 pixels allows none.
+        report.allowed_over = report.allowed_over.max((p / 100.0 * report.compared as f64).floor() as usize);
+    }
+    report.pass = report.over_tolerance.total <= report.allowed_over
+        && report.coverage_mismatches.total <= options.fail_coverage
+        && report.hard_failures == 0;
+    report.warn = report.pass && report.over_warn.total > 0;
     Ok((report, per_pixel))
 }
 
@@ -277,15 +315,30 @@ impl DiffReport {
         s += &format!("RMSE: {:.3e} W/(m²·sr), PSNR: {:.1} dB (peak {:.4e})\n", self.rmse, self.psnr_db, self.peak);
         s += &format!(
             "over tolerance ({tol}): {} (edge {}, interior {}; allowed {})\n",
-            self.over_tolerance.total, self.over_tolerance.edge, self.over_tolerance.interior, self.options.fail_count
+            self.over_tolerance.total, self.over_tolerance.edge, self.over_tolerance.interior, self.allowed_over
         );
+        if o.warn_rel.is_some() || o.warn_abs.is_some() {
+            let level: Vec<String> =
+                [o.warn_rel.map(|r| format!("rel > {r:e}")), o.warn_abs.map(|a| format!("abs > {a:e}"))]
+                    .into_iter()
+                    .flatten()
+                    .collect();
+            s += &format!("over warn level ({}): {}\n", level.join(" and "), self.over_warn.total);
+        }
+        if let Some(h) = o.hard_fail {
+            s += &format!("over hard fail (rel > {h:e}): {}\n", self.hard_failures);
+        }
         if let Some(wp) = &self.worst {
             s += &format!(
                 "worst pixel: ({}, {}) rel {:.3e} abs {:.3e}\n  A = [{:e}, {:e}, {:e}, {}]\n  B = [{:e}, {:e}, {:e}, {}]\n",
                 wp.x, wp.y, wp.rel, wp.abs, wp.a[0], wp.a[1], wp.a[2], wp.a[3], wp.b[0], wp.b[1], wp.b[2], wp.b[3]
             );
         }
-        s += if self.pass { "result: PASS\n" } else { "result: FAIL\n" };
+        s += match (self.pass, self.warn) {
+            (true, false) => "result: PASS\n",
+            (true, true) => "result: WARN\n",
+            (false, _) => "result: FAIL\n",
+        };
         s
     }
 
@@ -302,8 +355,17 @@ impl DiffReport {
             "rmse": finite(self.rmse), "psnr_db": finite(self.psnr_db), "peak": finite(self.peak), "floor": finite(self.floor),
             "over_tolerance": { "total": self.over_tolerance.total, "edge": self.over_tolerance.edge, "interior": self.over_tolerance.interior },
             "worst": self.worst.map(|w| json!({ "x": w.x, "y": w.y, "a": w.a, "b": w.b, "rel": finite(w.rel), "abs": finite(w.abs) })),
-            "tolerances": { "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_peak": self.options.fail_peak, "fail_count": self.options.fail_count, "fail_coverage": self.options.fail_coverage },
+            "over_warn": { "total": self.over_warn.total, "edge": self.over_warn.edge, "interior": self.over_warn.interior },
+            "hard_failures": self.hard_failures,
+            "allowed_over": self.allowed_over,
+            "tolerances": {
+                "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_peak": self.options.fail_peak,
+                "fail_count": self.options.fail_count, "fail_percent": self.options.fail_percent,
+                "fail_coverage": self.options.fail_coverage, "hard_fail": self.options.hard_fail,
+                "warn_rel": self.options.warn_rel, "warn_abs": self.options.warn_abs
+            },
             "pass": self.pass,
+            "warn": self.warn,
         })
     }
 }
@@ -365,6 +427,29 @@ mod tests {
         assert!(!run(None, Some(1e-3)));
         assert!(run(Some(1e-3), Some(0.1)), "within the absolute tolerance");
         assert!(run(Some(0.1), Some(1e-3)), "within the relative tolerance");
+    }
+
+    #[test]
+    fn warn_level_percentages_and_hard_fail() {
+        // 100 pixels at 1, ten of them 1% off, one 50% off.
+        let a = img(10, 10, |_, _| [1.0, 1.0, 1.0, 1.0]);
+        let b = img(10, 10, |x, y| match (x, y) {
+            (0, 0) => [1.5, 1.0, 1.0, 1.0],
+            (_, 1) => [1.01, 1.0, 1.0, 1.0],
+            _ => [1.0, 1.0, 1.0, 1.0],
+        });
+        let run = |o: DiffOptions| diff(&a, &b, &o).unwrap().0;
+        let base = DiffOptions { fail_rel: Some(1e-3), fail_peak: None, ..Default::default() };
+        assert!(!run(base).pass);
+        let r = run(DiffOptions { fail_percent: Some(11.0), ..base });
+        assert!(r.pass && r.allowed_over == 11, "{r:?}");
+        assert!(!run(DiffOptions { fail_percent: Some(10.9), ..base }).pass);
+        let r = run(DiffOptions { fail_percent: Some(11.0), hard_fail: Some(0.3), ..base });
+        assert!(!r.pass && r.hard_failures == 1, "{r:?}");
+        let r = run(DiffOptions { fail_rel: Some(0.4), warn_rel: Some(1e-3), ..base });
+        assert!(r.pass && r.warn && r.over_warn.total == 11 && r.text("a", "b").contains("result: WARN"), "{r:?}");
+        let r = run(DiffOptions { fail_rel: Some(0.4), warn_rel: Some(0.4), ..base });
+        assert!(r.pass && !r.warn);
     }
 
     #[test]
