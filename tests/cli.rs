@@ -470,3 +470,39 @@ fn diff_warns_allows_percentages_hard_fails_and_writes_the_difference_image() {
     assert_eq!(diff.get(9, 9), [1.0, 1.0, 1.0, 1.0], "a coverage mismatch shows in alpha");
     assert_eq!(run(&["-o", s(&dir.path("d.png"))]).0, Some(2));
 }
+
+#[test]
+fn outputs_record_camera_lights_and_settings() {
+    let dir = TempDir::new("metadata");
+    let input = dir.write("scene.glb", &scene());
+    let exr = dir.path("m.exr");
+    let o = sunshade(&["render", s(&input), "-o", s(&exr), "--width", "64", "--height", "48", "--sky-radiance", "300"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+    let layer = &meta.headers[0].own_attributes;
+    let text = |k: &str| match layer.other.get(&exr::prelude::Text::from(k)) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => t.to_string(),
+        other => panic!("{k}: {other:?}"),
+    };
+    let settings: serde_json::Value = serde_json::from_str(&text("sunshadeSettings")).unwrap();
+    assert_eq!((settings["width"].as_u64(), settings["height"].as_u64()), (Some(64), Some(48)));
+    assert!(settings["renderer"].as_str().unwrap().starts_with("gpu: "), "{settings}");
+    let lights: serde_json::Value = serde_json::from_str(&text("sunshadeLights")).unwrap();
+    assert_eq!(lights["sky_radiance"], json!([300.0, 300.0, 300.0]));
+    assert!(text("sunshadeQuantity").contains("W/(m2 sr)"));
+    // worldToNDC (Imath: row vectors) takes a point straight ahead of the eye to the centre of the image.
+    let m = layer.world_to_normalized_device.expect("worldToNDC");
+    let eye: Vec<f64> = settings["camera"]["eye"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let fwd: Vec<f64> = settings["camera"]["forward"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let p: Vec<f64> = (0..3).map(|i| eye[i] + 2.0 * fwd[i]).chain([1.0]).collect();
+    let clip: Vec<f64> = (0..4).map(|c| (0..4).map(|r| p[r] * m[r * 4 + c] as f64).sum()).collect();
+    assert!((clip[0] / clip[3]).abs() < 1e-5 && (clip[1] / clip[3]).abs() < 1e-5, "{clip:?}");
+    assert!(layer.world_to_camera.is_some());
+    // The PNG carries the same settings as text.
+    let png = dir.path("m.png");
+    let o = sunshade(&["reference", s(&input), "-o", s(&png), "--width", "64", "--height", "48"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap())).read_info().unwrap();
+    let chunk = reader.info().uncompressed_latin1_text.iter().find(|t| t.keyword == "sunshadeSettings").unwrap();
+    assert!(chunk.text.contains("\"renderer\":\"cpu reference\""), "{}", chunk.text);
+}

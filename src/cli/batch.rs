@@ -20,7 +20,7 @@ use serde_json::Value;
 use super::render::{cache_dir, check_job, render_job, RenderArgs};
 use super::session::Session;
 use super::{clap_error_line, one_line, CliError};
-use crate::film::{write_image, Exposure, Image};
+use crate::film::{write_image_with, Exposure, Image, Metadata};
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
@@ -115,6 +115,7 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
 struct Encode {
     job: usize,
     image: Image,
+    metadata: Metadata,
     output: PathBuf,
     exposure: Exposure,
 }
@@ -146,8 +147,9 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
             let (queue, done_tx) = (&queue, done_tx.clone());
             scope.spawn(move || loop {
                 let Ok(item) = queue.lock().expect("encoder queue").recv() else { break };
-                let result =
-                    write_image(&item.image, &item.output, item.exposure).map(|_| ()).map_err(|e| e.to_string());
+                let result = write_image_with(&item.image, &item.output, item.exposure, &item.metadata)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string());
                 let _ = done_tx.send((item.job, result));
             });
         }
@@ -171,9 +173,12 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
             match result {
                 Ok(job) => {
                     let args = jobs[i].as_ref().expect("rendered");
+                    let metadata =
+                        super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
                     let item = Encode {
                         job: i,
                         image: job.image,
+                        metadata,
                         output: args.output.output.clone(),
                         exposure: args.output.exposure(),
                     };

@@ -10,6 +10,7 @@ mod bench;
 mod diff;
 mod generated;
 mod info;
+mod metadata;
 mod reference;
 pub(crate) mod render;
 mod session;

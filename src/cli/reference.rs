@@ -7,7 +7,7 @@ use clap::Args;
 use super::args::{OutputArgs, SceneArgs};
 use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
-use crate::film::write_image;
+use crate::film::write_image_with;
 
 /// Options of the reference rasterizer that mirror the device.
 #[derive(Args, Clone, Debug)]
@@ -58,7 +58,8 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    let ev = write_image(&image, &a.output.output, a.output.exposure())?;
+    let meta = super::metadata::of_render(&settings, "cpu reference");
+    let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
     if a.verbose {
         eprintln!(
             "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",

@@ -9,7 +9,7 @@ use super::diff::{compare_and_report, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
 use crate::cpu::{self, ReferenceOptions};
-use crate::film::{write_image, Image};
+use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
 use crate::settings::RenderSettings;
 
@@ -138,7 +138,8 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
-    let ev = write_image(&job.image, &a.output.output, a.output.exposure())?;
+    let meta = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+    let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();

@@ -79,6 +79,13 @@ impl Session {
         Ok(self.renderers.len() - 1)
     }
 
+    /// "gpu: DEVICE (DRIVER INFO); interpolation MODE", for the files a renderer's images go to.
+    pub fn renderer_description(&self, index: usize) -> String {
+        let r = &self.renderers[index].1;
+        let i = r.device_info();
+        format!("gpu: {} ({} {}); interpolation {}", i.name, i.driver_name, i.driver_info, r.interpolation().name())
+    }
+
     pub fn renderer_mut(&mut self, index: usize) -> &mut Renderer {
         &mut self.renderers[index].1
     }

@@ -53,15 +53,34 @@ impl ImageIoError {
     }
 }
 
+/// What an image file says about itself, beside its pixels: text attributes (EXR string attributes, PNG tEXt
+/// chunks; ASCII) and 4×4 matrices (EXR `m44f` attributes, Imath's layout: row vectors, `p' = p M`, which is
+/// glam's column-major array read row by row). PFM has no place for either.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Metadata {
+    pub text: Vec<(String, String)>,
+    pub matrices: Vec<(String, [f32; 16])>,
+}
+
 /// Writes `image` to `path` in the format its extension names. `exposure` applies to PNG only; for a PNG the EV
 /// applied is returned (and recorded in the file's `sunshade exposure EV` tEXt chunk).
 pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<Option<f64>, ImageIoError> {
+    write_image_with(image, path, exposure, &Metadata::default())
+}
+
+/// [`write_image`] with metadata in the file.
+pub fn write_image_with(
+    image: &Image,
+    path: &Path,
+    exposure: Exposure,
+    metadata: &Metadata,
+) -> Result<Option<f64>, ImageIoError> {
     let format =
         ImageFormat::from_path(path).ok_or_else(|| ImageIoError::UnsupportedExtension { path: path.to_path_buf() })?;
     let io_err = |error| ImageIoError::Io { path: path.to_path_buf(), error };
     match format {
         ImageFormat::Exr => {
-            write_atomically(path, |w| write_exr(image, w)).map_err(io_err)?;
+            write_atomically(path, |w| write_exr(image, w, metadata)).map_err(io_err)?;
             Ok(None)
         }
         ImageFormat::Pfm => {
@@ -78,7 +97,8 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<Opt
                 }
                 data.push((p[3].clamp(0.0, 1.0) * 255.0).round() as u8);
             }
-            write_atomically(path, |w| write_png(w, image.width(), image.height(), &data, ev)).map_err(io_err)?;
+            write_atomically(path, |w| write_png(w, image.width(), image.height(), &data, ev, metadata))
+                .map_err(io_err)?;
             Ok(Some(ev))
         }
     }
@@ -86,7 +106,8 @@ pub fn write_image(image: &Image, path: &Path, exposure: Exposure) -> Result<Opt
 
 /// OpenEXR through the `exr` crate: one RGBA f32 layer, ZIP compression over 16-scan-line blocks (lossless, the
 /// blocks compressed in parallel), and header attributes naming the software and the quantity's unit.
-fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W) -> io::Result<()> {
+fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata) -> io::Result<()> {
+    use exr::meta::attribute::AttributeValue;
     use exr::prelude::{Encoding, Layer, LayerAttributes, SpecificChannels, Text, Vec2, WritableImage};
     let (width, height) = (image.width() as usize, image.height() as usize);
     let pixels = image.pixels();
@@ -102,6 +123,19 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W) -> io::Result<()> {
             "radiance W/(m2 sr) per linear RGB channel; A = coverage",
         )),
     );
+    for (key, value) in &metadata.text {
+        attributes.other.insert(Text::from(key.as_str()), AttributeValue::Text(Text::from(value.as_str())));
+    }
+    for (key, m) in &metadata.matrices {
+        // The two standard camera matrices have fields of their own in the exr crate.
+        match key.as_str() {
+            "worldToCamera" => attributes.world_to_camera = Some(*m),
+            "worldToNDC" => attributes.world_to_normalized_device = Some(*m),
+            _ => {
+                attributes.other.insert(Text::from(key.as_str()), AttributeValue::Matrix4x4(*m));
+            }
+        }
+    }
     let layer = Layer::new((width, height), attributes, Encoding::SMALL_LOSSLESS, channels);
     exr::prelude::Image::from_layer(layer).write().to_buffered(w).map_err(io::Error::other)
 }
@@ -110,7 +144,7 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W) -> io::Result<()> {
 pub const PNG_EXPOSURE_KEYWORD: &str = "sunshade exposure EV";
 
 /// 8-bit RGBA with an sRGB chunk (the values are sRGB-encoded) and tEXt chunks naming the software and the EV.
-fn write_png(w: &mut impl Write, width: u32, height: u32, rgba: &[u8], ev: f64) -> io::Result<()> {
+fn write_png(w: &mut impl Write, width: u32, height: u32, rgba: &[u8], ev: f64, metadata: &Metadata) -> io::Result<()> {
     let mut encoder = png::Encoder::new(w, width, height);
     encoder.set_color(png::ColorType::Rgba);
     encoder.set_depth(png::BitDepth::Eight);
@@ -120,6 +154,9 @@ fn write_png(w: &mut impl Write, width: u32, height: u32, rgba: &[u8], ev: f64) 
         |e: &mut png::Encoder<_>, k: &str, v: String| e.add_text_chunk(k.to_string(), v).map_err(io::Error::other);
     text(&mut encoder, "Software", format!("sunshade {}", env!("CARGO_PKG_VERSION")))?;
     text(&mut encoder, PNG_EXPOSURE_KEYWORD, format!("{ev}"))?;
+    for (key, value) in &metadata.text {
+        text(&mut encoder, key, value.clone())?;
+    }
     let mut writer = encoder.write_header().map_err(io::Error::other)?;
     writer.write_image_data(rgba).map_err(io::Error::other)?;
     writer.finish().map_err(io::Error::other)

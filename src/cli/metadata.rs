@@ -1,0 +1,54 @@
+//! What an output file records about its render: the camera as OpenEXR's standard `worldToCamera` and
+//! `worldToNDC` matrices, and the lights and quality settings as JSON text (`sunshadeLights`,
+//! `sunshadeSettings`). No error bound is recorded yet: sunshade has no model of one (the speed-against-error
+//! issue adds it).
+
+use serde_json::json;
+
+use crate::film::Metadata;
+use crate::settings::RenderSettings;
+use crate::shading::{DiskModel, SunModel};
+
+/// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference").
+pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
+    let aspect = settings.width as f64 / settings.height as f64;
+    let cam = &settings.camera;
+    let m = |x: glam::DMat4| x.to_cols_array().map(|v| v as f32);
+    let l = &settings.lights;
+    let lights = json!({
+        "units": { "sun_irradiance": "W/m2 on a surface facing the sun", "radiance": "W/(m2 sr)", "lengths": "m" },
+        "sun": l.sun.map(|s| json!({
+            "direction_towards_sun": s.direction.to_array(),
+            "irradiance": s.irradiance,
+            "angular_diameter_deg": (s.angular_diameter as f64).to_degrees(),
+        })),
+        "disks": l.disks.iter().map(|d| json!({
+            "center": d.center.to_array(), "direction": d.direction.to_array(), "radius": d.radius, "radiance": d.radiance,
+        })).collect::<Vec<_>>(),
+        "sky_radiance": l.sky,
+    });
+    let sh = &settings.shading;
+    let quality = json!({
+        "renderer": renderer,
+        "width": settings.width,
+        "height": settings.height,
+        "sun_model": match sh.sun { SunModel::Disk => "disk", SunModel::Delta => "delta" },
+        "sun_samples": sh.sun_samples_per_axis * sh.sun_samples_per_axis,
+        "disk_model": match sh.disk { DiskModel::Exact => "exact", DiskModel::SmallSource => "small-source" },
+        "samples": sh.samples_per_axis * sh.samples_per_axis,
+        "camera": { "eye": cam.eye.to_array(), "forward": cam.forward.to_array(), "up": cam.up.to_array(),
+                    "orthographic": cam.is_orthographic() },
+        "worldToNDC": "Vulkan clip space before the divide by w: x right, y down, depth in [0, 1]",
+    });
+    Metadata {
+        text: vec![
+            ("sunshadeLights".into(), lights.to_string()),
+            ("sunshadeSettings".into(), quality.to_string()),
+            ("sunshadeVersion".into(), env!("CARGO_PKG_VERSION").into()),
+        ],
+        matrices: vec![
+            ("worldToCamera".into(), m(cam.view_from_world())),
+            ("worldToNDC".into(), m(cam.clip_from_world(aspect))),
+        ],
+    }
+}
