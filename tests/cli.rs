@@ -506,3 +506,45 @@ fn outputs_record_camera_lights_and_settings() {
     let chunk = reader.info().uncompressed_latin1_text.iter().find(|t| t.keyword == "sunshadeSettings").unwrap();
     assert!(chunk.text.contains("\"renderer\":\"cpu reference\""), "{}", chunk.text);
 }
+
+#[test]
+fn scripts_get_json_silence_completions_and_a_man_page() {
+    let dir = TempDir::new("scripts");
+    let input = dir.write("scene.glb", &scene());
+    let json_of = |args: &[&str]| -> serde_json::Value {
+        let o = sunshade(args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{args:?}: not JSON: {e}"))
+    };
+    let info = json_of(&["info", "--json"]);
+    assert!(info["devices"].as_array().unwrap().iter().any(|d| d["sub_pixel_precision_bits"].is_u64()), "{info}");
+    let out = dir.path("o.exr");
+    let check = json_of(&["render", s(&input), "-o", s(&out), "--width", "32", "--height", "24", "--check", "--json"]);
+    assert_eq!(check["pass"], true, "{check}");
+    let bench = json_of(&["bench", s(&input), "--width", "32", "--height", "32", "--repeat", "1", "--json"]);
+    assert_eq!(bench["tables"][0]["rows"][0]["scene"], "scene.glb", "{bench}");
+    let albedo = json_of(&["albedo", s(&input), "--json"]);
+    assert!(!albedo["tables"][0]["rows"].as_array().unwrap().is_empty(), "{albedo}");
+    // -q: nothing on either stream, the exit code says it.
+    let mut b = scene();
+    b.add_material("unused", [0.5; 3], false, None);
+    let unused = dir.write("unused.glb", &b);
+    let o = sunshade(&["render", s(&unused), "-o", s(&out), "--width", "32", "--height", "24", "--check", "-q"]);
+    assert!(o.status.success() && o.stdout.is_empty() && o.stderr.is_empty(), "{}", stderr(&o));
+    let o = sunshade(&["diff", s(&out), s(&out), "-q"]);
+    assert!(o.status.success() && o.stdout.is_empty());
+    // Help grouped by topic; completions; man pages.
+    let help = String::from_utf8_lossy(&sunshade(&["render", "--help"]).stdout).into_owned();
+    for heading in ["Camera:", "Sun:", "Disk lights and sky:", "Quality:", "Output:", "Check tolerances:"] {
+        assert!(help.contains(heading), "{heading} missing from render --help");
+    }
+    let bash = sunshade(&["completions", "bash"]);
+    assert!(bash.status.success() && String::from_utf8_lossy(&bash.stdout).contains("_sunshade"));
+    let man = sunshade(&["man"]);
+    assert!(String::from_utf8_lossy(&man.stdout).contains(".TH sunshade 1"));
+    let pages = dir.path("man");
+    std::fs::create_dir(&pages).unwrap();
+    assert!(sunshade(&["man", "--dir", s(&pages)]).status.success());
+    let render_page = std::fs::read_to_string(pages.join("sunshade-render.1")).unwrap();
+    assert!(render_page.contains("sun\\-elevation"));
+}

@@ -14,7 +14,7 @@ use clap::Args;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::generated::{check_region, machine, today, update_region};
+use super::generated::{check_region, machine, print_output, today, update_region};
 use super::CliError;
 use crate::scene::{self, Brdf, LoadOptions};
 use crate::shading::albedo::lobe_albedo;
@@ -30,6 +30,9 @@ pub struct AlbedoArgs {
     /// Replace the generated regions "albedo" and "convergence" of this Markdown file (repeatable).
     #[arg(long, value_name = "MARKDOWN")]
     pub update: Vec<PathBuf>,
+    /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Incidence angles [degrees] of the albedo tables.
@@ -78,14 +81,21 @@ pub fn run(a: &AlbedoArgs) -> Result<(), CliError> {
         None => lobe_table(&standard_lobes()),
     };
     let albedo = format!("{header}{albedo}");
-    print!("{albedo}");
+    if !a.json {
+        print!("{albedo}");
+    }
     let convergence = if a.scene.is_none() {
         let c = format!("{header}{}", convergence_tables());
-        print!("\n{c}");
+        if !a.json {
+            print!("\n{c}");
+        }
         Some(c)
     } else {
         None
     };
+    if a.json {
+        print_output(&format!("{albedo}\n{}", convergence.as_deref().unwrap_or("")), true);
+    }
     for doc in &a.update {
         update_region(doc, "albedo", &albedo)?;
         if let Some(c) = &convergence {

@@ -119,107 +119,108 @@ pub fn parse_positive(s: &str) -> Result<f64, String> {
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
     /// glTF 2.0 scene (.gltf with its .bin files or data URIs, or .glb).
+    #[arg(help_heading = "Scene")]
     pub scene: PathBuf,
 
     /// Image width [pixels].
-    #[arg(long, default_value_t = DEFAULT_WIDTH, value_parser = parse_pixels)]
+    #[arg(help_heading = "Image", long, default_value_t = DEFAULT_WIDTH, value_parser = parse_pixels)]
     pub width: u32,
 
     /// Image height [pixels].
-    #[arg(long, default_value_t = DEFAULT_HEIGHT, value_parser = parse_pixels)]
+    #[arg(help_heading = "Image", long, default_value_t = DEFAULT_HEIGHT, value_parser = parse_pixels)]
     pub height: u32,
 
     /// Buffer and image files must lie inside DIR (symbolic links resolved); default: the scene file's folder.
-    #[arg(long, value_name = "DIR", conflicts_with = "allow_outside_uris")]
+    #[arg(help_heading = "Scene", long, value_name = "DIR", conflicts_with = "allow_outside_uris")]
     pub asset_root: Option<PathBuf>,
 
     /// Read buffer and image files wherever their URIs point, absolute paths and `..` included (only for files
     /// you trust).
-    #[arg(long)]
+    #[arg(help_heading = "Scene", long)]
     pub allow_outside_uris: bool,
 
     /// Which glTF scene of the file to render (default: the file's default scene).
-    #[arg(long = "scene", value_name = "N")]
+    #[arg(help_heading = "Scene", long = "scene", value_name = "N")]
     pub scene_index: Option<usize>,
 
     /// Use glTF camera N (as placed by the scene's nodes) instead of the first one.
-    #[arg(long, value_name = "N")]
+    #[arg(help_heading = "Camera", long, value_name = "N")]
     pub camera: Option<usize>,
 
     /// Camera position x,y,z [m] (world, +Y up).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    #[arg(help_heading = "Camera", long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
     pub eye: Option<DVec3>,
 
     /// Point the camera looks at x,y,z [m].
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    #[arg(help_heading = "Camera", long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
     pub target: Option<DVec3>,
 
     /// Camera up vector x,y,z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    #[arg(help_heading = "Camera", long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
     pub up: Option<DVec3>,
 
     /// Vertical field of view [degrees] (perspective cameras; the automatic camera uses 45).
-    #[arg(long, value_parser = parse_positive, value_name = "DEGREES")]
+    #[arg(help_heading = "Camera", long, value_parser = parse_positive, value_name = "DEGREES")]
     pub fov: Option<f64>,
 
     /// Direction towards the sun x,y,z (world, +Y up; need not be normalised).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z",
-          conflicts_with_all = ["sun_elevation", "sun_azimuth"])]
+          conflicts_with_all = ["sun_elevation", "sun_azimuth"], help_heading = "Sun")]
     pub sun_dir: Option<DVec3>,
 
     /// Sun elevation above the horizontal XZ plane [degrees] (default 45 when only --sun-azimuth is given).
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
     pub sun_elevation: Option<f64>,
 
     /// Sun azimuth [degrees]: 0 = towards +Z, 90 = towards +X.
-    #[arg(long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_finite, allow_hyphen_values = true, value_name = "DEGREES")]
     pub sun_azimuth: Option<f64>,
 
     /// Sun irradiance on a surface facing it, E⊥ [W/m²] (default 1000, or the scene's directional light).
-    #[arg(long, value_parser = parse_finite, value_name = "W/M2", conflicts_with = "sun_radiance")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_finite, value_name = "W/M2", conflicts_with = "sun_radiance")]
     pub sun_irradiance: Option<f64>,
 
     /// Sun radiance L_sun [W/(m²·sr)]; E⊥ = L_sun·π·sin²(δ/2) ≈ L_sun·Ω_sun.
-    #[arg(long, value_parser = parse_finite, value_name = "W/(M2·SR)")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_finite, value_name = "W/(M2·SR)")]
     pub sun_radiance: Option<f64>,
 
     /// Sun angular diameter δ [degrees].
-    #[arg(long, value_parser = parse_positive, value_name = "DEGREES")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_positive, value_name = "DEGREES")]
     pub sun_diameter: Option<f64>,
 
     /// Per-channel factors on E⊥, r,g,b.
-    #[arg(long, value_parser = parse_rgb, value_name = "R,G,B")]
+    #[arg(help_heading = "Sun", long, value_parser = parse_rgb, value_name = "R,G,B")]
     pub sun_color: Option<[f64; 3]>,
 
     /// The sun as a disk (default: exact also while it sets) or as a single direction.
-    #[arg(long, default_value = "disk", value_name = "disk|delta")]
+    #[arg(help_heading = "Sun", long, default_value = "disk", value_name = "disk|delta")]
     pub sun_model: SunModel,
 
     /// Add a disk skylight: centre x,y,z [m], emission direction, radius [m], radiance L0 [W/(m²·sr)] (one value
     /// or r,g,b). Repeatable.
-    #[arg(long = "disk-light", value_parser = parse_disk_light, allow_hyphen_values = true, value_name = "X,Y,Z:NX,NY,NZ:R:L0")]
+    #[arg(help_heading = "Disk lights and sky", long = "disk-light", value_parser = parse_disk_light, allow_hyphen_values = true, value_name = "X,Y,Z:NX,NY,NZ:R:L0")]
     pub disk_lights: Vec<DiskLight>,
 
     /// Disk lights: the exact irradiance (default) or the small-source estimate L0·A·cosθr·cosθd/d².
-    #[arg(long, default_value = "exact", value_name = "exact|small-source")]
+    #[arg(help_heading = "Disk lights and sky", long, default_value = "exact", value_name = "exact|small-source")]
     pub disk_model: DiskModel,
 
     /// Overcast sky of uniform radiance L0 [W/(m²·sr)], one value or r,g,b (replaces the scene's sky).
-    #[arg(long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
+    #[arg(help_heading = "Disk lights and sky", long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
     pub sky_radiance: Option<[f64; 3]>,
 
     /// Map every material's glTF metallic-roughness onto this BRDF (README "BRDFs"); `lambert` forces Lambert.
-    #[arg(long, value_name = "lambert|phong|blinn-phong|ward")]
+    #[arg(help_heading = "Materials", long, value_name = "lambert|phong|blinn-phong|ward")]
     pub brdf: Option<BrdfKind>,
 
     /// Samples for integrating specular lobes over disk lights and the sky (a stratified grid; rounded up to a
     /// square).
-    #[arg(long, default_value_t = DEFAULT_SAMPLES_PER_AXIS * DEFAULT_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_SAMPLES_PER_AXIS * DEFAULT_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub samples: u32,
 
     /// Samples for integrating specular lobes over the sun's disk (--sun-model disk; rounded up to a square)
     /// [default: 64].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
 }
 
@@ -281,12 +282,12 @@ impl SceneArgs {
 #[derive(Args, Clone, Debug)]
 pub struct OutputArgs {
     /// Output image: .exr (float32 RGBA radiance), .pfm (float32 RGB), .png (8-bit sRGB, see --exposure).
-    #[arg(short, long, value_name = "FILE")]
+    #[arg(short, long, value_name = "FILE", help_heading = "Output")]
     pub output: PathBuf,
 
     /// PNG exposure: EV stops (display value = radiance × 2^EV) or 'auto' (the default: the 99th percentile of the
     /// covered pixels displays at 80% of white).
-    #[arg(long, allow_hyphen_values = true, value_name = "EV|auto")]
+    #[arg(long, allow_hyphen_values = true, value_name = "EV|auto", help_heading = "Output")]
     pub exposure: Option<Exposure>,
 }
 

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::args::parse_positive;
-use super::generated::{check_region, machine, today, update_region};
+use super::generated::{check_region, machine, print_output, today, update_region};
 use super::CliError;
 use crate::authoring::chart;
 use crate::compare::{self, DiffOptions};
@@ -59,6 +59,9 @@ pub struct BenchArgs {
     /// frame time of each. Its --update region is "brdf-chart".
     #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs"])]
     pub brdf_chart: bool,
+    /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
+    #[arg(long)]
+    pub json: bool,
 }
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -115,7 +118,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         out += "\n";
         out += &process_timing(a.process_scene.as_ref().unwrap_or(&scenes[0]), width, height, a.process_runs)?;
     }
-    print!("{out}");
+    print_output(&out, a.json);
     for doc in &a.update {
         update_region(doc, "", &out)?;
         eprintln!("sunshade bench: updated {}", doc.display());
@@ -144,7 +147,7 @@ fn brdf_chart(a: &BenchArgs) -> Result<(), CliError> {
     let result = brdf_chart_in(a, &dir, width, height);
     let _ = std::fs::remove_dir_all(&dir);
     let out = result?;
-    print!("{out}");
+    print_output(&out, a.json);
     for doc in &a.update {
         update_region(doc, "brdf-chart", &out)?;
         eprintln!("sunshade bench: updated {}", doc.display());

@@ -113,6 +113,9 @@ pub struct DiffCommand {
     /// Print the metrics as JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Print nothing: the exit code says whether the images agree (errors still print).
+    #[arg(short, long, conflicts_with = "json")]
+    pub quiet: bool,
 }
 
 /// Compares, writes the heatmap if asked, prints the report; `Ok(pass)`.
@@ -130,7 +133,9 @@ pub fn compare_and_report(
         compare::write_heatmap(path, a.width(), a.height(), &per_pixel)
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))?;
     }
-    if json {
+    if super::quiet() {
+        // -q: the exit code says it.
+    } else if json {
         println!("{}", serde_json::to_string_pretty(&report.json(names.0, names.1)).expect("serialisable"));
     } else {
         print!("{}", report.text(names.0, names.1));
@@ -139,6 +144,7 @@ pub fn compare_and_report(
 }
 
 pub fn run(a: &DiffCommand) -> Result<(), CliError> {
+    super::set_quiet(a.quiet);
     let format = |p: &PathBuf| {
         ImageFormat::from_path(p).ok_or_else(|| {
             CliError::Usage(format!("{}: unsupported image extension (use .exr, .pfm or .png)", p.display()))
@@ -169,7 +175,9 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
         for img in [&mut ia, &mut ib] {
             img.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
         }
-        eprintln!("sunshade diff: note: a PFM has no alpha; every pixel is compared, without coverage");
+        if !super::quiet() {
+            eprintln!("sunshade diff: note: a PFM has no alpha; every pixel is compared, without coverage");
+        }
     }
     if let Some(o) = &a.output {
         let d = compare::difference_image(&ia, &ib)

@@ -71,3 +71,68 @@ pub fn today() -> String {
     let y = yoe + era * 400 + (m <= 2) as i64;
     format!("{y:04}-{m:02}-{d:02}")
 }
+
+/// The Markdown tables of a command's output as JSON, for scripts: `{"tables": [{"caption", "columns", "rows"}]}`,
+/// each row an object by column title, cells that are numbers as numbers. The caption is the paragraph before
+/// the table (the machine and settings it was measured with). The figures are the ones of the Markdown table.
+pub fn tables_json(markdown: &str) -> serde_json::Value {
+    let cells = |line: &str| -> Vec<String> {
+        line.trim().trim_start_matches('|').trim_end_matches('|').split('|').map(|c| c.trim().to_string()).collect()
+    };
+    let value = |c: &str| match c.parse::<f64>() {
+        Ok(v) if v.is_finite() => serde_json::json!(v),
+        _ => serde_json::json!(c),
+    };
+    let mut tables = Vec::new();
+    let mut caption = String::new();
+    let lines: Vec<&str> = markdown.lines().collect();
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i].trim();
+        let is_table = line.starts_with('|') && lines.get(i + 1).is_some_and(|l| l.trim().starts_with("|--"));
+        if !is_table {
+            if !line.is_empty() {
+                caption = line.to_string();
+            }
+            i += 1;
+            continue;
+        }
+        let columns = cells(line);
+        let mut rows = Vec::new();
+        i += 2;
+        while i < lines.len() && lines[i].trim().starts_with('|') {
+            let row: serde_json::Map<String, serde_json::Value> =
+                columns.iter().cloned().zip(cells(lines[i]).iter().map(|c| value(c))).collect();
+            rows.push(serde_json::Value::Object(row));
+            i += 1;
+        }
+        tables.push(serde_json::json!({ "caption": caption, "columns": columns, "rows": rows }));
+        caption.clear();
+    }
+    serde_json::json!({ "tables": tables })
+}
+
+/// Prints a command's Markdown output, or its tables as JSON.
+pub fn print_output(markdown: &str, json: bool) {
+    if json {
+        println!("{}", serde_json::to_string_pretty(&tables_json(markdown)).expect("serialisable"));
+    } else {
+        print!("{markdown}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn markdown_tables_become_json_rows() {
+        let md = "Measured on a machine.\n\n| scene | max rel | GPU frame [ms] |\n|---|---:|---:|\n| a.glb | 8.0e-6 | 23.15 |\n| b | — | 1 |\n";
+        let j = tables_json(md);
+        assert_eq!(j["tables"][0]["caption"], "Measured on a machine.");
+        assert_eq!(j["tables"][0]["rows"][0]["max rel"], 8.0e-6);
+        assert_eq!(j["tables"][0]["rows"][0]["GPU frame [ms]"], 23.15);
+        assert_eq!(j["tables"][0]["rows"][1]["max rel"], "—");
+        assert_eq!(j["tables"].as_array().unwrap().len(), 1);
+    }
+}

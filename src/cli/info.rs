@@ -10,11 +10,46 @@ pub struct InfoArgs {
     /// Show which device this selector picks: an index or part of a name.
     #[arg(long, value_name = "INDEX|NAME")]
     pub device: Option<String>,
+    /// Print the devices as JSON (`devices`, `chosen`).
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub fn run(a: &InfoArgs) -> Result<(), CliError> {
     let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
     let (devices, chosen) = list_devices(&options)?;
+    if a.json {
+        let list: Vec<serde_json::Value> = devices
+            .iter()
+            .map(|d| {
+                serde_json::json!({
+                    "index": d.index, "name": d.name, "type": d.type_name(),
+                    "api_version": format!("{}.{}.{}", d.api_version.0, d.api_version.1, d.api_version.2),
+                    "driver_name": d.driver_name, "driver_info": d.driver_info,
+                    "vendor_id": d.vendor_id, "device_id": d.device_id, "driver_version": d.driver_version,
+                    "sub_pixel_precision_bits": d.sub_pixel_precision_bits,
+                    "viewport_sub_pixel_bits": d.viewport_sub_pixel_bits,
+                    "max_image_dimension_2d": d.max_image_dimension_2d,
+                    "max_viewport_dimensions": d.max_viewport_dimensions,
+                    "device_local_heap_bytes": d.device_local_heap_bytes,
+                    "max_memory_allocation_size": d.max_memory_allocation_size,
+                    "max_push_constants_size": d.max_push_constants_size,
+                    "shader_float64": d.shader_float64,
+                    "unusable": d.unusable,
+                })
+            })
+            .collect();
+        let chosen_json = match &chosen {
+            Ok(i) => serde_json::json!(i),
+            Err(_) => serde_json::Value::Null,
+        };
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "devices": list, "chosen": chosen_json }))
+                .expect("serialisable")
+        );
+        return chosen.map(|_| ()).map_err(|e| CliError::Failure(anyhow::anyhow!(e)));
+    }
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     for d in &devices {
         let mark = if chosen.as_ref().is_ok_and(|c| *c == d.index) { "*" } else { " " };

@@ -56,12 +56,42 @@ enum Command {
     /// reference; JUnit XML and an HTML report on request; exit 1 when any case fails.
     #[command(allow_negative_numbers = true)]
     Test(suite::TestArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell), e.g.
+    /// `sunshade completions bash > /etc/bash_completion.d/sunshade`.
+    Completions {
+        #[arg(value_name = "SHELL")]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff), e.g. `sunshade man > sunshade.1 && man ./sunshade.1`; with --dir, write a page
+    /// for every subcommand too (sunshade-render.1, ...) into DIR.
+    Man {
+        #[arg(long, value_name = "DIR")]
+        dir: Option<std::path::PathBuf>,
+    },
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     #[command(allow_negative_numbers = true)]
     Bench(Box<bench::BenchArgs>),
     /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
     /// light integrals per sample count; with a scene, the albedo of its materials.
     Albedo(albedo::AlbedoArgs),
+}
+
+/// `-q`: warnings and notes are not printed (errors still are, on one line, and the exit code says the rest).
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+pub(crate) fn set_quiet(quiet: bool) {
+    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+}
+
+pub(crate) fn quiet() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Prints a warning on stderr unless `-q` was given.
+pub(crate) fn warn(message: &str) {
+    if !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
+        eprintln!("sunshade: warning: {message}");
+    }
 }
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
@@ -97,6 +127,20 @@ pub fn main() -> ExitCode {
         Command::Render(a) => render::run(&a),
         Command::Batch(a) => batch::run(&a),
         Command::Test(a) => suite::run(&a),
+        Command::Completions { shell } => {
+            clap_complete::generate(
+                shell,
+                &mut <Cli as clap::CommandFactory>::command(),
+                "sunshade",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
+        Command::Man { dir: None } => clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
+            .render(&mut std::io::stdout())
+            .map_err(|e| CliError::Failure(e.into())),
+        Command::Man { dir: Some(dir) } => clap_mangen::generate_to(<Cli as clap::CommandFactory>::command(), &dir)
+            .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", dir.display()))),
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Info(a) => info::run(&a),
@@ -154,7 +198,7 @@ pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliErr
     }
     let load_time = t.elapsed();
     for w in &scene.warnings {
-        eprintln!("sunshade: warning: {}: {w}", a.scene.display());
+        warn(&format!("{}: {w}", a.scene.display()));
     }
     Ok((scene, load_time))
 }
@@ -200,10 +244,10 @@ pub(crate) fn check_folder_exists(path: &std::path::Path) -> Result<(), CliError
 /// say so, naming the scene.
 fn warn_if_nothing_covered(image: &crate::film::Image, scene: &std::path::Path) {
     if image.covered_count() == 0 {
-        eprintln!(
-            "sunshade: warning: {}: no pixel is covered: the image is empty (is the camera looking at the scene?)",
+        warn(&format!(
+            "{}: no pixel is covered: the image is empty (is the camera looking at the scene?)",
             scene.display()
-        );
+        ));
     }
 }
 

@@ -45,10 +45,14 @@ pub struct ReferenceCommand {
     /// Print the time of each phase.
     #[arg(short, long)]
     pub verbose: bool,
+    /// Print no warnings (errors still print).
+    #[arg(short, long, conflicts_with = "verbose")]
+    pub quiet: bool,
 }
 
 pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let started = Instant::now();
+    super::set_quiet(a.quiet);
     a.output.check()?;
     a.scene.check()?;
     cpu::check_size(a.scene.width, a.scene.height, a.max_pixels).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;

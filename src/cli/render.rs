@@ -20,32 +20,38 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub output: OutputArgs,
     /// Vulkan device: an index from `sunshade info`, or part of its name.
-    #[arg(long, value_name = "INDEX|NAME")]
+    #[arg(help_heading = "Device", long, value_name = "INDEX|NAME")]
     pub device: Option<String>,
     /// How the fragment shader interpolates position and normal: its own barycentrics in f64 (default where the
     /// device has shaderFloat64) or f32, or the device's varyings (docs/accuracy.md compares them).
-    #[arg(long, value_name = "f64|f32|device")]
+    #[arg(help_heading = "Device", long, value_name = "f64|f32|device")]
     pub interpolation: Option<Interpolation>,
     /// Do not read or write the pipeline cache on disk ($SUNSHADE_CACHE_DIR, else $XDG_CACHE_HOME/sunshade, else
     /// ~/.cache/sunshade).
-    #[arg(long)]
+    #[arg(help_heading = "Device", long)]
     pub no_cache: bool,
     /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
     /// encode).
-    #[arg(short, long)]
+    #[arg(help_heading = "Output", short, long)]
     pub verbose: bool,
+    /// Print no warnings, and with --check no report: the exit code says whether it passed (errors still print).
+    #[arg(help_heading = "Output", short, long, conflicts_with = "verbose")]
+    pub quiet: bool,
     /// Also render the CPU reference (with the device's sub-pixel bits) and compare: exit 1 outside tolerance.
-    #[arg(long)]
+    #[arg(help_heading = "Check", long)]
     pub check: bool,
+    /// With --check: print the comparison as JSON instead of text.
+    #[arg(help_heading = "Check", long, requires = "check")]
+    pub json: bool,
     /// With --check: write the comparison heatmap here.
-    #[arg(long, value_name = "PNG", requires = "check")]
+    #[arg(help_heading = "Check", long, value_name = "PNG", requires = "check")]
     pub heatmap: Option<std::path::PathBuf>,
     /// With --check: the tolerances of the comparison (as `diff`'s).
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "Check tolerances")]
     pub tolerances: ToleranceArgs,
     /// With --check: whether the device fuses the viewport multiply-add for unclipped vertices (default: whether
     /// this CPU has FMA, which is what lavapipe does). The reference takes the device's sub-pixel bits.
-    #[arg(long, action = clap::ArgAction::Set, value_name = "true|false", requires = "check")]
+    #[arg(help_heading = "Check", long, action = clap::ArgAction::Set, value_name = "true|false", requires = "check")]
     pub fused_viewport: Option<bool>,
 }
 
@@ -109,7 +115,7 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
         ("gpu", "cpu reference"),
         &a.tolerances.options(),
         a.heatmap.as_deref(),
-        false,
+        a.json,
     )?;
     if report.pass {
         Ok(())
@@ -129,12 +135,13 @@ pub fn cache_dir(no_cache: bool) -> Option<std::path::PathBuf> {
 
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
+    super::set_quiet(a.quiet);
     a.check()?;
     let mut session = Session::new(cache_dir(a.no_cache));
     let job = render_job(&mut session, a)?;
     let t_cache = Instant::now();
     for w in session.save_pipeline_caches() {
-        eprintln!("sunshade: warning: pipeline cache not saved: {w}");
+        super::warn(&format!("pipeline cache not saved: {w}"));
     }
     let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
