@@ -480,16 +480,16 @@ fn outputs_record_camera_lights_and_settings() {
     assert!(o.status.success(), "{}", stderr(&o));
     let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
     let layer = &meta.headers[0].own_attributes;
-    let text = |k: &str| match layer.other.get(&exr::prelude::Text::from(k)) {
-        Some(exr::meta::attribute::AttributeValue::Text(t)) => t.to_string(),
-        other => panic!("{k}: {other:?}"),
+    let all: serde_json::Value = match layer.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
     };
-    let settings: serde_json::Value = serde_json::from_str(&text("sunshadeSettings")).unwrap();
+    assert_eq!(layer.other.len(), 1, "one custom attribute, so that the header's bytes do not vary");
+    let settings = &all["sunshadeSettings"];
     assert_eq!((settings["width"].as_u64(), settings["height"].as_u64()), (Some(64), Some(48)));
     assert!(settings["renderer"].as_str().unwrap().starts_with("gpu: "), "{settings}");
-    let lights: serde_json::Value = serde_json::from_str(&text("sunshadeLights")).unwrap();
-    assert_eq!(lights["sky_radiance"], json!([300.0, 300.0, 300.0]));
-    assert!(text("sunshadeQuantity").contains("W/(m2 sr)"));
+    assert_eq!(all["sunshadeLights"]["sky_radiance"], json!([300.0, 300.0, 300.0]));
+    assert!(all["quantity"].as_str().unwrap().contains("W/(m2 sr)"));
     // worldToNDC (Imath: row vectors) takes a point straight ahead of the eye to the centre of the image.
     let m = layer.world_to_normalized_device.expect("worldToNDC");
     let eye: Vec<f64> = settings["camera"]["eye"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();

@@ -1,6 +1,6 @@
 //! What an output file records about its render: the camera as OpenEXR's standard `worldToCamera` and
 //! `worldToNDC` matrices, and the lights and quality settings as JSON text (`sunshadeLights`,
-//! `sunshadeSettings`). No error bound is recorded yet: sunshade has no model of one (the speed-against-error
+//! `sunshadeSettings`: in EXR inside the one JSON attribute `sunshade`, in PNG as tEXt chunks). No error bound is recorded yet: sunshade has no model of one (the speed-against-error
 //! issue adds it).
 
 use serde_json::json;

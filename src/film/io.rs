@@ -105,7 +105,8 @@ pub fn write_image_with(
 }
 
 /// OpenEXR through the `exr` crate: one RGBA f32 layer, ZIP compression over 16-scan-line blocks (lossless, the
-/// blocks compressed in parallel), and header attributes naming the software and the quantity's unit.
+/// blocks compressed in parallel), the software's name, the standard camera matrices, and one JSON attribute
+/// `sunshade` holding the quantity's unit and the metadata texts.
 fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata) -> io::Result<()> {
     use exr::meta::attribute::AttributeValue;
     use exr::prelude::{Encoding, Layer, LayerAttributes, SpecificChannels, Text, Vec2, WritableImage};
@@ -117,23 +118,24 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata)
     });
     let mut attributes = LayerAttributes::named("radiance");
     attributes.software_name = Some(Text::from(format!("sunshade {}", env!("CARGO_PKG_VERSION")).as_str()));
-    attributes.other.insert(
-        Text::from("sunshadeQuantity"),
-        exr::meta::attribute::AttributeValue::Text(Text::from(
-            "radiance W/(m2 sr) per linear RGB channel; A = coverage",
-        )),
-    );
+    // One custom attribute, `sunshade`: a JSON object of the quantity and every metadata text (JSON texts nested
+    // as JSON). The exr crate keeps custom attributes in a HashMap, whose order changes from process to process;
+    // with one, the same image always gives the same bytes.
+    let mut all = serde_json::Map::new();
+    all.insert("quantity".into(), serde_json::json!("radiance W/(m2 sr) per linear RGB channel; A = coverage"));
     for (key, value) in &metadata.text {
-        attributes.other.insert(Text::from(key.as_str()), AttributeValue::Text(Text::from(value.as_str())));
+        let v = serde_json::from_str(value).unwrap_or_else(|_| serde_json::Value::String(value.clone()));
+        all.insert(key.clone(), v);
     }
+    let text = serde_json::Value::Object(all).to_string();
+    attributes.other.insert(Text::from("sunshade"), AttributeValue::Text(Text::from(text.as_str())));
     for (key, m) in &metadata.matrices {
-        // The two standard camera matrices have fields of their own in the exr crate.
+        // The two standard camera matrices have fields of their own in the exr crate; others have no place in
+        // the file (a custom attribute would make the byte order of the header vary, see above).
         match key.as_str() {
             "worldToCamera" => attributes.world_to_camera = Some(*m),
             "worldToNDC" => attributes.world_to_normalized_device = Some(*m),
-            _ => {
-                attributes.other.insert(Text::from(key.as_str()), AttributeValue::Matrix4x4(*m));
-            }
+            _ => {}
         }
     }
     let layer = Layer::new((width, height), attributes, Encoding::SMALL_LOSSLESS, channels);
