@@ -28,8 +28,6 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use clap::Parser;
-
 use crate::cli::render::RenderArgs;
 use crate::cli::{load_only, resolve_settings, CliError};
 use crate::compare::{self, DiffOptions, DiffReport};
@@ -58,17 +56,9 @@ impl From<CliError> for TestingError {
     fn from(e: CliError) -> Self {
         match e {
             CliError::Usage(m) => TestingError::Flags(m),
-            CliError::Failure(e) => TestingError::Scene(format!("{e:#}")),
-            CliError::Quiet(code) => TestingError::Scene(format!("failed with exit code {code}")),
+            other => TestingError::Scene(other.message()),
         }
     }
-}
-
-#[derive(Parser, Debug)]
-#[command(name = "render", allow_negative_numbers = true, no_binary_name = true)]
-struct JobArgs {
-    #[command(flatten)]
-    args: RenderArgs,
 }
 
 /// A scene and the flags of `sunshade render` (no `--output` needed).
@@ -81,7 +71,7 @@ pub struct Job {
 pub fn job(scene: impl AsRef<Path>, flags: &[&str]) -> Result<Job, TestingError> {
     let mut argv: Vec<String> = vec![scene.as_ref().display().to_string(), "--output".into(), "unused.exr".into()];
     argv.extend(flags.iter().map(|f| f.to_string()));
-    let args = JobArgs::try_parse_from(&argv).map_err(|e| TestingError::Flags(crate::cli::clap_error_line(&e)))?.args;
+    let args = RenderArgs::parse_list(&argv).map_err(TestingError::Flags)?;
     args.scene.check()?;
     Ok(Job { args })
 }

@@ -13,13 +13,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
-use clap::{Args, Parser};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::Value;
 
 use super::render::{cache_dir, check_job, render_job, RenderArgs};
 use super::session::Session;
-use super::{clap_error_line, one_line, CliError};
+use super::CliError;
 use crate::film::{write_image_with, Exposure, Image, Metadata};
 
 #[derive(Args, Debug)]
@@ -51,14 +51,6 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
         return Err(format!("'{s}': needs 0 ≤ K < N"));
     }
     Ok((k, n))
-}
-
-/// `render`'s parser, for one job's argument list.
-#[derive(Parser, Debug)]
-#[command(name = "render", allow_negative_numbers = true, no_binary_name = true)]
-struct Job {
-    #[command(flatten)]
-    args: RenderArgs,
 }
 
 /// A job object → `render`'s argument list. Errors name the key.
@@ -102,13 +94,7 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
     let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
     let value: Value = serde_json::from_str(&text).map_err(|e| fail(format!("invalid JSON: {e}")))?;
     let jobs = value.as_array().ok_or_else(|| fail("the manifest must be a JSON array of jobs".into()))?;
-    Ok(jobs
-        .iter()
-        .map(|job| {
-            let argv = job_arguments(job)?;
-            Job::try_parse_from(&argv).map(|j| j.args).map_err(|e| clap_error_line(&e))
-        })
-        .collect())
+    Ok(jobs.iter().map(|job| RenderArgs::parse_list(&job_arguments(job)?)).collect())
 }
 
 /// An image to write, and which job it is.
@@ -164,11 +150,7 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
                         }
                         Ok(job)
                     })
-                    .map_err(|e| match e {
-                        CliError::Usage(m) => m,
-                        CliError::Failure(e) => one_line(&e),
-                        CliError::Quiet(_) => "outside tolerance (report above)".into(),
-                    }),
+                    .map_err(|e| e.message()),
             };
             match result {
                 Ok(job) => {
@@ -251,12 +233,14 @@ mod tests {
             assert!(argv.contains(&a.to_string()), "{a} missing from {argv:?}");
         }
         assert!(!argv.iter().any(|a| a.contains("no-cache")));
-        let parsed = Job::try_parse_from(&argv).unwrap().args;
+        let parsed = RenderArgs::parse_list(&argv).unwrap();
         assert_eq!((parsed.scene.width, parsed.scene.sun_elevation, parsed.check), (256, Some(-3.5), true));
         assert!(job_arguments(&json!({ "output": "a.png" })).unwrap_err().contains("scene"));
         assert!(job_arguments(&json!({ "scene": "a", "output": "b.png", "width": { "x": 1 } })).is_err());
-        assert!(Job::try_parse_from(job_arguments(&json!({ "scene": "a", "output": "b.png", "nope": 1 })).unwrap())
-            .is_err());
+        assert!(RenderArgs::parse_list(
+            &job_arguments(&json!({ "scene": "a", "output": "b.png", "nope": 1 })).unwrap()
+        )
+        .is_err());
     }
 
     #[test]

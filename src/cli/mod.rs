@@ -103,6 +103,17 @@ pub enum CliError {
     Quiet(u8),
 }
 
+impl CliError {
+    /// The failure as one line, for a command that reports it and goes on (batch jobs, suite cases).
+    pub fn message(&self) -> String {
+        match self {
+            CliError::Usage(m) => m.clone(),
+            CliError::Failure(e) => one_line(e),
+            CliError::Quiet(code) => format!("failed with exit code {code} (report above)"),
+        }
+    }
+}
+
 impl<E: Into<anyhow::Error>> From<E> for CliError {
     fn from(e: E) -> Self {
         CliError::Failure(e.into())

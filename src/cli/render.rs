@@ -55,7 +55,21 @@ pub struct RenderArgs {
     pub fused_viewport: Option<bool>,
 }
 
+/// `render`'s parser on its own, for argument lists that come from elsewhere (batch jobs, suite cases, the
+/// `testing` API): the first element is the scene.
+#[derive(clap::Parser, Debug)]
+#[command(name = "render", allow_negative_numbers = true, no_binary_name = true)]
+struct RenderParser {
+    #[command(flatten)]
+    args: RenderArgs,
+}
+
 impl RenderArgs {
+    /// Parses `render`'s argument list (scene first, no program name); the error is clap's, on one line.
+    pub fn parse_list(argv: &[String]) -> Result<Self, String> {
+        <RenderParser as clap::Parser>::try_parse_from(argv).map(|p| p.args).map_err(|e| super::clap_error_line(&e))
+    }
+
     /// Refuses, before any work, flags that cannot be honoured or mean nothing together.
     pub fn check(&self) -> Result<(), CliError> {
         self.output.check()?;

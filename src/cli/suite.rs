@@ -20,7 +20,7 @@ use super::batch::{job_arguments, parse_shard};
 use super::diff::ToleranceArgs;
 use super::render::{cache_dir, render_job, RenderArgs};
 use super::session::Session;
-use super::{clap_error_line, one_line, CliError};
+use super::{clap_error_line, CliError};
 use crate::compare::{self, DiffReport};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{auto_exposure_ev, read_image, write_atomically, write_image, Exposure, Image};
@@ -48,13 +48,6 @@ pub struct TestArgs {
     /// Print only failures and the summary.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-#[derive(Parser, Debug)]
-#[command(name = "render", allow_negative_numbers = true, no_binary_name = true)]
-struct CaseArgs {
-    #[command(flatten)]
-    args: RenderArgs,
 }
 
 #[derive(Parser, Debug)]
@@ -162,7 +155,7 @@ fn read_suite(path: &Path, results: &Path) -> Result<Vec<Result<Case, BadCase>>,
                 Value::String(results.join(format!("{name}.actual.exr")).display().to_string()),
             );
             let argv = job_arguments(&Value::Object(job)).map_err(bad)?;
-            let args = CaseArgs::try_parse_from(&argv).map_err(|e| bad(clap_error_line(&e)))?.args;
+            let args = RenderArgs::parse_list(&argv).map_err(bad)?;
             Ok(Case { name, expected, tolerances, args })
         })
         .collect())
@@ -228,15 +221,10 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
 fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) -> Outcome {
     let mut outcome =
         Outcome { name: case.name.clone(), status: Status::Passed, seconds: 0.0, report: None, previews: None };
-    let message = |e: CliError| match e {
-        CliError::Usage(m) => m,
-        CliError::Failure(e) => one_line(&e),
-        CliError::Quiet(c) => format!("exit {c}"),
-    };
     let job = match render_job(session, &case.args) {
         Ok(job) => job,
         Err(e) => {
-            outcome.status = Status::Error(message(e));
+            outcome.status = Status::Error(e.message());
             return outcome;
         }
     };
