@@ -150,7 +150,6 @@ pub fn cache_dir(no_cache: bool) -> Option<std::path::PathBuf> {
 pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
     super::set_quiet(a.quiet);
-    a.check()?;
     let mut session = Session::new(cache_dir(a.no_cache));
     let job = render_job(&mut session, a)?;
     let t_cache = Instant::now();
