@@ -82,16 +82,27 @@ impl Renderer {
     /// otherwise, and compiled again only when the device turns out to lack f64).
     pub fn new(options: &ContextOptions) -> Result<Self, GpuError> {
         let guess = options.interpolation.unwrap_or(Interpolation::BarycentricF64);
+        // Modules built ahead of time take well under a millisecond to load, after the device is known; only a
+        // run-time compilation is worth overlapping with device creation.
+        let compile_at_run_time = std::env::var_os(shaders::SHADER_DIR_VAR).is_some();
         let (dev, instance, compiled, compile_time) = std::thread::scope(|s| {
-            let compiling = s.spawn(|| {
-                let t = Instant::now();
-                let stages = compile_stages(guess, options.naive_math);
-                (stages, t.elapsed())
+            let compiling = compile_at_run_time.then(|| {
+                s.spawn(|| {
+                    let t = Instant::now();
+                    let stages = compile_stages(guess, options.naive_math);
+                    (stages, t.elapsed())
+                })
             });
             let t = Instant::now();
             let dev = Device::new(options);
             let instance = t.elapsed();
-            let (stages, elapsed) = compiling.join().expect("the shader compiler thread panicked");
+            let (stages, elapsed) = match compiling {
+                Some(c) => {
+                    let (stages, elapsed) = c.join().expect("the shader compiler thread panicked");
+                    (Some(stages), elapsed)
+                }
+                None => (None, std::time::Duration::ZERO),
+            };
             (dev, instance, stages, elapsed)
         });
         let dev = dev?;
@@ -107,8 +118,10 @@ impl Renderer {
             None if dev.info.shader_float64 => Interpolation::BarycentricF64,
             None => Interpolation::BarycentricF32,
         };
-        let (vs, fs) =
-            if interpolation == guess { compiled? } else { compile_stages(interpolation, options.naive_math)? };
+        let (vs, fs) = match compiled {
+            Some(stages) if interpolation == guess => stages?,
+            _ => compile_stages(interpolation, options.naive_math)?,
+        };
         let pipeline = ScenePipeline::new(
             &dev,
             &vs,
