@@ -19,5 +19,6 @@ pub mod scene;
 pub mod settings;
 pub mod shading;
 pub mod testing;
+pub mod visibility;
 
 pub use film::Image;

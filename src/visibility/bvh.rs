@@ -1,0 +1,248 @@
+//! A bounding volume hierarchy over triangles for the reference's visibility rays: built once per scene by
+//! median splits along the longest axis of the centroids' box, traversed with an explicit stack.
+//!
+//! Exactness does not depend on the tree: a box test only decides what is tested, and the boxes are widened by a
+//! relative 1e-9 so that rounding in the slab test can never skip a triangle the ray touches. `any_hit` (shadow
+//! rays) and `closest_hit` return what testing every triangle with [`WatertightRay`] would return (tests below
+//! compare with brute force).
+
+use glam::DVec3;
+
+use super::ray_triangle::WatertightRay;
+
+/// Triangles per leaf at most.
+const LEAF_SIZE: usize = 4;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: DVec3,
+    max: DVec3,
+    /// Leaf: `first..first + count` of `order`; inner: children at `first` and `first + 1`, `count == 0`.
+    first: u32,
+    count: u32,
+}
+
+/// A BVH over triangles given in world space [m].
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    triangles: Vec<[DVec3; 3]>,
+    /// Triangle indices in leaf order.
+    order: Vec<u32>,
+    nodes: Vec<Node>,
+}
+
+fn bounds(t: &[DVec3; 3]) -> (DVec3, DVec3) {
+    (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]))
+}
+
+impl Bvh {
+    /// Builds the tree (iteratively: no recursion on the depth of the tree). Triangles with non-finite vertices
+    /// are left out (the loader refuses them anyway).
+    pub fn new(triangles: Vec<[DVec3; 3]>) -> Self {
+        let mut order: Vec<u32> =
+            (0..triangles.len() as u32).filter(|&i| triangles[i as usize].iter().all(|v| v.is_finite())).collect();
+        let centroid = |i: u32| {
+            let t = &triangles[i as usize];
+            (t[0] + t[1] + t[2]) / 3.0
+        };
+        let mut nodes = vec![Node { min: DVec3::ZERO, max: DVec3::ZERO, first: 0, count: order.len() as u32 }];
+        let mut todo = vec![0usize];
+        while let Some(n) = todo.pop() {
+            let (first, count) = (nodes[n].first as usize, nodes[n].count as usize);
+            let items = &mut order[first..first + count];
+            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for &i in items.iter() {
+                let (a, b) = bounds(&triangles[i as usize]);
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+            // Widen by a relative 1e-9 (and an absolute 1e-300): the slab test's rounding cannot cut a touching ray.
+            let pad = (hi - lo).abs().max(lo.abs()).max(hi.abs()) * 1e-9 + DVec3::splat(1e-300);
+            nodes[n].min = lo - pad;
+            nodes[n].max = hi + pad;
+            if count <= LEAF_SIZE {
+                continue;
+            }
+            let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for &i in items.iter() {
+                clo = clo.min(centroid(i));
+                chi = chi.max(centroid(i));
+            }
+            let extent = chi - clo;
+            let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                0
+            } else if extent.y >= extent.z {
+                1
+            } else {
+                2
+            };
+            let mid = count / 2;
+            items.select_nth_unstable_by(mid, |&a, &b| centroid(a)[axis].total_cmp(&centroid(b)[axis]));
+            let left = nodes.len();
+            nodes.push(Node { min: DVec3::ZERO, max: DVec3::ZERO, first: first as u32, count: mid as u32 });
+            nodes.push(Node {
+                min: DVec3::ZERO,
+                max: DVec3::ZERO,
+                first: (first + mid) as u32,
+                count: (count - mid) as u32,
+            });
+            nodes[n].first = left as u32;
+            nodes[n].count = 0;
+            todo.push(left);
+            todo.push(left + 1);
+        }
+        Self { triangles, order, nodes }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Whether the ray hits any triangle with `t_min < t < t_max` (a shadow ray: the light is occluded).
+    pub fn any_hit(&self, ray: &WatertightRay, t_min: f64, t_max: f64) -> bool {
+        self.traverse(ray, t_min, t_max, true).is_some()
+    }
+
+    /// The nearest hit with `t_min < t < t_max`: its `t` and the triangle's index as given to [`Bvh::new`].
+    pub fn closest_hit(&self, ray: &WatertightRay, t_min: f64, t_max: f64) -> Option<(f64, usize)> {
+        self.traverse(ray, t_min, t_max, false)
+    }
+
+    fn traverse(&self, ray: &WatertightRay, t_min: f64, mut t_max: f64, any: bool) -> Option<(f64, usize)> {
+        if self.order.is_empty() {
+            return None;
+        }
+        let inv = ray.direction.recip();
+        let mut best = None;
+        let mut stack = vec![0usize];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n];
+            if !slab(node, ray.origin, inv, t_min, t_max) {
+                continue;
+            }
+            if node.count == 0 {
+                stack.push(node.first as usize);
+                stack.push(node.first as usize + 1);
+                continue;
+            }
+            for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                if let Some(t) = ray.intersect(self.triangles[i as usize], t_min, t_max) {
+                    best = Some((t, i as usize));
+                    if any {
+                        return best;
+                    }
+                    t_max = t;
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The slab test of a padded box. An axis with a zero direction component gives ±inf or NaN products: the
+/// comparisons are written so that a NaN (origin on the slab's plane) keeps the box rather than dropping it.
+fn slab(node: &Node, origin: DVec3, inv: DVec3, t_min: f64, t_max: f64) -> bool {
+    let (mut lo, mut hi) = (t_min, t_max);
+    for k in 0..3 {
+        let (a, b) = ((node.min[k] - origin[k]) * inv[k], (node.max[k] - origin[k]) * inv[k]);
+        let (near, far) = if a <= b { (a, b) } else { (b, a) };
+        if near > lo {
+            lo = near;
+        }
+        if far < hi {
+            hi = far;
+        }
+        if lo > hi {
+            return false;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Rng(u64);
+    impl Rng {
+        fn f(&mut self) -> f64 {
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn v(&mut self, s: f64) -> DVec3 {
+            DVec3::new(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5) * s
+        }
+    }
+
+    #[test]
+    fn agrees_with_brute_force_on_random_soups() {
+        let mut rng = Rng(7);
+        for (count, size) in [(1usize, 0.5), (3, 0.5), (200, 0.2), (3000, 0.05)] {
+            let tris: Vec<[DVec3; 3]> = (0..count)
+                .map(|_| {
+                    let c = rng.v(2.0);
+                    [c + rng.v(size), c + rng.v(size), c + rng.v(size)]
+                })
+                .collect();
+            let bvh = Bvh::new(tris.clone());
+            assert_eq!(bvh.triangle_count(), count);
+            for _ in 0..2000 {
+                let origin = rng.v(3.0);
+                // Some rays along an axis, to exercise zero direction components in the slab test.
+                let dir = match rng.f() {
+                    x if x < 0.1 => DVec3::X,
+                    x if x < 0.2 => -DVec3::Y,
+                    _ => rng.v(1.0),
+                };
+                let Some(ray) = WatertightRay::new(origin, dir) else { continue };
+                let t_max = if rng.f() < 0.5 { f64::INFINITY } else { rng.f() * 4.0 };
+                let brute = tris
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, &t)| ray.intersect(t, 0.0, t_max).map(|t| (t, i)))
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                assert_eq!(bvh.any_hit(&ray, 0.0, t_max), brute.is_some(), "{count} triangles");
+                assert_eq!(bvh.closest_hit(&ray, 0.0, t_max).map(|h| h.0), brute.map(|h| h.0), "{count} triangles");
+            }
+        }
+        assert!(!Bvh::new(Vec::new()).any_hit(&WatertightRay::new(DVec3::ZERO, DVec3::X).unwrap(), 0.0, 1.0));
+    }
+
+    #[test]
+    fn a_closed_mesh_has_no_holes_for_rays_from_inside() {
+        // A UV sphere of 64 × 32 quads (two triangles each): every ray from inside must hit, including rays aimed
+        // exactly at its vertices and edge midpoints, where triangles meet.
+        let (stacks, slices) = (32usize, 64usize);
+        let p = |i: usize, j: usize| {
+            let (th, ph) =
+                (i as f64 / stacks as f64 * std::f64::consts::PI, j as f64 / slices as f64 * std::f64::consts::TAU);
+            DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()) * 1.3 + DVec3::new(0.1, -0.2, 0.3)
+        };
+        let mut tris = Vec::new();
+        for i in 0..stacks {
+            for j in 0..slices {
+                // (j + 1) % slices: the seam's vertices must be the same numbers on both sides (sin 2π ≠ sin 0 in
+                // floating point would leave a real crack, which is what a watertight test then finds).
+                let jn = (j + 1) % slices;
+                let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, jn), p(i, jn));
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+        let bvh = Bvh::new(tris.clone());
+        let origin = DVec3::new(0.12, -0.17, 0.29);
+        let (mut misses, mut brute_misses) = (0, 0);
+        for i in 0..=stacks {
+            for j in 0..slices {
+                for aim in
+                    [p(i, j), (p(i, j) + p(i.min(stacks - 1) + 1, j)) / 2.0, (p(i, j) + p(i, (j + 1) % slices)) / 2.0]
+                {
+                    let ray = WatertightRay::new(origin, aim - origin).unwrap();
+                    misses += usize::from(!bvh.any_hit(&ray, 1e-9, f64::INFINITY));
+                    brute_misses += usize::from(!tris.iter().any(|&t| ray.intersect(t, 1e-9, f64::INFINITY).is_some()));
+                }
+            }
+        }
+        assert_eq!((misses, brute_misses), (0, 0), "rays slipped through the closed sphere");
+    }
+}
