@@ -548,3 +548,40 @@ fn scripts_get_json_silence_completions_and_a_man_page() {
     let render_page = std::fs::read_to_string(pages.join("sunshade-render.1")).unwrap();
     assert!(render_page.contains("sun\\-elevation"));
 }
+
+#[test]
+fn info_says_whether_the_device_has_ray_queries_on_both_lavapipes() {
+    let info = |prefix: &str| -> serde_json::Value {
+        let script = format!("{prefix}exec '{}' info --json", env!("CARGO_BIN_EXE_sunshade"));
+        let o = Command::new("sh").arg("-c").arg(&script).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap();
+        assert!(o.status.success(), "{script}: {}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let system = info("");
+    for d in system["devices"].as_array().unwrap() {
+        assert!(d["ray_query"].is_boolean(), "{d}");
+        if d["driver_info"].as_str().unwrap_or("").contains("Mesa 22.") {
+            assert_eq!(d["ray_query"], false, "Debian 12's lavapipe has no ray queries: {d}");
+        }
+    }
+    let install = Command::new("sh")
+        .arg("-c")
+        .arg("scripts/lavapipe-rt.sh")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    if !install.status.success() {
+        // Said on the real stderr (not the test's captured output), so that the skip is never silent.
+        use std::io::Write;
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED: the lavapipe with ray queries cannot be installed here: {}",
+            stderr(&install).trim()
+        );
+        return;
+    }
+    let rt = info("eval \"$(scripts/lavapipe-rt.sh)\" && ");
+    let lavapipe = &rt["devices"][rt["chosen"].as_u64().unwrap() as usize];
+    assert_eq!(lavapipe["ray_query"], true, "{lavapipe}");
+    assert!(lavapipe["driver_info"].as_str().unwrap().contains("Mesa 25"), "{lavapipe}");
+}

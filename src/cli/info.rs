@@ -35,6 +35,7 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
                     "max_memory_allocation_size": d.max_memory_allocation_size,
                     "max_push_constants_size": d.max_push_constants_size,
                     "shader_float64": d.shader_float64,
+                    "ray_query": d.ray_query,
                     "unusable": d.unusable,
                 })
             })
@@ -81,6 +82,10 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
             "      shaderFloat64 {} (fragment barycentrics in {})",
             d.shader_float64,
             if d.shader_float64 { "f64" } else { "f32" }
+        );
+        println!(
+            "      ray queries (VK_KHR_ray_query + acceleration structures): {}",
+            if d.ray_query { "yes" } else { "no" }
         );
         if let Some(why) = &d.unusable {
             println!("      not usable: {why}");

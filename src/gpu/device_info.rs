@@ -32,6 +32,8 @@ pub struct DeviceInfo {
     pub graphics_queue_family: Option<u32>,
     /// Why sunshade cannot use this device, if it cannot.
     pub unusable: Option<String>,
+    /// `VK_KHR_ray_query` and `VK_KHR_acceleration_structure` are both offered (ray-traced visibility possible).
+    pub ray_query: bool,
     /// `vendorID`, `deviceID`, `driverVersion` and `pipelineCacheUUID`: what a pipeline cache is valid for.
     pub vendor_id: u32,
     pub device_id: u32,
@@ -106,8 +108,12 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
         let text = |s: Result<&std::ffi::CStr, _>| {
             s.map(|c: &std::ffi::CStr| c.to_string_lossy().into_owned()).unwrap_or_default()
         };
+        let extensions = instance.enumerate_device_extension_properties(physical).unwrap_or_default();
+        let offers = |name: &std::ffi::CStr| extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
+        let ray_query = offers(c"VK_KHR_ray_query") && offers(c"VK_KHR_acceleration_structure");
         DeviceInfo {
             index,
+            ray_query,
             vendor_id: props.vendor_id,
             device_id: props.device_id,
             driver_version: props.driver_version,
