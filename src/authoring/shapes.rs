@@ -100,6 +100,73 @@ pub fn uv_sphere(center: Vec3, radius: f32, stacks: u32, slices: u32) -> MeshDat
     m
 }
 
+/// An icosphere: the icosahedron (20 triangles) with each triangle split into four `subdivisions` times (80 at
+/// 1, 320 at 2), vertices shared and pushed out to the sphere, counter-clockwise seen from outside, smooth normals.
+/// Closed: every edge is shared by two triangles through the same vertex indices.
+pub fn icosphere(center: Vec3, radius: f32, subdivisions: u32) -> MeshData {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut points: Vec<glam::DVec3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|p| glam::DVec3::from_array(*p).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoints = std::collections::HashMap::new();
+        let mut mid = |a: u32, b: u32, points: &mut Vec<glam::DVec3>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                points.push(((points[a as usize] + points[b as usize]) * 0.5).normalize());
+                points.len() as u32 - 1
+            })
+        };
+        faces = faces
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (mid(a, b, &mut points), mid(b, c, &mut points), mid(c, a, &mut points));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    MeshData {
+        positions: points.iter().map(|p| (center + p.as_vec3() * radius).to_array()).collect(),
+        normals: points.iter().map(|p| p.as_vec3().to_array()).collect(),
+        indices: faces.into_iter().flatten().collect(),
+    }
+}
+
 /// A `size × size` square in the XZ plane at height `y`, facing +Y, split into `n × n` cells (2 triangles each).
 pub fn grid(center: Vec3, size: f32, n: u32) -> MeshData {
     let mut m = MeshData::default();

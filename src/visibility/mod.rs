@@ -6,7 +6,9 @@
 //! triangles come in as world-space corners.
 
 pub mod bvh;
+pub mod occluders;
 pub mod ray_triangle;
 
 pub use bvh::Bvh;
+pub use occluders::can_occlude;
 pub use ray_triangle::WatertightRay;
