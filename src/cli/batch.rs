@@ -29,15 +29,30 @@ pub struct BatchArgs {
     /// Threads that encode and write images while the next job renders.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub jobs: u32,
-    /// Render only every N-th job from K (0 ≤ K < N), to split a manifest over N machines or processes.
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// What `batch` and `test` share: which of the jobs (or cases) this process runs, and the pipeline cache.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Run only every N-th job or case from K (0 ≤ K < N), to split one file over N machines or processes.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<(usize, usize)>,
     /// Do not read or write the pipeline cache on disk.
     #[arg(long)]
     pub no_cache: bool,
-    /// No progress bar and no summary line.
-    #[arg(short, long)]
-    pub quiet: bool,
+}
+
+impl RunArgs {
+    /// The indices of `count` items this shard runs.
+    pub fn mine(&self, count: usize) -> Vec<usize> {
+        let (k, n) = self.shard.unwrap_or((0, 1));
+        (0..count).filter(|i| i % n == k).collect()
+    }
 }
 
 /// `K/N` with 0 ≤ K < N.
@@ -108,8 +123,7 @@ struct Encode {
 
 pub fn run(a: &BatchArgs) -> Result<(), CliError> {
     let jobs = read_manifest(&a.manifest)?;
-    let (k, n) = a.shard.unwrap_or((0, 1));
-    let mine: Vec<usize> = (0..jobs.len()).filter(|i| i % n == k).collect();
+    let mine = a.run.mine(jobs.len());
     let bar = if a.quiet {
         ProgressBar::hidden()
     } else {
@@ -124,7 +138,7 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
         bar.suspend(|| eprintln!("sunshade batch: job {job}{output}: {e}"));
     };
     let mut failed = 0usize;
-    let mut session = Session::new(cache_dir(a.no_cache));
+    let mut session = Session::new(cache_dir(a.run.no_cache));
     let (to_encoders, queue) = mpsc::sync_channel::<Encode>(a.jobs as usize);
     let queue = std::sync::Mutex::new(queue);
     std::thread::scope(|scope| {
@@ -198,7 +212,7 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
             "sunshade batch: {} of {} jobs rendered, {failed} failed{}",
             mine.len() - failed,
             mine.len(),
-            match a.shard {
+            match a.run.shard {
                 Some((k, n)) => format!(" (shard {k}/{n} of {} jobs)", jobs.len()),
                 None => String::new(),
             }

@@ -16,7 +16,7 @@ use std::time::Instant;
 use clap::{Args, Parser};
 use serde_json::{Map, Value};
 
-use super::batch::{job_arguments, parse_shard};
+use super::batch::{job_arguments, RunArgs};
 use super::diff::ToleranceArgs;
 use super::render::{cache_dir, render_job, RenderArgs};
 use super::session::Session;
@@ -39,12 +39,8 @@ pub struct TestArgs {
     /// DIR.
     #[arg(long, value_name = "DIR")]
     pub report: Option<PathBuf>,
-    /// Run only every N-th case from K (0 ≤ K < N).
-    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
-    pub shard: Option<(usize, usize)>,
-    /// Do not read or write the pipeline cache on disk.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
     /// Print only failures and the summary.
     #[arg(short, long)]
     pub quiet: bool,
@@ -169,11 +165,10 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
     }
     let cases = read_suite(&a.suite, &results)?;
     std::fs::create_dir_all(&results).map_err(|e| CliError::Usage(format!("{}: {e}", results.display())))?;
-    let (k, n) = a.shard.unwrap_or((0, 1));
-    let mut session = Session::new(cache_dir(a.no_cache));
+    let mut session = Session::new(cache_dir(a.run.no_cache));
     let started = Instant::now();
     let mut outcomes = Vec::new();
-    for (_, case) in cases.iter().enumerate().filter(|(i, _)| i % n == k) {
+    for case in a.run.mine(cases.len()).into_iter().map(|i| &cases[i]) {
         let t = Instant::now();
         let mut outcome = match case {
             Err((name, e)) => Outcome {
