@@ -133,11 +133,17 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} jobs, {elapsed} ({eta} left) {msg}")
             .expect("a valid template"),
     );
-    let report = |bar: &ProgressBar, job: usize, e: &str| {
-        let output = jobs[job].as_ref().map_or_else(|_| String::new(), |j| format!(" ({})", j.output.output.display()));
-        bar.suspend(|| eprintln!("sunshade batch: job {job}{output}: {e}"));
-    };
     let mut failed = 0usize;
+    // A job is done when it failed to render or its image is written (or failed to be): count and report it.
+    let mut finish = |job: usize, result: Result<(), String>| {
+        if let Err(e) = result {
+            failed += 1;
+            let output =
+                jobs[job].as_ref().map_or_else(|_| String::new(), |j| format!(" ({})", j.output.output.display()));
+            bar.suspend(|| eprintln!("sunshade batch: job {job}{output}: {e}"));
+        }
+        bar.inc(1);
+    };
     let mut session = Session::new(cache_dir(a.run.no_cache));
     let (to_encoders, queue) = mpsc::sync_channel::<Encode>(a.jobs as usize);
     let queue = std::sync::Mutex::new(queue);
@@ -180,27 +186,15 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
                     };
                     to_encoders.send(item).expect("encoder threads alive");
                 }
-                Err(e) => {
-                    failed += 1;
-                    report(&bar, i, &e);
-                    bar.inc(1);
-                }
+                Err(e) => finish(i, Err(e)),
             }
             while let Ok((job, r)) = done.try_recv() {
-                if let Err(e) = r {
-                    failed += 1;
-                    report(&bar, job, &e);
-                }
-                bar.inc(1);
+                finish(job, r);
             }
         }
         drop(to_encoders);
         for (job, r) in done.iter() {
-            if let Err(e) = r {
-                failed += 1;
-                report(&bar, job, &e);
-            }
-            bar.inc(1);
+            finish(job, r);
         }
     });
     for w in session.save_pipeline_caches() {

@@ -89,7 +89,7 @@ pub(crate) fn quiet() -> bool {
 
 /// Prints a warning on stderr unless `-q` was given.
 pub(crate) fn warn(message: &str) {
-    if !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
+    if !quiet() {
         eprintln!("sunshade: warning: {message}");
     }
 }

@@ -113,13 +113,19 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     Ok(Rendered { image, settings, frame, load, upload, scene, renderer })
 }
 
-/// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
-pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose: bool) -> Result<(), CliError> {
+/// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
+/// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
+pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> Image {
     let sub_pixel_bits = session.renderer_mut(job.renderer).device_info().sub_pixel_precision_bits;
     let options =
         ReferenceOptions { sub_pixel_bits, fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma) };
+    cpu::render(session.scene_ref(job.scene), &job.settings, &options)
+}
+
+/// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
+pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose: bool) -> Result<(), CliError> {
     let t = Instant::now();
-    let reference = cpu::render(session.scene_ref(job.scene), &job.settings, &options);
+    let reference = reference_of(session, a, job);
     if verbose {
         eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     }

@@ -18,11 +18,10 @@ use serde_json::{Map, Value};
 
 use super::batch::{job_arguments, RunArgs};
 use super::diff::ToleranceArgs;
-use super::render::{cache_dir, render_job, RenderArgs};
+use super::render::{cache_dir, reference_of, render_job, RenderArgs};
 use super::session::Session;
 use super::{clap_error_line, CliError};
 use crate::compare::{self, DiffReport};
-use crate::cpu::{self, ReferenceOptions};
 use crate::film::{auto_exposure_ev, read_image, write_atomically, write_image, Exposure, Image};
 
 #[derive(Args, Debug)]
@@ -71,6 +70,13 @@ enum Status {
     Updated,
     Failed(String),
     Error(String),
+}
+
+impl Status {
+    /// A failed comparison or a case that could not run: either makes the suite fail.
+    fn is_failure(&self) -> bool {
+        matches!(self, Status::Failed(_) | Status::Error(_))
+    }
 }
 
 struct Outcome {
@@ -164,6 +170,7 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
         super::check_folder_exists(j)?;
     }
     let cases = read_suite(&a.suite, &results)?;
+    // Made before any case runs: each case's --output lies in it, and render checks an output's folder first.
     std::fs::create_dir_all(&results).map_err(|e| CliError::Usage(format!("{}: {e}", results.display())))?;
     let mut session = Session::new(cache_dir(a.run.no_cache));
     let started = Instant::now();
@@ -187,12 +194,12 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
             Status::Failed(m) => format!("FAIL {}: {m}", outcome.name),
             Status::Error(m) => format!("ERROR {}: {m}", outcome.name),
         };
-        if !a.quiet || matches!(outcome.status, Status::Failed(_) | Status::Error(_)) {
+        if !a.quiet || outcome.status.is_failure() {
             println!("{line}");
         }
         outcomes.push(outcome);
     }
-    let failed = outcomes.iter().filter(|o| matches!(o.status, Status::Failed(_) | Status::Error(_))).count();
+    let failed = outcomes.iter().filter(|o| o.status.is_failure()).count();
     let passed = outcomes.len() - failed;
     if let Some(path) = &a.junit {
         let xml = junit(&stem, &outcomes, started.elapsed().as_secs_f64());
@@ -214,6 +221,8 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
 }
 
 fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) -> Outcome {
+    // read_suite made the case's --output the results folder's NAME.actual.exr.
+    let actual = &case.args.output.output;
     let mut outcome =
         Outcome { name: case.name.clone(), status: Status::Passed, seconds: 0.0, report: None, previews: None };
     let job = match render_job(session, &case.args) {
@@ -224,15 +233,7 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         }
     };
     let expected = match &case.expected {
-        Expected::Reference => {
-            let sub_pixel_bits = session.renderer_mut(job.renderer).device_info().sub_pixel_precision_bits;
-            let fused_viewport = case.args.fused_viewport.unwrap_or_else(cpu::host_has_fma);
-            cpu::render(
-                session.scene_ref(job.scene),
-                &job.settings,
-                &ReferenceOptions { sub_pixel_bits, fused_viewport },
-            )
-        }
+        Expected::Reference => reference_of(session, &case.args, &job),
         Expected::Golden(path) if a.update => {
             outcome.status = match write_image(&job.image, path, Exposure::Auto) {
                 Ok(_) => Status::Updated,
@@ -242,7 +243,8 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         }
         Expected::Golden(path) if !path.exists() => {
             outcome.status = Status::Failed(format!("golden {} is missing (--update writes it)", path.display()));
-            let _ = write_image(&job.image, &results.join(format!("{}.actual.exr", case.name)), Exposure::Auto);
+            // A result file that cannot be written does not change the outcome, which is already a failure.
+            let _ = write_image(&job.image, actual, Exposure::Auto);
             return outcome;
         }
         Expected::Golden(path) => match read_image(path) {
@@ -267,10 +269,10 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             report.over_tolerance.total,
             report.coverage_mismatches.total,
             report.max_rel,
-            results.join(format!("{}.actual.exr", case.name)).display(),
+            actual.display(),
             heatmap.display()
         ));
-        let _ = write_image(&job.image, &results.join(format!("{}.actual.exr", case.name)), Exposure::Auto);
+        let _ = write_image(&job.image, actual, Exposure::Auto);
     }
     if a.report.is_some() || !report.pass {
         let _ = compare::write_heatmap(&heatmap, job.image.width(), job.image.height(), &per_pixel);
@@ -333,7 +335,7 @@ fn junit(suite: &str, outcomes: &[Outcome], seconds: f64) -> String {
 }
 
 fn html(suite: &str, outcomes: &[Outcome]) -> String {
-    let failed = outcomes.iter().filter(|o| matches!(o.status, Status::Failed(_) | Status::Error(_))).count();
+    let failed = outcomes.iter().filter(|o| o.status.is_failure()).count();
     let mut h = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>sunshade test: {s}</title><style>\
          body{{font-family:sans-serif;margin:2em;background:#fafafa}} table{{border-collapse:collapse}} \
