@@ -14,9 +14,17 @@ build: setup
 render: build
 	$(SUNSHADE) render models/teapot.glb -o teapot.png -v
 
-# Every test (unit, GPU on lavapipe with validation layers, CPU reference, CLI).
+# Every test (unit, GPU on lavapipe with validation layers, CPU reference, CLI), then the GPU shadow-ray tests
+# on Mesa 25's lavapipe (ray queries; scripts/lavapipe-rt.sh installs it into .lavapipe-rt/ without touching the
+# system). Where it cannot be installed those tests are skipped with a message, never silently.
 test: setup
 	$(CARGO) test --release --workspace
+	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
+		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
+		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli -- gpu_ ray_quer; \
+	else \
+		echo "make test: SKIPPED the ray-query tests: scripts/lavapipe-rt.sh could not install Mesa 25's lavapipe (above)"; \
+	fi
 
 lint:
 	$(CARGO) fmt --all --check

@@ -16,6 +16,9 @@
 #define DISKS_EXACT 1u
 #define DISKS_SMALL_SOURCE 2u
 #define SKY_PRESENT 1u
+// Shadows (VARIANT_SHADOWS); values match gpu::layout.
+#define SHADOWS_NONE 0u
+#define SHADOWS_RAY 1u
 
 // The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
 // material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
@@ -25,6 +28,7 @@ layout(constant_id = 0) const uint VARIANT_BRDF = 0u;  // BRDF_*
 layout(constant_id = 1) const uint VARIANT_SUN = 0u;   // LIGHT_ABSENT, SUN_DISK or SUN_DELTA
 layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EXACT or DISKS_SMALL_SOURCE
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
+layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 
 struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
@@ -52,7 +56,7 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
     uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
-    uvec4 sampling; // x: samples per axis over the sun's disk
+    uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions)
     DiskGpu disks[];
 } lights;
 

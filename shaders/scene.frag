@@ -1,4 +1,7 @@
-#version 450
+#version 460
+#ifdef SUNSHADE_RAY_QUERY
+#extension GL_EXT_ray_query : require
+#endif
 // Radiance of each covered pixel, linear, in W/(m^2 sr); alpha 1 marks coverage.
 //
 // The fragment fetches its triangle's three vertices (gl_PrimitiveID) and interpolates position and normal with
@@ -65,5 +68,21 @@ void main() {
     frame.tangent = orthonormal_tangent(tangent.xyz, normal);
     frame.bitangent = (tangent.w < 0.0 ? -1.0 : 1.0) * cross(normal, frame.tangent);
     frame.to_viewer = to_viewer;
+    frame.shadow_origin = position;
+    if (SHADOWS_ON) {
+        // The shadow rays' origin from the triangle's corners and vertex normals on the side being shaded, at the
+        // fragment's own barycentrics (visibility.glsl; with device interpolation they are computed here too).
+        uint first_s = pc.first_index + 3u * uint(gl_PrimitiveID);
+        uint j0 = uint(int(indices[first_s]) + pc.vertex_offset);
+        uint j1 = uint(int(indices[first_s + 1u]) + pc.vertex_offset);
+        uint j2 = uint(int(indices[first_s + 2u]) + pc.vertex_offset);
+        vec3 q0 = vertex_vec3(j0, 0u), q1 = vertex_vec3(j1, 0u), q2 = vertex_vec3(j2, 0u);
+        vec3 b = triangle_barycentrics(clip_position(q0), clip_position(q1), clip_position(q2), pixel_ndc(gl_FragCoord.xy));
+        float side = gl_FrontFacing ? 1.0 : -1.0;
+        vec3 n0 = side * safe_normalize(vertex_vec3(j0, 3u));
+        vec3 n1 = side * safe_normalize(vertex_vec3(j1, 3u));
+        vec3 n2 = side * safe_normalize(vertex_vec3(j2, 3u));
+        frame.shadow_origin = shadow_ray_origin(q0, q1, q2, n0, n1, n2, b, position, normal);
+    }
     out_radiance = vec4(radiance_out(material, frame), 1.0);
 }

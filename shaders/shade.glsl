@@ -5,6 +5,15 @@
 
 #include "bindings.glsl"
 #include "brdf.glsl"
+#include "visibility.glsl"
+
+// Whether this pipeline casts shadow rays (the pipeline variant; only modules built with SUNSHADE_RAY_QUERY can).
+const bool SHADOWS_ON = VARIANT_SHADOWS == SHADOWS_RAY;
+
+// Which shadow rays a lobe integral's samples cast (Rust: Option<SampleRays>).
+#define RAYS_NONE 0u
+#define RAYS_ALONG 1u
+#define RAYS_TO_POINT 2u
 
 // v/|v|, or 0 when |v|^2 is 0 (or flushed to 0) so that a degenerate normal shades to 0 instead of NaN.
 vec3 safe_normalize(vec3 v) {
@@ -19,28 +28,54 @@ struct Frame {
     vec3 tangent;
     vec3 bitangent;
     vec3 to_viewer;
+    vec3 shadow_origin; // the shadow rays' origin [m] (visibility.glsl's shadow_ray_origin)
 };
 
-// Irradiance [W/m^2] per channel from all the lights (which, and their models: the pipeline variant).
-vec3 irradiance(vec3 position, vec3 normal) {
+// Irradiance [W/m^2] per channel from the visible part of every light (which, and their models: the pipeline
+// variant): each light's exact unoccluded irradiance times its visible fraction (a single ray for a delta sun and
+// a small-source disk); every fraction is 1 without shadows.
+vec3 irradiance_visible(Frame p) {
+    vec3 position = p.position;
+    vec3 normal = p.normal;
+    uint k = lights.sampling.y;
     vec3 e = vec3(0.0);
     if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
-        float n_dot_l = dot(normal, lights.sun.direction.xyz);
+        vec3 l = lights.sun.direction.xyz;
+        float n_dot_l = dot(normal, l);
+        float delta = lights.sun.direction.w;
+        vec3 unoccluded;
         if (VARIANT_SUN == SUN_DELTA) {
-            e += sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
+            unoccluded = sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
         } else {
-            e += sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, lights.sun.direction.w);
+            unoccluded = sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, delta);
         }
+        float v = 1.0;
+        if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
+            v = VARIANT_SUN == SUN_DELTA ? (visible_along(p.shadow_origin, l) ? 1.0 : 0.0)
+                                         : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+        }
+        e += unoccluded * v;
     }
     for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
         DiskGpu d = lights.disks[i];
         float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
             ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
             : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        float v = 1.0;
+        if (SHADOWS_ON && omega > 0.0) {
+            v = VARIANT_DISKS == DISKS_SMALL_SOURCE
+                ? (visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0)
+                : disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        }
+        omega = omega * v;
         e += d.radiance.rgb * omega;
     }
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
-        e += sky_irradiance(lights.sky.rgb, normal.y);
+        float v = 1.0;
+        if (SHADOWS_ON && normal.y > -1.0) {
+            v = sky_visible_fraction(p.shadow_origin, k, normal);
+        }
+        e += sky_irradiance(lights.sky.rgb, normal.y) * v;
     }
     return e;
 }
@@ -91,7 +126,7 @@ vec2 sinh_warp_ends(float a, float b, float c, float w) {
 // integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance, for the disk of radius
 // `radius` centred at q from the point, emitting along d: segment coordinates, the grid graded about the lobe's
 // peak (see the Rust).
-float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis) {
+float segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
     vec3 n = p.normal;
     float h = -dot(d, q);
     if (!(h > 0.0 && radius > 0.0)) {
@@ -147,12 +182,19 @@ float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius
             float dist = sqrt(dist2);
             vec3 omega = y / dist;
             float c = dot(n, omega);
-            if (c > 0.0) {
+            // A sample that contributes casts its shadow ray (&& and || short-circuit).
+            if (c > 0.0 && (rays == RAYS_NONE || (rays == RAYS_ALONG ? visible_along(p.shadow_origin, omega)
+                                                                   : visible_to(p.shadow_origin, p.position + y)))) {
                 sum += specular_lobe(m, p, omega) * c * h / (dist2 * dist) * radius * radius * sb * sb * bw.y * sw.y;
             }
         }
     }
     return sum / (k * k);
+}
+
+// segment_lobe_integral_visible without shadow rays.
+float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis) {
+    return segment_lobe_integral_visible(m, p, q, d, radius, per_axis, RAYS_NONE);
 }
 
 // integral of lobe (n.w)+ over the part of a disk light above the horizon, per unit radiance.
@@ -178,7 +220,7 @@ vec3 cos_power_direction(vec3 axis, vec3 t, vec3 b, float exponent, float xi1, f
 
 // integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
 // inverse CDF, each sample weighted by lobe/pdf (see the Rust).
-float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
+float sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
     vec3 n = p.normal;
     vec3 v = p.to_viewer;
     uint kind = VARIANT_BRDF;
@@ -196,14 +238,20 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
             if (kind == BRDF_PHONG) {
                 float e = m.ks.w;
                 vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
-                sum += (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
+                float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
+                if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                    sum += value;
+                }
             } else if (kind == BRDF_BLINN_PHONG) {
                 float e = m.ks.w;
                 vec3 h = cos_power_direction(axis, t, b, e, xi1, phi);
                 float vh = dot(v, h);
                 if (vh > 0.0) {
                     vec3 omega = 2.0 * vh * h - v;
-                    sum += blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
+                    float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
+                    if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
                 }
             } else if (kind == BRDF_WARD) {
                 float ax = m.params.x;
@@ -218,7 +266,10 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
                 float vh = dot(v, h);
                 if (vh > 0.0) {
                     vec3 omega = 2.0 * vh * h - v;
-                    sum += max(dot(n, omega), 0.0) / (vh * cos_d);
+                    float value = max(dot(n, omega), 0.0) / (vh * cos_d);
+                    if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
                 }
             }
         }
@@ -226,13 +277,19 @@ float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
     return sum / (k * k);
 }
 
-// Outgoing radiance [W/(m^2 sr)] per channel. `p.normal` is unit (or 0) on the side being seen.
+// sky_lobe_integral_visible without shadow rays.
+float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
+    return sky_lobe_integral_visible(m, p, per_axis, false);
+}
+
+// Outgoing radiance [W/(m^2 sr)] per channel from the visible part of each light. `p.normal` is unit (or 0) on
+// the side being seen.
 vec3 radiance_out(MaterialGpu material, Frame p) {
     // An undefined (zero) normal reflects nothing: n.l = 0 would otherwise read as a surface edge-on to every light.
     if (dot(p.normal, p.normal) == 0.0) {
         return vec3(0.0);
     }
-    vec3 radiance = lambert_brdf(material.kd.rgb) * irradiance(p.position, p.normal);
+    vec3 radiance = lambert_brdf(material.kd.rgb) * irradiance_visible(p);
     if (VARIANT_BRDF == BRDF_LAMBERT) {
         return radiance;
     }
@@ -240,11 +297,17 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
     if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
         vec3 l = lights.sun.direction.xyz;
         if (VARIANT_SUN == SUN_DELTA) {
-            specular += specular_lobe(material, p, l) * max(dot(p.normal, l), 0.0) * lights.sun.irradiance.rgb;
+            float factor = specular_lobe(material, p, l) * max(dot(p.normal, l), 0.0);
+            if (SHADOWS_ON && factor > 0.0 && !visible_along(p.shadow_origin, l)) {
+                factor = 0.0;
+            }
+            specular += factor * lights.sun.irradiance.rgb;
         } else {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
-            float integral = sun_lobe_integral(material, p, l, delta, lights.sampling.x);
+            float radius = tan(0.5 * delta);
+            float integral = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
+                SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
             specular += integral * lights.sun.irradiance.rgb / (PI * s * s);
         }
     }
@@ -255,13 +318,17 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             vec3 to_center = safe_normalize(d.center_radius.xyz - p.position);
             integral = specular_lobe(material, p, to_center)
                 * disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+            if (SHADOWS_ON && integral > 0.0 && !visible_to(p.shadow_origin, d.center_radius.xyz)) {
+                integral = 0.0;
+            }
         } else {
-            integral = disk_lobe_integral(material, p, d.center_radius.xyz, d.direction.xyz, d.center_radius.w, lights.counts.w);
+            integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
+                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE);
         }
         specular += integral * d.radiance.rgb;
     }
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
-        specular += sky_lobe_integral(material, p, lights.counts.w) * lights.sky.rgb;
+        specular += sky_lobe_integral_visible(material, p, lights.counts.w, SHADOWS_ON) * lights.sky.rgb;
     }
     return radiance + material.ks.rgb * specular;
 }

@@ -132,9 +132,15 @@ impl CheckedRenderer {
         self.renderer.as_ref().expect("alive").device_info().sub_pixel_precision_bits
     }
 
-    /// The reference options that mirror this device (its sub-pixel bits; FMA as the host has it).
+    /// The reference options that mirror this device (its sub-pixel bits and whether it has ray queries; FMA
+    /// as the host has it).
     pub fn reference_options(&self) -> ReferenceOptions {
-        ReferenceOptions { sub_pixel_bits: self.sub_pixel_bits(), ..Default::default() }
+        let info = self.renderer.as_ref().expect("alive").device_info();
+        ReferenceOptions {
+            sub_pixel_bits: self.sub_pixel_bits(),
+            device_ray_queries: info.ray_query,
+            ..Default::default()
+        }
     }
 }
 

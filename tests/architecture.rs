@@ -57,7 +57,7 @@ fn glsl_functions(text: &str) -> Vec<String> {
 fn every_glsl_shading_function_has_a_rust_twin() {
     let rust: String = sources("src/shading").into_iter().map(|(_, t)| t).collect();
     let mut checked = 0;
-    for file in ["radiometry.glsl", "brdf.glsl", "shade.glsl"] {
+    for file in ["radiometry.glsl", "brdf.glsl", "shade.glsl", "visibility.glsl"] {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders").join(file)).unwrap();
         for name in glsl_functions(&text) {
             assert!(

@@ -15,7 +15,7 @@ use sunshade::authoring::chart;
 use sunshade::authoring::shapes::quad;
 use sunshade::authoring::{GltfBuilder, Node};
 use sunshade::compare::{self, DiffOptions};
-use sunshade::cpu::{self, ReferenceOptions};
+use sunshade::cpu;
 use sunshade::scene::{Camera, Lights, Projection, Scene, Sun};
 use sunshade::settings::RenderSettings;
 use sunshade::shading::{ShadingOptions, SunModel};
@@ -99,11 +99,7 @@ fn brdf_chart_gpu_against_reference() {
             let mut s = RenderSettings::new(256, 256, scene.cameras[0].1, lights);
             s.shading = ShadingOptions { sun: SunModel::Delta, ..Default::default() };
             let g = gpu.render(&scene, &s);
-            let c = cpu::render(
-                &scene,
-                &s,
-                &ReferenceOptions { sub_pixel_bits: gpu.sub_pixel_bits(), ..Default::default() },
-            );
+            let c = cpu::render(&scene, &s, &gpu.reference_options());
             assert!(
                 g.pixels().iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)),
                 "{name}: non-finite pixel"
@@ -187,11 +183,7 @@ fn light_at_and_below_the_horizon() {
                     let mut s = RenderSettings::new(48, 48, camera, lights);
                     s.shading = ShadingOptions { sun: model, ..Default::default() };
                     let g = gpu.render(&scene, &s);
-                    let c = cpu::render(
-                        &scene,
-                        &s,
-                        &ReferenceOptions { sub_pixel_bits: gpu.sub_pixel_bits(), ..Default::default() },
-                    );
+                    let c = cpu::render(&scene, &s, &gpu.reference_options());
                     let what = format!("{extras} sun at elevation {elevation}, azimuth {azimuth}, {model:?}");
                     assert!(
                         g.pixels().iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)),

@@ -167,10 +167,25 @@ fn render_check_and_diff_agree_and_report() {
     let dir = TempDir::new("cli-check");
     let input = dir.write("scene.glb", &scene());
     let (gpu, cpu, heat) = (dir.path("gpu.exr"), dir.path("cpu.exr"), dir.path("heat.png"));
-    let o = sunshade(&["render", s(&input), "-o", s(&gpu), "--width", "160", "--height", "120", "--check"]);
+    // Unshadowed, so that the two commands agree on every device (without ray queries `render` casts no shadows;
+    // tests/shadows.rs compares shadows where it does).
+    let o = sunshade(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&gpu),
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--check",
+        "--shadows",
+        "none",
+    ]);
     assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("result: PASS"));
-    let o = sunshade(&["reference", s(&input), "-o", s(&cpu), "--width", "160", "--height", "120"]);
+    let o =
+        sunshade(&["reference", s(&input), "-o", s(&cpu), "--width", "160", "--height", "120", "--shadows", "none"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = sunshade(&["diff", s(&gpu), s(&cpu), "--heatmap", s(&heat), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));

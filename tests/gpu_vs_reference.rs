@@ -14,7 +14,7 @@ use glam::{DVec3, Quat, Vec3};
 use sunshade::authoring::shapes::{cube, grid, quad, triangle_soup, uv_sphere, MeshData};
 use sunshade::authoring::{GltfBuilder, Node, Transform};
 use sunshade::compare::{self, DiffOptions, PixelDiff};
-use sunshade::cpu::{self, ReferenceOptions};
+use sunshade::cpu;
 use sunshade::scene::{Camera, DiskLight, Lights, Projection, Scene, Sun};
 use sunshade::settings::{self, CameraOptions, RenderSettings, SunOptions};
 use sunshade::shading::{DiskModel, ShadingOptions, SunModel};
@@ -37,7 +37,7 @@ fn check_with(
     max_mismatches: usize,
 ) -> (usize, f64) {
     let g = gpu.render(scene, s);
-    let options = ReferenceOptions { sub_pixel_bits: gpu.sub_pixel_bits(), ..Default::default() };
+    let options = gpu.reference_options();
     let c = cpu::render(scene, s, &options);
     let (report, per_pixel) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
     println!(
@@ -397,7 +397,7 @@ fn spheres_near_the_terminator_pass_the_default_tolerance() {
                 SunOptions { azimuth_degrees: Some(azimuth), elevation_degrees: Some(elevation), ..Default::default() };
             let s = settings::resolve(&scene, 1024, 1024, &CameraOptions::default(), &sun).unwrap();
             let g = gpu.render(&scene, &s);
-            let options = ReferenceOptions { sub_pixel_bits: gpu.sub_pixel_bits(), ..Default::default() };
+            let options = gpu.reference_options();
             let c = cpu::render(&scene, &s, &options);
             let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
             // The radiance of a surface facing the sun, ρ E⊥ = 0.8/π × 1000 W/(m²·sr).

@@ -10,7 +10,7 @@ use serde_json::json;
 use std::f64::consts::PI;
 use sunshade::authoring::shapes::{grid, quad, uv_sphere, MeshData};
 use sunshade::authoring::{GltfBuilder, Node, Primitive, Transform};
-use sunshade::cpu::{self, ReferenceOptions};
+use sunshade::cpu;
 use sunshade::scene::{Camera, Lights, Projection, Scene, Sun};
 use sunshade::settings::RenderSettings;
 use sunshade::shading::quadrature::integrate_composite;
@@ -23,7 +23,7 @@ const ALBEDO: f32 = 0.5;
 /// The GPU and the CPU image of the same settings.
 fn both(gpu: &mut CheckedRenderer, scene: &Scene, s: &RenderSettings) -> [(&'static str, Image); 2] {
     let g = gpu.render(scene, s);
-    let c = cpu::render(scene, s, &ReferenceOptions { sub_pixel_bits: gpu.sub_pixel_bits(), ..Default::default() });
+    let c = cpu::render(scene, s, &gpu.reference_options());
     [("gpu", g), ("cpu", c)]
 }
 

@@ -9,7 +9,10 @@ use crate::film::{Exposure, ImageFormat};
 use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
-use crate::shading::{DiskModel, ShadingOptions, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS};
+use crate::shading::{
+    DiskModel, ShadingOptions, Shadows, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+    DEFAULT_SUN_SAMPLES_PER_AXIS,
+};
 
 /// `x,y,z` → a finite vector.
 pub fn parse_vec3(s: &str) -> Result<DVec3, String> {
@@ -222,6 +225,16 @@ pub struct SceneArgs {
     /// [default: 64].
     #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
+
+    /// Shadows: `auto` (ray queries where the device has them, else shadow maps; none where nothing can occlude
+    /// a light), `none`, `ray` or `map`. The reference casts rays for every technique but `none`.
+    #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
+    pub shadows: Shadows,
+
+    /// Shadow rays per light and pixel for each light's visible fraction (a stratified grid over the light;
+    /// rounded up to a square; 1: the light's centre alone, a hard shadow).
+    #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_SAMPLES_PER_AXIS * DEFAULT_SHADOW_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub shadow_samples: u32,
 }
 
 /// The side of the smallest square grid with at least `samples` cells.
@@ -261,6 +274,8 @@ impl SceneArgs {
                 disk: self.disk_model,
                 sun_samples_per_axis: self.sun_samples.map_or(DEFAULT_SUN_SAMPLES_PER_AXIS, per_axis),
                 samples_per_axis: per_axis(self.samples),
+                shadows: self.shadows,
+                shadow_samples_per_axis: per_axis(self.shadow_samples),
             },
         }
     }

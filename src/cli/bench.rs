@@ -18,7 +18,7 @@ use crate::cpu::{self, ReferenceOptions};
 use crate::gpu::{ContextOptions, DeviceInfo, Interpolation, Renderer};
 use crate::scene::{self, LoadOptions};
 use crate::settings::{self, CameraOptions, SunOptions};
-use crate::shading::SunModel;
+use crate::shading::{Shadows, SunModel};
 use glam::DVec3;
 
 #[derive(Args, Debug)]
@@ -59,27 +59,43 @@ pub struct BenchArgs {
     /// frame time of each. Its --update region is "brdf-chart".
     #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs"])]
     pub brdf_chart: bool,
+    /// Instead of scenes, measure the shadow techniques and sample counts on shadowed scenes (the teapot on a
+    /// floor under the sun, the room under its skylight; 256 × 192 unless --width/--height are given): GPU frame
+    /// time, CPU reference time, and the visible-fraction error against a converged reference. Run from the
+    /// repository (it reads models/); GPU rows need ray queries (`eval "$(scripts/lavapipe-rt.sh)"`). Its
+    /// --update region is "shadows".
+    #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs", "brdf_chart"])]
+    pub shadows: bool,
     /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
     #[arg(long)]
     pub json: bool,
 }
 
-fn median(mut v: Vec<Duration>) -> Duration {
+pub(super) fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
     v[v.len() / 2]
 }
 
-fn ms(d: Duration) -> f64 {
+pub(super) fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
-    let region = if a.brdf_chart { "brdf-chart" } else { "" };
+    let region = if a.brdf_chart {
+        "brdf-chart"
+    } else if a.shadows {
+        "shadows"
+    } else {
+        ""
+    };
     for doc in &a.update {
         check_region(doc, region)?;
     }
     if a.brdf_chart {
         return brdf_chart(a);
+    }
+    if a.shadows {
+        return super::bench_shadows::run(a);
     }
     let (width, height) = (a.width.unwrap_or(1024), a.height.unwrap_or(1024));
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
@@ -126,11 +142,11 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn device_description(info: &DeviceInfo) -> String {
+pub(super) fn device_description(info: &DeviceInfo) -> String {
     format!("{} ({}, {} {})", info.name, info.type_name(), info.driver_name, info.driver_info)
 }
 
-fn build() -> &'static str {
+pub(super) fn build() -> &'static str {
     if cfg!(debug_assertions) {
         "debug"
     } else {
@@ -192,6 +208,8 @@ fn brdf_chart_in(a: &BenchArgs, dir: &Path, width: u32, height: u32) -> Result<S
             let mut s = settings::resolve(&scene, width, height, &CameraOptions::default(), &sun)
                 .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
             s.shading.sun = SunModel::Delta;
+            // The BRDF chart measures the lobes, unshadowed (shadows have their own table).
+            s.shading.shadows = Shadows::None;
             let cpu_image = cpu::render(&scene, &s, &reference);
             let mut uploaded = Vec::new();
             for (k, renderer) in renderers.iter_mut().enumerate() {
@@ -239,8 +257,10 @@ fn bench_scenes(
     let mut rows = Vec::new();
     for path in scenes {
         let scene = scene::load_with_options(path, &LoadOptions::default())?;
-        let s = settings::resolve(&scene, width, height, &CameraOptions::default(), &SunOptions::default())
+        let mut s = settings::resolve(&scene, width, height, &CameraOptions::default(), &SunOptions::default())
             .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        // This table measures the renderers' agreement unshadowed (shadows have their own table).
+        s.shading.shadows = Shadows::None;
         let gpu_scene = renderer.upload(&scene)?;
         let (gpu_image, _) = renderer.render(&gpu_scene, &s)?; // warm-up: the device compiles shaders at first draw
         let mut gpu_times = Vec::new();

@@ -36,6 +36,8 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "sun_samples": sh.sun_samples_per_axis * sh.sun_samples_per_axis,
         "disk_model": match sh.disk { DiskModel::Exact => "exact", DiskModel::SmallSource => "small-source" },
         "samples": sh.samples_per_axis * sh.samples_per_axis,
+        "shadows": sh.shadows.name(),
+        "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
         "camera": { "eye": cam.eye.to_array(), "forward": cam.forward.to_array(), "up": cam.up.to_array(),
                     "orthographic": cam.is_orthographic() },
         "worldToNDC": "Vulkan clip space before the divide by w: x right, y down, depth in [0, 1]",

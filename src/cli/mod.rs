@@ -7,6 +7,7 @@ mod albedo;
 mod args;
 mod batch;
 mod bench;
+mod bench_shadows;
 mod diff;
 mod generated;
 mod info;

@@ -26,6 +26,8 @@ impl ReferenceArgs {
         ReferenceOptions {
             sub_pixel_bits: self.sub_pixel_bits,
             fused_viewport: self.fused_viewport.unwrap_or_else(cpu::host_has_fma),
+            // The reference is the truth: `--shadows auto` casts rays wherever something can occlude.
+            device_ray_queries: true,
         }
     }
 }
@@ -56,9 +58,12 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     a.output.check()?;
     a.scene.check()?;
     cpu::check_size(a.scene.width, a.scene.height, a.max_pixels).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-    let (scene, settings, load_time) = load_scene(&a.scene)?;
+    let (scene, mut settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
-    let image = cpu::render(&scene, &settings, &a.reference.options());
+    let options = a.reference.options();
+    let choice = cpu::shadow_choice(&scene, &settings, &options);
+    settings.shading.shadows = choice.technique;
+    let image = cpu::render(&scene, &settings, &options);
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
@@ -73,6 +78,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
+        eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
         print_exposure(ev);
         print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())], started.elapsed());
     }

@@ -89,7 +89,10 @@ impl RenderArgs {
 /// A rendered job, not yet written.
 pub struct Rendered {
     pub image: Image,
+    /// The settings it was rendered with, `shadows` the technique actually used (never `auto`).
     pub settings: RenderSettings,
+    /// Why that shadow technique.
+    pub shadow_reason: String,
     pub frame: FrameTimings,
     pub load: Duration,
     pub upload: Duration,
@@ -108,17 +111,26 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     session.renderer_mut(renderer).check_size(settings.width, settings.height)?;
     let upload = session.upload(scene, renderer)?;
     let (_, gpu_scene, r) = session.parts(scene, renderer);
+    let choice = r.shadow_choice(gpu_scene, &settings)?;
+    if choice.warning {
+        super::warn(&format!("shadows: {}", choice.reason));
+    }
+    let mut settings = settings;
+    settings.shading.shadows = choice.technique;
     let (image, frame) = r.render(gpu_scene, &settings)?;
     warn_if_nothing_covered(&image, &a.scene.scene);
-    Ok(Rendered { image, settings, frame, load, upload, scene, renderer })
+    Ok(Rendered { image, settings, shadow_reason: choice.reason, frame, load, upload, scene, renderer })
 }
 
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
 /// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
 pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> Image {
-    let sub_pixel_bits = session.renderer_mut(job.renderer).device_info().sub_pixel_precision_bits;
-    let options =
-        ReferenceOptions { sub_pixel_bits, fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma) };
+    let info = session.renderer_mut(job.renderer).device_info();
+    let options = ReferenceOptions {
+        sub_pixel_bits: info.sub_pixel_precision_bits,
+        fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
+        device_ray_queries: info.ray_query,
+    };
     cpu::render(session.scene_ref(job.scene), &job.settings, &options)
 }
 
@@ -187,6 +199,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             job.settings.height,
             job.image.covered_count()
         );
+        eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
         print_exposure(ev);
         match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {
             (None, _) => eprintln!("sunshade: pipeline cache: off"),

@@ -10,7 +10,8 @@
 //!    rule, depth test LESS against a cleared depth of 1;
 //! 5. [`barycentric`]: the fragment shader's own perspective-correct barycentrics in the (unclipped) triangle,
 //!    which interpolate world position and normal; depth is interpolated in window space ([`interpolate`]);
-//! 6. shading in f64 by [`crate::shading`], the specification the GLSL mirrors.
+//! 6. shading in f64 by [`crate::shading`], the specification the GLSL mirrors, with shadow rays in f64 through a
+//!    BVH of every triangle ([`crate::visibility`]) where the scene can shadow itself.
 //!
 //! Rows are rendered in parallel bands (rayon); triangles are binned by band and kept in submission order, so
 //! depth ties resolve as on the device (the first drawn wins). Nothing here calls into `gpu`.
@@ -35,7 +36,9 @@ use crate::film::Image;
 use crate::scene::tangent::orthonormal_tangent;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::{radiance_out, safe_normalize, SurfacePoint};
+use crate::shading::visibility::shadow_ray_origin;
+use crate::shading::{radiance_out, radiance_out_visible, safe_normalize, Occlusion, Shadowing, Shadows, SurfacePoint};
+use crate::visibility::{Bvh, ShadowChoice};
 
 /// How the reference mirrors the device.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,11 +49,15 @@ pub struct ReferenceOptions {
     /// JIT does where the host CPU has FMA: measured on a dense lattice of isolated triangles at 1000×1000, the
     /// fused mirror matched lavapipe's coverage exactly and the unfused one did not.
     pub fused_viewport: bool,
+    /// Whether the device has ray queries, for `--shadows auto`: a device without them would use shadow maps,
+    /// which sunshade does not have yet, and renders every light unoccluded; the reference then does the same,
+    /// so that it mirrors what the device computed. (An explicit `ray` or `map` always gets rays.)
+    pub device_ray_queries: bool,
 }
 
 impl Default for ReferenceOptions {
     fn default() -> Self {
-        Self { sub_pixel_bits: 8, fused_viewport: host_has_fma() }
+        Self { sub_pixel_bits: 8, fused_viewport: host_has_fma(), device_ray_queries: true }
     }
 }
 
@@ -109,8 +116,48 @@ struct Prepared {
     flip_normal: bool,
 }
 
-/// Renders `scene` as the GPU path would, on the CPU.
+/// The reference's shadow technique for this scene and these settings, and why (see
+/// [`crate::visibility::choose_reference`]).
+pub fn shadow_choice(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> ShadowChoice {
+    let requested = settings.shading.shadows;
+    let can_occlude = requested != Shadows::Auto || crate::visibility::can_occlude(scene);
+    let choice = crate::visibility::choose_reference(requested, &settings.lights, can_occlude);
+    if requested == Shadows::Auto && choice.technique == Shadows::Ray && !options.device_ray_queries {
+        return ShadowChoice {
+            technique: Shadows::None,
+            reason: "auto, mirroring a device without ray queries (and so without shadows)".into(),
+            warning: true,
+        };
+    }
+    choice
+}
+
+/// Every triangle of the scene in world space, for the shadow rays.
+pub fn occluder_bvh(scene: &Scene) -> Bvh {
+    let triangles = scene
+        .meshes
+        .iter()
+        .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
+        .collect();
+    Bvh::new(triangles)
+}
+
+/// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
+    let occluders = match shadow_choice(scene, settings, options).technique {
+        Shadows::None => None,
+        _ => Some(occluder_bvh(scene)),
+    };
+    render_with(scene, settings, options, occluders.as_ref().map(|b| b as &dyn Occlusion))
+}
+
+/// Renders with these occluders (`None`: every light unoccluded).
+pub fn render_with(
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+    occluders: Option<&dyn Occlusion>,
+) -> Image {
     let (width, height) = (settings.width, settings.height);
     let triangles = prepare(scene, settings, options);
 
@@ -151,7 +198,7 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
                 let (x, y) = (k as u32 % width, y0 + k as u32 / width);
                 let t = &triangles[ti as usize];
                 let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
-                let radiance = shade(scene, settings, t, w.to_array(), viewer);
+                let radiance = shade(scene, settings, t, w.to_array(), viewer, occluders);
                 pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
             }
         },
@@ -234,7 +281,14 @@ fn prepare(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions)
 }
 
 /// Radiance at the point of triangle `t` with barycentrics `w`.
-fn shade(scene: &Scene, settings: &RenderSettings, t: &Prepared, w: [f64; 3], viewer: glam::Vec4) -> [f64; 3] {
+fn shade(
+    scene: &Scene,
+    settings: &RenderSettings,
+    t: &Prepared,
+    w: [f64; 3],
+    viewer: glam::Vec4,
+    occluders: Option<&dyn Occlusion>,
+) -> [f64; 3] {
     let mut a = [0.0f64; ATTRIBUTES];
     for (k, slot) in a.iter_mut().enumerate() {
         *slot = w[0] * t.attributes[0][k] + w[1] * t.attributes[1][k] + w[2] * t.attributes[2][k];
@@ -254,5 +308,21 @@ fn shade(scene: &Scene, settings: &RenderSettings, t: &Prepared, w: [f64; 3], vi
         viewer.truncate().as_dvec3()
     };
     let point = SurfacePoint { position, normal, tangent, bitangent, to_viewer };
-    radiance_out(&scene.materials[t.material], &point, &settings.lights, &settings.shading)
+    let material = &scene.materials[t.material];
+    let Some(occluders) = occluders else {
+        return radiance_out(material, &point, &settings.lights, &settings.shading);
+    };
+    // The shadow rays' origin from the triangle's corners and vertex normals (on the side being shaded).
+    let corner = |k: usize| DVec3::new(t.attributes[k][0], t.attributes[k][1], t.attributes[k][2]);
+    let sign = if t.flip_normal { -1.0 } else { 1.0 };
+    let vertex_normal =
+        |k: usize| sign * safe_normalize(DVec3::new(t.attributes[k][3], t.attributes[k][4], t.attributes[k][5]));
+    let corners = [corner(0), corner(1), corner(2)];
+    let normals = [vertex_normal(0), vertex_normal(1), vertex_normal(2)];
+    let shadow = Shadowing {
+        origin: shadow_ray_origin(&corners, &normals, w, position, normal),
+        occluders,
+        samples_per_axis: settings.shading.shadow_samples_per_axis,
+    };
+    radiance_out_visible(material, &point, &settings.lights, &settings.shading, Some(&shadow))
 }

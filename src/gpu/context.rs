@@ -253,10 +253,26 @@ impl Device {
             // shaderFloat64 where present: the fragment shader's barycentrics in f64.
             let features =
                 vk::PhysicalDeviceFeatures::default().geometry_shader(true).shader_float64(info.shader_float64);
-            let create_info = vk::DeviceCreateInfo::default()
+            // Ray queries (shadow rays) where the device has them: the extensions, their features and buffer
+            // device addresses (acceleration structures are built from buffer addresses).
+            let rq = info.ray_query;
+            let mut features12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(rq);
+            let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
+            let mut query = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
+            let rq_extensions = [
+                ash::khr::acceleration_structure::NAME.as_ptr(),
+                ash::khr::ray_query::NAME.as_ptr(),
+                ash::khr::deferred_host_operations::NAME.as_ptr(),
+            ];
+            let mut create_info = vk::DeviceCreateInfo::default()
                 .queue_create_infos(&queue_info)
                 .enabled_features(&features)
-                .push_next(&mut features13);
+                .push_next(&mut features13)
+                .push_next(&mut features12);
+            if rq {
+                create_info =
+                    create_info.enabled_extension_names(&rq_extensions).push_next(&mut accel).push_next(&mut query);
+            }
             let device = instance.instance.create_device(physical, &create_info, None).vk("vkCreateDevice")?;
             let queue = device.get_device_queue(queue_family, 0);
             let allocator = Allocator::new(&AllocatorCreateDesc {
@@ -264,7 +280,7 @@ impl Device {
                 device: device.clone(),
                 physical_device: physical,
                 debug_settings: Default::default(),
-                buffer_device_address: false,
+                buffer_device_address: info.ray_query,
                 allocation_sizes: Default::default(),
             });
             let allocator = match allocator {

@@ -32,8 +32,11 @@ pub struct DeviceInfo {
     pub graphics_queue_family: Option<u32>,
     /// Why sunshade cannot use this device, if it cannot.
     pub unusable: Option<String>,
-    /// `VK_KHR_ray_query` and `VK_KHR_acceleration_structure` are both offered (ray-traced visibility possible).
+    /// `VK_KHR_ray_query`, `VK_KHR_acceleration_structure` (with `VK_KHR_deferred_host_operations`) and their
+    /// features, and `bufferDeviceAddress`: shadow rays on the GPU possible (sunshade enables them all then).
     pub ray_query: bool,
+    /// `minAccelerationStructureScratchOffsetAlignment` (0 without acceleration structures).
+    pub min_acceleration_structure_scratch_offset_alignment: u32,
     /// `vendorID`, `deviceID`, `driverVersion` and `pipelineCacheUUID`: what a pipeline cache is valid for.
     pub vendor_id: u32,
     pub device_id: u32,
@@ -110,10 +113,34 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
         };
         let extensions = instance.enumerate_device_extension_properties(physical).unwrap_or_default();
         let offers = |name: &std::ffi::CStr| extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
-        let ray_query = offers(c"VK_KHR_ray_query") && offers(c"VK_KHR_acceleration_structure");
+        let ray_query = offers(c"VK_KHR_ray_query")
+            && offers(c"VK_KHR_acceleration_structure")
+            && offers(c"VK_KHR_deferred_host_operations")
+            && {
+                let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+                let mut query = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+                let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+                let mut features = vk::PhysicalDeviceFeatures2::default()
+                    .push_next(&mut accel)
+                    .push_next(&mut query)
+                    .push_next(&mut v12);
+                instance.get_physical_device_features2(physical, &mut features);
+                accel.acceleration_structure == vk::TRUE
+                    && query.ray_query == vk::TRUE
+                    && v12.buffer_device_address == vk::TRUE
+            };
+        let min_acceleration_structure_scratch_offset_alignment = if ray_query {
+            let mut accel = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+            let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut accel);
+            instance.get_physical_device_properties2(physical, &mut props2);
+            accel.min_acceleration_structure_scratch_offset_alignment
+        } else {
+            0
+        };
         DeviceInfo {
             index,
             ray_query,
+            min_acceleration_structure_scratch_offset_alignment,
             vendor_id: props.vendor_id,
             device_id: props.device_id,
             driver_version: props.driver_version,

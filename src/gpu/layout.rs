@@ -16,9 +16,12 @@ pub const SUN_DELTA: u32 = 2;
 pub const DISKS_EXACT: u32 = 1;
 pub const DISKS_SMALL_SOURCE: u32 = 2;
 pub const SKY_PRESENT: u32 = 1;
+pub const SHADOWS_NONE: u32 = 0;
+pub const SHADOWS_RAY: u32 = 1;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 3). The shader keeps only the code these select.
+/// `shaders/bindings.glsl`, constant ids 0 to 4). The shader keeps only the code these select; `shadows` also
+/// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
     /// `BRDF_*` of the draw's material.
@@ -29,11 +32,13 @@ pub struct ShaderVariant {
     pub disks: u32,
     /// `LIGHT_ABSENT` or `SKY_PRESENT`.
     pub sky: u32,
+    /// `SHADOWS_NONE` or `SHADOWS_RAY`.
+    pub shadows: u32,
 }
 
 impl ShaderVariant {
     /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights.
-    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions) -> Self {
+    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions, shadow_rays: bool) -> Self {
         let sun = match (&lights.sun, shading.sun) {
             (None, _) => LIGHT_ABSENT,
             (Some(_), SunModel::Disk) => SUN_DISK,
@@ -45,12 +50,13 @@ impl ShaderVariant {
             (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
         };
         let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
-        Self { brdf, sun, disks, sky }
+        let shadows = if shadow_rays { SHADOWS_RAY } else { SHADOWS_NONE };
+        Self { brdf, sun, disks, sky, shadows }
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 4] {
-        [self.brdf, self.sun, self.disks, self.sky]
+    pub fn constants(&self) -> [u32; 5] {
+        [self.brdf, self.sun, self.disks, self.sky, self.shadows]
     }
 }
 
@@ -96,7 +102,7 @@ pub struct LightsHeader {
     pub sky: [f32; 4],
     /// Disk count, unused, unused, samples per axis for disks and the sky.
     pub counts: [u32; 4],
-    /// Samples per axis over the sun's disk; the rest unused.
+    /// Samples per axis over the sun's disk, shadow samples per axis (visible fractions); the rest unused.
     pub sampling: [u32; 4],
 }
 
@@ -145,7 +151,7 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
         sun,
         sky,
         counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
-        sampling: [shading.sun_samples_per_axis, 0, 0, 0],
+        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, 0, 0],
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
@@ -175,6 +181,36 @@ pub fn push_constants(settings: &RenderSettings, material: u32, first_index: u32
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn glsl_constants_match() {
+        let glsl = include_str!("../../shaders/bindings.glsl");
+        let constants = [
+            ("BRDF_LAMBERT", BRDF_LAMBERT),
+            ("BRDF_PHONG", BRDF_PHONG),
+            ("BRDF_BLINN_PHONG", BRDF_BLINN_PHONG),
+            ("BRDF_WARD", BRDF_WARD),
+            ("LIGHT_ABSENT", LIGHT_ABSENT),
+            ("SUN_DISK", SUN_DISK),
+            ("SUN_DELTA", SUN_DELTA),
+            ("DISKS_EXACT", DISKS_EXACT),
+            ("DISKS_SMALL_SOURCE", DISKS_SMALL_SOURCE),
+            ("SKY_PRESENT", SKY_PRESENT),
+            ("SHADOWS_NONE", SHADOWS_NONE),
+            ("SHADOWS_RAY", SHADOWS_RAY),
+        ];
+        for (name, value) in constants {
+            assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
+        }
+        for (id, name) in
+            ["VARIANT_BRDF", "VARIANT_SUN", "VARIANT_DISKS", "VARIANT_SKY", "VARIANT_SHADOWS"].iter().enumerate()
+        {
+            assert!(
+                glsl.contains(&format!("layout(constant_id = {id}) const uint {name} ")),
+                "{name} is not constant {id}"
+            );
+        }
+    }
 
     #[test]
     fn sizes_match_std430() {

@@ -7,8 +7,12 @@
 //! - `shaders`: the embedded GLSL and its run-time compilation;
 //! - `layout`: the byte layouts shared with the shaders;
 //! - `pipeline`: the graphics pipeline (dynamic rendering, RGBA32F + D32);
+//! - `commands`: record, submit, wait;
+//! - `accel`: acceleration structures for the shadow rays (ray queries);
 //! - `renderer`: upload, draw, readback.
 
+mod accel;
+mod commands;
 mod context;
 mod device_info;
 mod error;

@@ -15,7 +15,7 @@ use ash::vk;
 
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::layout::{PushConstants, ShaderVariant, Vertex};
+use super::layout::{PushConstants, ShaderVariant, Vertex, SHADOWS_RAY};
 use super::pipeline_cache::{self, DiskPipelineCache};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -29,6 +29,8 @@ pub(crate) struct ScenePipeline {
     pub descriptor_set: vk::DescriptorSet,
     vertex_module: vk::ShaderModule,
     fragment_module: vk::ShaderModule,
+    /// The fragment shader with shadow rays (devices with ray queries only).
+    ray_query_module: vk::ShaderModule,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
     cache: Option<DiskPipelineCache>,
@@ -43,6 +45,7 @@ impl ScenePipeline {
         dev: &Arc<Device>,
         vertex_spirv: &[u32],
         fragment_spirv: &[u32],
+        ray_query_spirv: Option<&[u32]>,
         with_normals: bool,
         cache_dir: Option<&Path>,
     ) -> Result<Self, GpuError> {
@@ -55,6 +58,7 @@ impl ScenePipeline {
             descriptor_set: vk::DescriptorSet::null(),
             vertex_module: vk::ShaderModule::null(),
             fragment_module: vk::ShaderModule::null(),
+            ray_query_module: vk::ShaderModule::null(),
             with_normals,
             variants: HashMap::new(),
             cache: None,
@@ -62,14 +66,26 @@ impl ScenePipeline {
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
-            // 0 materials, 1 lights, 2 indices, 3 vertices: all read by the fragment shader.
-            let bindings = [0, 1, 2, 3].map(|b| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-            });
+            // 0 materials, 1 lights, 2 indices, 3 vertices: all read by the fragment shader; 4 the scene's top-level
+            // acceleration structure, on devices with ray queries.
+            let mut bindings: Vec<_> = [0, 1, 2, 3]
+                .map(|b| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(b)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                })
+                .to_vec();
+            if ray_query_spirv.is_some() {
+                bindings.push(
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(4)
+                        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+                );
+            }
             out.set_layout = d
                 .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
                 .vk("vkCreateDescriptorSetLayout")?;
@@ -84,7 +100,14 @@ impl ScenePipeline {
                     None,
                 )
                 .vk("vkCreatePipelineLayout")?;
-            let pool_sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 4 }];
+            let mut pool_sizes =
+                vec![vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 4 }];
+            if ray_query_spirv.is_some() {
+                pool_sizes.push(vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+                    descriptor_count: 1,
+                });
+            }
             out.descriptor_pool = d
                 .create_descriptor_pool(
                     &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&pool_sizes),
@@ -104,8 +127,14 @@ impl ScenePipeline {
             out.fragment_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None)
                 .vk("vkCreateShaderModule")?;
-            let name =
-                pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&[vertex_spirv, fragment_spirv]));
+            if let Some(words) = ray_query_spirv {
+                out.ray_query_module = d
+                    .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
+                    .vk("vkCreateShaderModule")?;
+            }
+            let mut hashed = vec![vertex_spirv, fragment_spirv];
+            hashed.extend(ray_query_spirv);
+            let name = pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&hashed));
             out.cache = Some(DiskPipelineCache::open(d, cache_dir, &name)?);
         }
         Ok(out)
@@ -125,10 +154,18 @@ impl ScenePipeline {
         self.cache.as_ref().map_or(Ok(()), |c| unsafe { c.save(&self.dev.device) })
     }
 
+    /// Whether pipelines with shadow rays can be made (the device has ray queries).
+    pub fn has_ray_queries(&self) -> bool {
+        self.ray_query_module != vk::ShaderModule::null()
+    }
+
     /// The pipeline of a variant, created on first use. Returns it and whether it was created now.
     pub fn variant(&mut self, variant: ShaderVariant) -> Result<(vk::Pipeline, bool), GpuError> {
         if let Some(&p) = self.variants.get(&variant) {
             return Ok((p, false));
+        }
+        if variant.shadows == SHADOWS_RAY && !self.has_ray_queries() {
+            return Err(GpuError::Unsupported(format!("{} has no ray queries for shadow rays", self.dev.info.name)));
         }
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
         // SAFETY: valid device, layout, modules and cache owned by self.
@@ -138,7 +175,7 @@ impl ScenePipeline {
                 cache,
                 self.layout,
                 self.vertex_module,
-                self.fragment_module,
+                if variant.shadows == SHADOWS_RAY { self.ray_query_module } else { self.fragment_module },
                 self.with_normals,
                 variant,
             )?
@@ -243,6 +280,7 @@ impl Drop for ScenePipeline {
             }
             d.destroy_shader_module(self.vertex_module, None);
             d.destroy_shader_module(self.fragment_module, None);
+            d.destroy_shader_module(self.ray_query_module, None);
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

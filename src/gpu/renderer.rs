@@ -6,9 +6,11 @@ use std::time::{Duration, Instant};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
+use super::accel::SceneAccel;
+use super::commands::Commands;
 use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
-use super::error::{GpuError, VkContext};
+use super::error::GpuError;
 use super::layout::{lights_bytes, material_gpu, push_constants, ShaderVariant, Vertex};
 use super::memory::{subresource_range, Buffer, Image2d};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
@@ -16,6 +18,8 @@ use super::shaders;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::shading::Shadows;
+use crate::visibility::ShadowChoice;
 
 /// Wall-clock time of the set-up phases [s].
 #[derive(Clone, Copy, Debug, Default)]
@@ -41,10 +45,21 @@ pub struct FrameTimings {
 
 /// A scene's geometry and materials on the device.
 pub struct GpuScene {
+    // The acceleration structure goes before the buffers it was built from.
+    accel: Option<SceneAccel>,
     vertices: Option<Buffer>,
     indices: Option<Buffer>,
     materials: Buffer,
     draws: Vec<Draw>,
+    /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
+    can_occlude: bool,
+}
+
+impl GpuScene {
+    /// Whether the scene can shadow itself (`visibility::can_occlude`, decided at upload).
+    pub fn can_occlude(&self) -> bool {
+        self.can_occlude
+    }
 }
 
 struct Draw {
@@ -122,10 +137,21 @@ impl Renderer {
             Some(stages) if interpolation == guess => stages?,
             _ => compile_stages(interpolation, options.naive_math)?,
         };
+        // The fragment shader with shadow rays, where the device has ray queries (not with the naive-math
+        // diagnostic).
+        let ray_query = if dev.info.ray_query && !options.naive_math {
+            Some(
+                shaders::stage_spirv("scene.frag", &[interpolation_define(interpolation), "SUNSHADE_RAY_QUERY"])
+                    .map_err(GpuError::ShaderCompile)?,
+            )
+        } else {
+            None
+        };
         let pipeline = ScenePipeline::new(
             &dev,
             &vs,
             &fs,
+            ray_query.as_deref(),
             interpolation == Interpolation::Device,
             options.pipeline_cache_dir.as_deref(),
         )?;
@@ -212,6 +238,9 @@ impl Renderer {
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
         let mut draws = Vec::new();
+        // With ray queries: every triangle's indices into the whole vertex buffer, for the acceleration structure.
+        let rq = self.pipeline.has_ray_queries();
+        let mut global_indices = Vec::new();
         let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
         for mesh in &scene.meshes {
             let vertex_offset = i32::try_from(vertices.len())
@@ -224,6 +253,9 @@ impl Renderer {
                 brdf: materials[mesh.material].kind[0],
                 double_sided: scene.materials[mesh.material].double_sided,
             });
+            if rq {
+                global_indices.extend(mesh.indices.iter().map(|&i| i + vertex_offset as u32));
+            }
             vertices.extend((0..mesh.positions.len()).map(|i| Vertex {
                 position: mesh.positions[i].to_array(),
                 normal: mesh.normals[i].to_array(),
@@ -232,27 +264,47 @@ impl Renderer {
             indices.extend_from_slice(&mesh.indices);
         }
         let materials_bytes: &[u8] = if materials.is_empty() { &[0; 64] } else { bytemuck::cast_slice(&materials) };
+        // With ray queries the vertex buffer is also the acceleration structure's build input.
+        let accel_usage = if rq {
+            vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
+                | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS
+        } else {
+            vk::BufferUsageFlags::empty()
+        };
+        let vertices = (!vertices.is_empty())
+            .then(|| {
+                Buffer::with_data(
+                    &self.dev,
+                    bytemuck::cast_slice(&vertices),
+                    vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER | accel_usage,
+                    "vertices",
+                )
+            })
+            .transpose()?;
+        let indices = (!indices.is_empty())
+            .then(|| {
+                Buffer::with_data(
+                    &self.dev,
+                    bytemuck::cast_slice(&indices),
+                    vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
+                    "indices",
+                )
+            })
+            .transpose()?;
+        let accel = match &vertices {
+            Some(vb) if rq && !global_indices.is_empty() => Some(SceneAccel::build(
+                &self.dev,
+                vb,
+                (vb.size / std::mem::size_of::<Vertex>() as u64) as u32,
+                std::mem::size_of::<Vertex>() as u64,
+                &global_indices,
+            )?),
+            _ => None,
+        };
         Ok(GpuScene {
-            vertices: (!vertices.is_empty())
-                .then(|| {
-                    Buffer::with_data(
-                        &self.dev,
-                        bytemuck::cast_slice(&vertices),
-                        vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
-                        "vertices",
-                    )
-                })
-                .transpose()?,
-            indices: (!indices.is_empty())
-                .then(|| {
-                    Buffer::with_data(
-                        &self.dev,
-                        bytemuck::cast_slice(&indices),
-                        vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
-                        "indices",
-                    )
-                })
-                .transpose()?,
+            accel,
+            vertices,
+            indices,
             materials: Buffer::with_data(
                 &self.dev,
                 materials_bytes,
@@ -260,7 +312,43 @@ impl Renderer {
                 "materials",
             )?,
             draws,
+            can_occlude: crate::visibility::can_occlude(scene),
         })
+    }
+
+    /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
+    /// the device has ray queries; without them shadow maps would be used, which sunshade does not have yet, so
+    /// the lights stay unoccluded and the choice carries a warning. `ray` without ray queries and `map` are
+    /// refused.
+    pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
+        let rq = self.pipeline.has_ray_queries();
+        let requested = settings.shading.shadows;
+        let mut choice = crate::visibility::choose(requested, &settings.lights, scene.can_occlude, rq);
+        if choice.technique == Shadows::Ray && !rq {
+            return Err(GpuError::Unsupported(format!(
+                "{} has no ray queries (VK_KHR_ray_query) for --shadows ray: use the lavapipe of \
+                 scripts/lavapipe-rt.sh, or --shadows none",
+                self.dev.info.name
+            )));
+        }
+        if choice.technique == Shadows::Map {
+            if requested == Shadows::Map {
+                return Err(GpuError::Unsupported(
+                    "--shadows map: shadow maps are not implemented yet; use --shadows ray on a device with ray \
+                     queries, or --shadows none"
+                        .into(),
+                ));
+            }
+            choice = ShadowChoice {
+                technique: Shadows::None,
+                reason: format!(
+                    "{}; shadow maps are not implemented yet, so every light is unoccluded (no shadows)",
+                    choice.reason
+                ),
+                warning: true,
+            };
+        }
+        Ok(choice)
     }
 
     /// Uploads and renders in one go.
@@ -315,10 +403,11 @@ impl Renderer {
             "lights",
         )?;
         // The pipeline variant of each draw, created now if this is its first frame.
+        let shadow_rays = self.shadow_choice(scene, settings)?.technique == Shadows::Ray && scene.accel.is_some();
         let t_pipelines = Instant::now();
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
         for draw in &scene.draws {
-            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading);
+            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading, shadow_rays);
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
         let pipelines = t_pipelines.elapsed();
@@ -346,6 +435,19 @@ impl Renderer {
                     })
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
+            }
+            // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
+            if let Some(accel) = &scene.accel {
+                let structures = [accel.top_level()];
+                let mut info =
+                    vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(&structures);
+                let write = vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(4)
+                    .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+                    .descriptor_count(1)
+                    .push_next(&mut info);
+                d.update_descriptor_sets(&[write], &[]);
             }
 
             let cb = self.commands.begin(&self.dev)?;
@@ -522,11 +624,7 @@ fn copy_pixels(bytes: &[u8]) -> Vec<[f32; 4]> {
 /// SPIR-V of the vertex and fragment stages for an interpolation mode: built ahead of time, or compiled on two
 /// threads from `SUNSHADE_SHADER_DIR`.
 fn compile_stages(interpolation: Interpolation, naive_math: bool) -> Result<(Vec<u32>, Vec<u32>), GpuError> {
-    let mut defines = vec![match interpolation {
-        Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
-        Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
-        Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
-    }];
+    let mut defines = vec![interpolation_define(interpolation)];
     if naive_math {
         defines.push("SUNSHADE_NAIVE_MATH");
     }
@@ -536,6 +634,15 @@ fn compile_stages(interpolation: Interpolation, naive_math: bool) -> Result<(Vec
         (vs.join().expect("the shader compiler thread panicked"), fs)
     });
     Ok((vs.map_err(GpuError::ShaderCompile)?, fs.map_err(GpuError::ShaderCompile)?))
+}
+
+/// The `#define` that selects an interpolation mode in the shaders.
+fn interpolation_define(interpolation: Interpolation) -> &'static str {
+    match interpolation {
+        Interpolation::Device => "SUNSHADE_DEVICE_INTERPOLATION",
+        Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
+        Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
+    }
 }
 
 fn image_barrier(
@@ -557,81 +664,4 @@ fn image_barrier(
         .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
         .subresource_range(subresource_range(aspect))
-}
-
-/// One command pool with one reusable primary command buffer and a fence.
-struct Commands {
-    dev: Arc<Device>,
-    pool: vk::CommandPool,
-    buffer: vk::CommandBuffer,
-    fence: vk::Fence,
-}
-
-impl Commands {
-    fn new(dev: &Arc<Device>) -> Result<Self, GpuError> {
-        // SAFETY: valid device and create infos.
-        unsafe {
-            let pool = dev
-                .device
-                .create_command_pool(
-                    &vk::CommandPoolCreateInfo::default()
-                        .queue_family_index(dev.queue_family)
-                        .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
-                    None,
-                )
-                .vk("vkCreateCommandPool")?;
-            let mut out = Self { dev: dev.clone(), pool, buffer: vk::CommandBuffer::null(), fence: vk::Fence::null() };
-            out.buffer = dev
-                .device
-                .allocate_command_buffers(
-                    &vk::CommandBufferAllocateInfo::default()
-                        .command_pool(pool)
-                        .level(vk::CommandBufferLevel::PRIMARY)
-                        .command_buffer_count(1),
-                )
-                .vk("vkAllocateCommandBuffers")?[0];
-            out.fence = dev.device.create_fence(&vk::FenceCreateInfo::default(), None).vk("vkCreateFence")?;
-            Ok(out)
-        }
-    }
-
-    /// Resets and begins the command buffer (the previous submission has been waited for).
-    unsafe fn begin(&self, dev: &Device) -> Result<vk::CommandBuffer, GpuError> {
-        // SAFETY: the buffer is not pending (submit_and_wait waits for completion).
-        unsafe {
-            dev.device
-                .reset_command_buffer(self.buffer, vk::CommandBufferResetFlags::empty())
-                .vk("vkResetCommandBuffer")?;
-            dev.device
-                .begin_command_buffer(
-                    self.buffer,
-                    &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-                .vk("vkBeginCommandBuffer")?;
-        }
-        Ok(self.buffer)
-    }
-
-    unsafe fn submit_and_wait(&self, dev: &Device, cb: vk::CommandBuffer) -> Result<(), GpuError> {
-        // SAFETY: `cb` was begun by `begin`; the fence is unsignalled (reset after every wait).
-        unsafe {
-            dev.device.end_command_buffer(cb).vk("vkEndCommandBuffer")?;
-            let buffers = [vk::CommandBufferSubmitInfo::default().command_buffer(cb)];
-            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&buffers)];
-            dev.device.queue_submit2(dev.queue, &submit, self.fence).vk("vkQueueSubmit2")?;
-            dev.device.wait_for_fences(&[self.fence], true, u64::MAX).vk("vkWaitForFences")?;
-            dev.device.reset_fences(&[self.fence]).vk("vkResetFences")?;
-        }
-        Ok(())
-    }
-}
-
-impl Drop for Commands {
-    fn drop(&mut self) {
-        // SAFETY: nothing is pending (every submission is waited for).
-        unsafe {
-            self.dev.device.destroy_fence(self.fence, None);
-            self.dev.device.destroy_command_pool(self.pool, None);
-        }
-    }
 }

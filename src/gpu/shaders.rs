@@ -12,6 +12,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("radiometry.glsl", include_str!("../../shaders/radiometry.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
+    ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),
@@ -72,13 +73,19 @@ mod tests {
                 let words = compile(name, SOURCES, defines).unwrap_or_else(|e| panic!("{e}"));
                 assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
             }
+            if name.ends_with(".frag") {
+                let words = compile(name, SOURCES, &["SUNSHADE_F64_BARYCENTRICS", "SUNSHADE_RAY_QUERY"])
+                    .unwrap_or_else(|e| panic!("{e}"));
+                assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+            }
         }
     }
 
     #[test]
     fn modules_built_ahead_equal_run_time_compilation() {
         // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
-        assert_eq!(MODULES.len(), 12);
+        // 2 stages × 3 interpolations × (plain, naive math), and the fragment stage's 3 with ray queries.
+        assert_eq!(MODULES.len(), 15);
         for m in MODULES {
             let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);

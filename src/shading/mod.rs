@@ -8,9 +8,11 @@ pub mod brdf;
 pub mod quadrature;
 pub mod radiometry;
 mod shade;
+pub mod visibility;
 
 pub use shade::{
-    disk_geometry, disk_lobe_integral, irradiance, orthonormal_to, radiance_out, safe_normalize, sky_lobe_integral,
-    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS,
-    DEFAULT_SUN_SAMPLES_PER_AXIS,
+    disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, orthonormal_to, radiance_out,
+    radiance_out_visible, safe_normalize, sky_lobe_integral, specular_lobe, sun_lobe_integral, DiskModel,
+    ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
+pub use visibility::{Occlusion, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_SAMPLES_PER_AXIS};

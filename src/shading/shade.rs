@@ -24,6 +24,10 @@ use super::radiometry::{
     disk_projected_solid_angle, disk_projected_solid_angle_small_source, sky_irradiance, sun_irradiance_delta,
     sun_irradiance_disk, DiskGeometry,
 };
+use super::visibility::{
+    disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, Shadowing, Shadows,
+    DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+};
 use crate::scene::{Brdf, DiskLight, Lights, Material};
 
 /// How the sun is evaluated.
@@ -59,6 +63,10 @@ pub struct ShadingOptions {
     pub sun_samples_per_axis: u32,
     /// Grid side for integrating lobes over disk lights and the sky (`n²` samples each).
     pub samples_per_axis: u32,
+    /// How shadows are computed.
+    pub shadows: Shadows,
+    /// Grid side of each light's visible-fraction grid (`n²` shadow rays per light and pixel).
+    pub shadow_samples_per_axis: u32,
 }
 
 impl Default for ShadingOptions {
@@ -68,6 +76,8 @@ impl Default for ShadingOptions {
             disk: DiskModel::Exact,
             sun_samples_per_axis: DEFAULT_SUN_SAMPLES_PER_AXIS,
             samples_per_axis: DEFAULT_SAMPLES_PER_AXIS,
+            shadows: Shadows::Auto,
+            shadow_samples_per_axis: DEFAULT_SHADOW_SAMPLES_PER_AXIS,
         }
     }
 }
@@ -135,16 +145,41 @@ pub fn disk_geometry(d: &DiskLight) -> DiskGeometry {
     DiskGeometry { center: d.center.as_dvec3(), direction: d.direction.as_dvec3(), radius: d.radius as f64 }
 }
 
-/// Irradiance [W/m²] per channel at `point` from all the lights.
+/// Irradiance [W/m²] per channel at `point` from all the lights, unoccluded.
 pub fn irradiance(point: &SurfacePoint, lights: &Lights, options: &ShadingOptions) -> [f64; 3] {
+    irradiance_visible(point, lights, options, None)
+}
+
+/// Irradiance [W/m²] per channel at `point` from the visible part of every light: each light's exact
+/// unoccluded irradiance times its visible fraction (`visibility`; a single ray for a delta sun and a
+/// small-source disk). `None`: unoccluded.
+pub fn irradiance_visible(
+    point: &SurfacePoint,
+    lights: &Lights,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
     let mut e = [0.0; 3];
     if let Some(sun) = &lights.sun {
-        let n_dot_l = point.normal.dot(sun.direction.as_dvec3());
-        for (ec, &perp) in e.iter_mut().zip(&sun.irradiance) {
-            *ec += match options.sun {
-                SunModel::Disk => sun_irradiance_disk(perp as f64, n_dot_l, sun.angular_diameter as f64),
+        let l = sun.direction.as_dvec3();
+        let n_dot_l = point.normal.dot(l);
+        let delta = sun.angular_diameter as f64;
+        let mut unoccluded = [0.0; 3];
+        for (ec, &perp) in unoccluded.iter_mut().zip(&sun.irradiance) {
+            *ec = match options.sun {
+                SunModel::Disk => sun_irradiance_disk(perp as f64, n_dot_l, delta),
                 SunModel::Delta => sun_irradiance_delta(perp as f64, n_dot_l),
             };
+        }
+        let v = match shadow {
+            Some(s) if unoccluded.iter().any(|&x| x > 0.0) => match options.sun {
+                SunModel::Disk => sun_visible_fraction(s, point.normal, l, delta),
+                SunModel::Delta => f64::from(u8::from(s.visible_along(l))),
+            },
+            _ => 1.0,
+        };
+        for (ec, u) in e.iter_mut().zip(unoccluded) {
+            *ec += u * v;
         }
     }
     for disk in &lights.disks {
@@ -153,13 +188,27 @@ pub fn irradiance(point: &SurfacePoint, lights: &Lights, options: &ShadingOption
             DiskModel::Exact => disk_projected_solid_angle(point.position, point.normal, &g),
             DiskModel::SmallSource => disk_projected_solid_angle_small_source(point.position, point.normal, &g),
         };
+        let v = match shadow {
+            Some(s) if omega > 0.0 => match options.disk {
+                DiskModel::Exact => {
+                    disk_visible_fraction(s, point.position, point.normal, g.center, g.direction, g.radius)
+                }
+                DiskModel::SmallSource => f64::from(u8::from(s.visible_to(g.center))),
+            },
+            _ => 1.0,
+        };
+        let omega = omega * v;
         for (ec, &l0) in e.iter_mut().zip(&disk.radiance) {
             *ec += l0 as f64 * omega;
         }
     }
     if let Some(sky) = &lights.sky {
+        let v = match shadow {
+            Some(s) if point.normal.y > -1.0 => sky_visible_fraction(s, point.normal),
+            _ => 1.0,
+        };
         for (ec, &l0) in e.iter_mut().zip(sky) {
-            *ec += sky_irradiance(l0 as f64, point.normal.y);
+            *ec += sky_irradiance(l0 as f64, point.normal.y) * v;
         }
     }
     e
@@ -183,7 +232,7 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
 /// grid of [`segment_lobe_integral`] integrates it, lobes narrower than the sun included (a Phong lobe of
 /// e = 1e6 is 0.06° wide against the sun's 0.53°).
 pub fn sun_lobe_integral(brdf: &Brdf, p: &SurfacePoint, direction: DVec3, angular_diameter: f64, per_axis: u32) -> f64 {
-    segment_lobe_integral(brdf, p, direction, -direction, (0.5 * angular_diameter).tan(), per_axis)
+    segment_lobe_integral_visible(brdf, p, direction, -direction, (0.5 * angular_diameter).tan(), per_axis, None)
 }
 
 /// The angular width [rad] about a specular lobe's peak (the mirror direction of the viewer) over which the disk
@@ -221,6 +270,24 @@ pub fn disk_lobe_integral(brdf: &Brdf, p: &SurfacePoint, disk: &DiskGeometry, pe
     segment_lobe_integral(brdf, p, disk.center - p.position, disk.direction, disk.radius, per_axis)
 }
 
+/// Which shadow rays a lobe integral's samples cast: none, along each sample's direction (a light at infinity:
+/// the sun's cap, the sky), or to each sample's point on a disk light.
+#[derive(Clone, Copy)]
+pub enum SampleRays<'a> {
+    Along(&'a Shadowing<'a>),
+    ToPoint(&'a Shadowing<'a>),
+}
+
+impl SampleRays<'_> {
+    /// Whether the sample at `y` (relative to the shading point `x`; a direction for `Along`) is visible.
+    fn visible(&self, x: DVec3, y: DVec3, omega: DVec3) -> bool {
+        match self {
+            SampleRays::Along(s) => s.visible_along(omega),
+            SampleRays::ToPoint(s) => s.visible_to(x + y),
+        }
+    }
+}
+
 /// `∫ lobe(ω) (n·ω)+ dω` over the part of a disk above the horizon, per unit radiance, for the disk of radius R
 /// centred at `q` from the surface point emitting along the unit vector `d`: a midpoint grid over the
 /// segment `β ∈ [0, α]`, `s ∈ [−1, 1]`, `y = C + R cos β w + R sin β s v`, `dω = h R² sin²β dβ ds / |y − x|³`.
@@ -232,6 +299,19 @@ pub fn disk_lobe_integral(brdf: &Brdf, p: &SurfacePoint, disk: &DiskGeometry, pe
 /// stays smooth in the warped coordinates, so the midpoint rule keeps its 1/k² convergence, and everything is a
 /// continuous function of the inputs: no sample switches on or off between the GPU and the reference.
 pub fn segment_lobe_integral(brdf: &Brdf, p: &SurfacePoint, q: DVec3, d: DVec3, radius: f64, per_axis: u32) -> f64 {
+    segment_lobe_integral_visible(brdf, p, q, d, radius, per_axis, None)
+}
+
+/// [`segment_lobe_integral`] with each sample's shadow ray (`rays`; `None`: unoccluded).
+pub fn segment_lobe_integral_visible(
+    brdf: &Brdf,
+    p: &SurfacePoint,
+    q: DVec3,
+    d: DVec3,
+    radius: f64,
+    per_axis: u32,
+    rays: Option<SampleRays>,
+) -> f64 {
     let n = p.normal;
     let h = -d.dot(q);
     if !(h > 0.0 && radius > 0.0) {
@@ -295,7 +375,7 @@ pub fn segment_lobe_integral(brdf: &Brdf, p: &SurfacePoint, q: DVec3, d: DVec3, 
             let dist = dist2.sqrt();
             let omega = y / dist;
             let cos = n.dot(omega);
-            if cos > 0.0 {
+            if cos > 0.0 && rays.is_none_or(|r| r.visible(p.position, y, omega)) {
                 sum +=
                     specular_lobe(brdf, p, omega) * cos * h / (dist2 * dist) * radius * radius * sb * sb * d_beta * d_s;
             }
@@ -330,6 +410,12 @@ pub fn cos_power_direction(axis: DVec3, t: DVec3, b: DVec3, exponent: f64, xi1: 
 /// `∫ lobe(ω) (n·ω)+ dω` over the hemisphere (the sky, per unit radiance), by a stratified grid of `per_axis²`
 /// cells through the lobe's inverse CDF, each sample weighted by lobe/pdf.
 pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
+    sky_lobe_integral_visible(brdf, p, per_axis, None)
+}
+
+/// [`sky_lobe_integral`] with a shadow ray along each sample's direction (`None`: unoccluded).
+pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, shadow: Option<&Shadowing>) -> f64 {
+    let visible = |omega: DVec3| shadow.is_none_or(|s| s.visible_along(omega));
     let (n, v) = (p.normal, p.to_viewer);
     // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
     let axis = if matches!(brdf, Brdf::Phong { .. }) { mirror(v, n) } else { n };
@@ -342,13 +428,13 @@ pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
         for j in 0..per_axis {
             let xi2 = (j as f64 + 0.5) / k;
             let phi = 2.0 * PI * xi2;
-            sum += match *brdf {
-                Brdf::Lambert { .. } => 0.0,
+            let (value, omega) = match *brdf {
+                Brdf::Lambert { .. } => (0.0, n),
                 Brdf::Phong { exponent, .. } => {
                     // cos α = (1 − ξ1)^{1/(e+1)} about r = mirror of v: pdf = (e+1)/(2π) cosᵉα, lobe/pdf = (e+2)/(e+1).
                     let e = exponent as f64;
                     let omega = cos_power_direction(axis, t, b, e, xi1, phi);
-                    (e + 2.0) / (e + 1.0) * n.dot(omega).max(0.0)
+                    ((e + 2.0) / (e + 1.0) * n.dot(omega).max(0.0), omega)
                 }
                 Brdf::BlinnPhong { exponent, .. } => {
                     // cos θh = (1 − ξ1)^{1/(e+1)} about n: pdf_h = (e+1)/(2π)(n·h)^e, dω = 4 (v·h) dh.
@@ -356,11 +442,13 @@ pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
                     let h = cos_power_direction(axis, t, b, e, xi1, phi);
                     let vh = v.dot(h);
                     if vh <= 0.0 {
-                        0.0
+                        (0.0, n)
                     } else {
                         let omega = 2.0 * vh * h - v;
-                        super::brdf::blinn_phong_normalization(e) * 4.0 * vh * n.dot(omega).max(0.0) * 2.0 * PI
-                            / (e + 1.0)
+                        let value =
+                            super::brdf::blinn_phong_normalization(e) * 4.0 * vh * n.dot(omega).max(0.0) * 2.0 * PI
+                                / (e + 1.0);
+                        (value, omega)
                     }
                 }
                 Brdf::Ward { alpha_x, alpha_y, .. } => {
@@ -376,26 +464,43 @@ pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
                     let h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
                     let vh = v.dot(h);
                     if vh <= 0.0 {
-                        0.0
+                        (0.0, n)
                     } else {
                         let omega = 2.0 * vh * h - v;
-                        n.dot(omega).max(0.0) / (vh * cos_d)
+                        (n.dot(omega).max(0.0) / (vh * cos_d), omega)
                     }
                 }
             };
+            // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
+            if value <= 0.0 || value.is_nan() || visible(omega) {
+                sum += value;
+            }
         }
     }
     sum / (k * k)
 }
 
-/// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer.
+/// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer, every light unoccluded.
 pub fn radiance_out(material: &Material, point: &SurfacePoint, lights: &Lights, options: &ShadingOptions) -> [f64; 3] {
+    radiance_out_visible(material, point, lights, options, None)
+}
+
+/// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer from the visible part of
+/// each light (`shadow`; `None`: unoccluded): the diffuse part by the lights' visible fractions, each specular
+/// sample by its own shadow ray (`visibility`).
+pub fn radiance_out_visible(
+    material: &Material,
+    point: &SurfacePoint,
+    lights: &Lights,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
     // An undefined (zero) normal reflects nothing: n·l = 0 would otherwise read as a surface edge-on to every light.
     if point.normal == DVec3::ZERO {
         return [0.0; 3];
     }
     let brdf = &material.brdf;
-    let e = irradiance(point, lights, options);
+    let e = irradiance_visible(point, lights, options, shadow);
     let (kd, ks) = (brdf.kd(), brdf.ks());
     let mut radiance = [0, 1, 2].map(|c| lambert_brdf(kd[c] as f64) * e[c]);
     if brdf.is_lambert() {
@@ -407,14 +512,20 @@ pub fn radiance_out(material: &Material, point: &SurfacePoint, lights: &Lights, 
         let l = sun.direction.as_dvec3();
         match options.sun {
             SunModel::Delta => {
-                let factor = specular_lobe(brdf, point, l) * point.normal.dot(l).max(0.0);
+                let mut factor = specular_lobe(brdf, point, l) * point.normal.dot(l).max(0.0);
+                if factor > 0.0 && shadow.is_some_and(|s| !s.visible_along(l)) {
+                    factor = 0.0;
+                }
                 for (sc, &perp) in specular.iter_mut().zip(&sun.irradiance) {
                     *sc += factor * perp as f64;
                 }
             }
             SunModel::Disk => {
                 let delta = sun.angular_diameter as f64;
-                let integral = sun_lobe_integral(brdf, point, l, delta, options.sun_samples_per_axis);
+                let radius = (0.5 * delta).tan();
+                let rays = shadow.map(SampleRays::Along);
+                let integral =
+                    segment_lobe_integral_visible(brdf, point, l, -l, radius, options.sun_samples_per_axis, rays);
                 let s = (0.5 * delta).sin();
                 for (sc, &perp) in specular.iter_mut().zip(&sun.irradiance) {
                     *sc += integral * perp as f64 / (PI * s * s);
@@ -425,11 +536,20 @@ pub fn radiance_out(material: &Material, point: &SurfacePoint, lights: &Lights, 
     for disk in &lights.disks {
         let g = disk_geometry(disk);
         let integral = match options.disk {
-            DiskModel::Exact => disk_lobe_integral(brdf, point, &g, options.samples_per_axis),
+            DiskModel::Exact => {
+                let rays = shadow.map(SampleRays::ToPoint);
+                let q = g.center - point.position;
+                segment_lobe_integral_visible(brdf, point, q, g.direction, g.radius, options.samples_per_axis, rays)
+            }
             DiskModel::SmallSource => {
                 let to_center = safe_normalize(g.center - point.position);
-                specular_lobe(brdf, point, to_center)
-                    * disk_projected_solid_angle_small_source(point.position, point.normal, &g)
+                let integral = specular_lobe(brdf, point, to_center)
+                    * disk_projected_solid_angle_small_source(point.position, point.normal, &g);
+                if integral > 0.0 && shadow.is_some_and(|s| !s.visible_to(g.center)) {
+                    0.0
+                } else {
+                    integral
+                }
             }
         };
         for (sc, &l0) in specular.iter_mut().zip(&disk.radiance) {
@@ -437,7 +557,7 @@ pub fn radiance_out(material: &Material, point: &SurfacePoint, lights: &Lights, 
         }
     }
     if let Some(sky) = &lights.sky {
-        let integral = sky_lobe_integral(brdf, point, options.samples_per_axis);
+        let integral = sky_lobe_integral_visible(brdf, point, options.samples_per_axis, shadow);
         for (sc, &l0) in specular.iter_mut().zip(sky) {
             *sc += integral * l0 as f64;
         }

@@ -114,15 +114,20 @@ impl Bvh {
         }
         let inv = ray.direction.recip();
         let mut best = None;
-        let mut stack = vec![0usize];
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n];
+        // Median splits halve the triangles per level, so the depth is at most log2(2^32) = 32 and the stack
+        // holds at most one pending sibling per level: 64 entries are plenty, on the stack, no allocation.
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
             if !slab(node, ray.origin, inv, t_min, t_max) {
                 continue;
             }
             if node.count == 0 {
-                stack.push(node.first as usize);
-                stack.push(node.first as usize + 1);
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
                 continue;
             }
             for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
@@ -136,6 +141,12 @@ impl Bvh {
             }
         }
         best
+    }
+}
+
+impl crate::shading::Occlusion for Bvh {
+    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
+        WatertightRay::new(origin, direction).is_some_and(|ray| self.any_hit(&ray, 0.0, t_max))
     }
 }
 

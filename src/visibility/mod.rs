@@ -2,13 +2,15 @@
 //! against every triangle, through a BVH, with a watertight ray/triangle test so that rays do not slip through
 //! shared edges.
 //!
-//! Groundwork for shadows (issue "Shadows"): the renderers do not use it yet. It knows neither Vulkan nor glTF:
-//! triangles come in as world-space corners.
+//! It knows neither Vulkan nor glTF: triangles come in as world-space corners. The sample grids and ray origins
+//! that both renderers share are in `shading::visibility`.
 
 pub mod bvh;
 pub mod occluders;
 pub mod ray_triangle;
+pub mod technique;
 
 pub use bvh::Bvh;
 pub use occluders::can_occlude;
 pub use ray_triangle::WatertightRay;
+pub use technique::{choose, choose_reference, ShadowChoice};

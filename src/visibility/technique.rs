@@ -1,0 +1,70 @@
+//! Which shadow technique a render uses, and why (`-v` prints the reason): the user's `--shadows`, the scene
+//! (whether anything can occlude a light at all) and the device (whether it has ray queries).
+
+use crate::scene::Lights;
+use crate::shading::Shadows;
+
+/// The technique a render uses: [`Shadows::None`], [`Shadows::Ray`] or [`Shadows::Map`], never `Auto`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShadowChoice {
+    pub technique: Shadows,
+    /// Why, in a few words, for `-v`.
+    pub reason: String,
+    /// Whether the reason deserves a warning (shadows were asked for and are not there).
+    pub warning: bool,
+}
+
+impl ShadowChoice {
+    fn new(technique: Shadows, reason: impl Into<String>) -> Self {
+        Self { technique, reason: reason.into(), warning: false }
+    }
+}
+
+/// The technique for `requested` on a scene whose triangles can (`can_occlude`, from
+/// [`super::can_occlude`]) or cannot occlude a light, on a device with or without ray queries.
+/// `Auto` gives rays with ray queries, else shadow maps; `Ray` without ray queries is refused by the caller.
+pub fn choose(requested: Shadows, lights: &Lights, can_occlude: bool, ray_queries: bool) -> ShadowChoice {
+    match requested {
+        Shadows::None => ShadowChoice::new(Shadows::None, "--shadows none"),
+        _ if lights.is_empty() => ShadowChoice::new(Shadows::None, "no lights"),
+        Shadows::Auto if !can_occlude => ShadowChoice::new(
+            Shadows::None,
+            "auto: the scene is one closed convex body, which cannot shadow itself (the image is exact unshadowed)",
+        ),
+        Shadows::Auto if ray_queries => ShadowChoice::new(Shadows::Ray, "auto: the device has ray queries"),
+        Shadows::Auto => ShadowChoice::new(Shadows::Map, "auto: the device has no ray queries"),
+        Shadows::Ray => ShadowChoice::new(Shadows::Ray, "--shadows ray"),
+        Shadows::Map => ShadowChoice::new(Shadows::Map, "--shadows map"),
+    }
+}
+
+/// The reference's technique: rays for every technique but `none` (it is the truth the GPU's techniques are
+/// measured against), nothing where `auto` finds that nothing can occlude.
+pub fn choose_reference(requested: Shadows, lights: &Lights, can_occlude: bool) -> ShadowChoice {
+    let mut choice = choose(requested, lights, can_occlude, true);
+    if choice.technique == Shadows::Map {
+        choice = ShadowChoice::new(Shadows::Ray, "the reference casts rays for --shadows map");
+    }
+    choice
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Sun;
+
+    #[test]
+    fn choices() {
+        let lit = Lights {
+            sun: Some(Sun { direction: glam::Vec3::Y, irradiance: [1.0; 3], angular_diameter: 0.01 }),
+            ..Default::default()
+        };
+        assert_eq!(choose(Shadows::Auto, &lit, true, true).technique, Shadows::Ray);
+        assert_eq!(choose(Shadows::Auto, &lit, true, false).technique, Shadows::Map);
+        assert_eq!(choose(Shadows::Auto, &lit, false, true).technique, Shadows::None);
+        assert_eq!(choose(Shadows::Ray, &lit, false, true).technique, Shadows::Ray);
+        assert_eq!(choose(Shadows::Ray, &Lights::default(), true, true).technique, Shadows::None);
+        assert_eq!(choose_reference(Shadows::Map, &lit, true).technique, Shadows::Ray);
+        assert_eq!(choose_reference(Shadows::None, &lit, true).technique, Shadows::None);
+    }
+}

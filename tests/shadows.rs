@@ -1,0 +1,400 @@
+//! Shadows: the reference's visible fractions against closed forms and the hard cases of the shadows issue
+//! (terminator, acne at grazing sun, contact shadows, thin occluders, the sun at the horizon, scales from 1 mm to
+//! 10 km); and the GPU's ray queries against the reference, where the device has them (the test command runs
+//! these on the lavapipe of `scripts/lavapipe-rt.sh` with `SUNSHADE_REQUIRE_RAY_QUERIES=1`, so that a device
+//! without them fails there instead of skipping).
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::CheckedRenderer;
+use glam::{DVec3, Vec3, Vec4};
+use sunshade::authoring::shapes::{cube, icosphere, quad, MeshData};
+use sunshade::compare::{self, DiffOptions};
+use sunshade::cpu::{self, ReferenceOptions};
+use sunshade::scene::{Brdf, Camera, Lights, Material, Mesh, MetallicRoughness, Projection, Scene, Sun};
+use sunshade::settings::RenderSettings;
+use sunshade::shading::quadrature::integrate_composite;
+use sunshade::shading::visibility::shadow_ray_origin;
+use sunshade::shading::{irradiance_visible, Occlusion, ShadingOptions, Shadowing, Shadows, SurfacePoint};
+use sunshade::visibility::Bvh;
+use sunshade::Image;
+
+const E_PERP: f32 = 1000.0;
+
+fn material(double_sided: bool) -> Material {
+    Material {
+        name: "white".into(),
+        double_sided,
+        brdf: Brdf::Lambert { albedo: [1.0; 3] },
+        pbr: MetallicRoughness { base_color: [1.0; 3], metallic: 0.0, roughness: 1.0 },
+    }
+}
+
+/// `mesh` scaled by `scale` about the origin and moved by `offset` [m].
+fn placed(mesh: &MeshData, scale: f32, offset: Vec3) -> MeshData {
+    MeshData {
+        positions: mesh.positions.iter().map(|p| (Vec3::from_array(*p) * scale + offset).to_array()).collect(),
+        ..mesh.clone()
+    }
+}
+
+fn scene(parts: &[MeshData]) -> Scene {
+    let meshes = parts
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Mesh {
+            name: format!("part {i}"),
+            positions: m.positions.iter().map(|p| Vec3::from_array(*p)).collect(),
+            normals: m.normals.iter().map(|n| Vec3::from_array(*n)).collect(),
+            tangents: m
+                .normals
+                .iter()
+                .map(|n| {
+                    sunshade::scene::tangent::default_tangent(Vec3::from_array(*n).as_dvec3()).as_vec3().extend(1.0)
+                })
+                .collect::<Vec<Vec4>>(),
+            indices: m.indices.clone(),
+            material: 0,
+        })
+        .collect();
+    Scene { meshes, materials: vec![material(false)], ..Default::default() }
+}
+
+fn sun_lights(direction: DVec3, diameter_degrees: f64) -> Lights {
+    Lights {
+        sun: Some(Sun {
+            direction: direction.normalize().as_vec3(),
+            irradiance: [E_PERP; 3],
+            angular_diameter: (diameter_degrees.to_radians()) as f32,
+        }),
+        ..Default::default()
+    }
+}
+
+fn settings(width: u32, height: u32, camera: Camera, lights: Lights, shadows: Shadows, k: u32) -> RenderSettings {
+    let mut s = RenderSettings::new(width, height, camera, lights);
+    s.shading = ShadingOptions { shadows, shadow_samples_per_axis: k, ..Default::default() };
+    s
+}
+
+/// A floor `y = 0` of half-size `half` [m], facing up.
+fn floor(half: f32) -> MeshData {
+    quad(Vec3::ZERO, Vec3::new(0.0, 0.0, half), Vec3::new(half, 0.0, 0.0))
+}
+
+/// An orthographic camera looking straight down at the floor from `height`, image right along world −x... as
+/// the camera's conventions make it; tests find each pixel's floor point by unprojecting ([`floor_point`]).
+fn camera_down(center: DVec3, ymag: f64, height: f64) -> Camera {
+    Camera::looking(
+        center + DVec3::Y * height,
+        -DVec3::Y,
+        DVec3::Z,
+        Projection::Orthographic { ymag, znear: 0.5 * height, zfar: 2.0 * height },
+    )
+    .expect("a valid camera")
+}
+
+/// The floor point (y = 0) seen at the centre of pixel (x, y), by unprojecting through the settings' matrix.
+fn floor_point(s: &RenderSettings, x: u32, y: u32) -> DVec3 {
+    let inv = s.clip_from_world().as_dmat4().inverse();
+    let ndc_x = 2.0 * (x as f64 + 0.5) / s.width as f64 - 1.0;
+    let ndc_y = 2.0 * (y as f64 + 0.5) / s.height as f64 - 1.0;
+    let a = inv.project_point3(DVec3::new(ndc_x, ndc_y, 0.2));
+    let b = inv.project_point3(DVec3::new(ndc_x, ndc_y, 0.8));
+    a + (b - a) * (-a.y / (b.y - a.y))
+}
+
+/// The exact visible fraction of a sun at the zenith (half-angle σ) from a floor point at x under the half-plane
+/// roof `{y = h, x < 0}`, weighted as the renderer weights it: over the disk of directions through the tangent
+/// plane one unit up, `P = (X, 1, Z)`, |P − Y| < T = tan σ, weight `cos³γ` (solid angle per area) × `cos γ` (n·ω)
+/// = `(1 + X² + Z²)⁻²`; the roof blocks `X < −x/h`. The Z integral in closed form,
+/// `∫ (a + Z²)⁻² dZ` over `|Z| ≤ s` = `s/(a(a + s²)) + atan(s/√a)/a^{3/2}` (a = 1 + X²), the X integral by
+/// Gauss–Legendre in X = T sin θ (smooth in θ).
+fn zenith_sun_fraction_under_edge(x: f64, h: f64, half_angle: f64) -> f64 {
+    let t = half_angle.tan();
+    let strip = |theta: f64| {
+        let (xx, s) = (t * theta.sin(), t * theta.cos());
+        let a = 1.0 + xx * xx;
+        (s / (a * (a + s * s)) + (s / a.sqrt()).atan() / (a * a.sqrt())) * t * theta.cos()
+    };
+    let total = integrate_composite(-0.5 * PI, 0.5 * PI, 64, 8, strip);
+    let c = (-x / h / t).clamp(-1.0, 1.0);
+    integrate_composite(c.asin(), 0.5 * PI, 64, 8, strip) / total
+}
+
+/// The floor under a roof that ends at x = 0, at height 1, sun at the zenith of diameter `diameter` degrees.
+fn edge_scene() -> Scene {
+    // The roof faces down: seen from the camera above it is a culled back face, so the camera sees the floor
+    // through it, while shadow rays meet both faces.
+    let roof = quad(Vec3::new(-5.0, 1.0, 0.0), Vec3::new(5.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 5.0));
+    scene(&[floor(1.0), roof])
+}
+
+/// Largest and mean |V − V_exact| along the penumbra of [`edge_scene`] for `k²` shadow rays.
+fn penumbra_errors(image: &Image, s: &RenderSettings, half_angle: f64) -> (f64, f64) {
+    let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0);
+    for y in 0..s.height {
+        for x in 0..s.width {
+            let p = floor_point(s, x, y);
+            let got = image.get(x, y)[0] as f64 / (E_PERP as f64 / PI);
+            let want = zenith_sun_fraction_under_edge(p.x, 1.0, half_angle);
+            let err = (got - want).abs();
+            max = max.max(err);
+            sum += err;
+            n += 1;
+        }
+    }
+    (max, sum / n as f64)
+}
+
+#[test]
+fn penumbra_of_a_straight_edge_converges_to_the_circular_segment() {
+    // --sun-diameter 10: a penumbra ±tan(5°) = ±87 mm wide under an edge 1 m up; the image spans ±0.15 m.
+    let scene = edge_scene();
+    let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
+    let half_angle = (10f64.to_radians() as f32 as f64) / 2.0;
+    let mut errors = Vec::new();
+    for k in [4u32, 16, 64] {
+        let s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, k);
+        let image = cpu::render(&scene, &s, &ReferenceOptions::default());
+        let (max, mean) = penumbra_errors(&image, &s, half_angle);
+        eprintln!("penumbra, {k}x{k} shadow rays: max |V - V_exact| {max:.2e}, mean {mean:.2e}");
+        errors.push((k, max, mean));
+    }
+    // The midpoint rule on the equal-area grid: the edge cuts about k of the k² cells, each worth 1/k², so the
+    // error is O(1/k) at worst and falls as k grows; umbra and full light are exact (0 and 1).
+    for w in errors.windows(2) {
+        assert!(w[1].2 < w[0].2, "the mean error must fall with the samples: {errors:?}");
+    }
+    for &(k, max, _) in &errors {
+        assert!(max <= 1.0 / k as f64, "{k}x{k}: max error {max} above 1/k");
+    }
+}
+
+#[test]
+fn gpu_ray_queries_agree_with_the_reference_on_the_penumbra() {
+    let Some(mut gpu) = ray_query_renderer() else { return };
+    let scene = edge_scene();
+    let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
+    let s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, 16);
+    let g = gpu.render(&scene, &s);
+    let c = cpu::render(&scene, &s, &gpu.reference_options());
+    let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+    assert!(report.pass, "{}", report.text("gpu", "reference"));
+    // And against the closed form directly, with the reference's bound at 16² rays.
+    let half_angle = (10f64.to_radians() as f32 as f64) / 2.0;
+    let (max, _) = penumbra_errors(&g, &s, half_angle);
+    assert!(max <= 1.0 / 16.0, "GPU penumbra: max error {max}");
+}
+
+/// A renderer with ray queries, or `None` (with a message) where the device has none and
+/// `SUNSHADE_REQUIRE_RAY_QUERIES=1` is not set.
+fn ray_query_renderer() -> Option<CheckedRenderer> {
+    let mut gpu = CheckedRenderer::new();
+    if gpu.renderer().device_info().ray_query {
+        return Some(gpu);
+    }
+    let name = gpu.renderer().device_info().name.clone();
+    assert!(
+        std::env::var("SUNSHADE_REQUIRE_RAY_QUERIES").map_or(true, |v| v != "1"),
+        "SUNSHADE_REQUIRE_RAY_QUERIES=1 but {name} has no ray queries"
+    );
+    eprintln!("skipped: {name} has no ray queries (make test runs this on scripts/lavapipe-rt.sh's lavapipe)");
+    None
+}
+
+/// Sample points on every triangle of an 80-triangle icosphere lit by a sun from `l`: (lit points, those with
+/// a visible fraction below 1) with Hanika's terminator origin, and with the naive origin (the point pushed
+/// along the face normal only).
+fn terminator_counts(l: DVec3) -> ((usize, usize), (usize, usize)) {
+    let ico = icosphere(Vec3::ZERO, 1.0, 1);
+    let corners =
+        |t: &[u32]| t.iter().map(|&i| Vec3::from_array(ico.positions[i as usize]).as_dvec3()).collect::<Vec<_>>();
+    let tris: Vec<[DVec3; 3]> = ico.indices.chunks_exact(3).map(|t| corners(t).try_into().unwrap()).collect();
+    let bvh = Bvh::new(tris.clone());
+    let lights = sun_lights(l, 0.53);
+    let options = ShadingOptions { shadow_samples_per_axis: 4, ..Default::default() };
+    let (mut hanika, mut naive) = ((0, 0), (0, 0));
+    for (t, idx) in tris.iter().zip(ico.indices.chunks_exact(3)) {
+        let normals: [DVec3; 3] =
+            std::array::from_fn(|k| Vec3::from_array(ico.normals[idx[k] as usize]).as_dvec3().normalize());
+        let m = 12;
+        for i in 0..=m {
+            for j in 0..=(m - i) {
+                let b = [i as f64 / m as f64, j as f64 / m as f64, (m - i - j) as f64 / m as f64];
+                let x = b[0] * t[0] + b[1] * t[1] + b[2] * t[2];
+                let n = (b[0] * normals[0] + b[1] * normals[1] + b[2] * normals[2]).normalize();
+                if n.dot(lights.sun.unwrap().direction.as_dvec3()) <= 0.0 {
+                    continue;
+                }
+                let point =
+                    SurfacePoint { position: x, normal: n, tangent: DVec3::X, bitangent: DVec3::Z, to_viewer: n };
+                let face = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                let offset = sunshade::shading::visibility::ray_offset(t);
+                for (origin, count) in
+                    [(shadow_ray_origin(t, &normals, b, x, n), &mut hanika), (x + offset * face, &mut naive)]
+                {
+                    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 4 };
+                    let e = irradiance_visible(&point, &lights, &options, Some(&sh))[0];
+                    let e0 = irradiance_visible(&point, &lights, &options, None)[0];
+                    count.0 += 1;
+                    count.1 += usize::from(e < e0);
+                }
+            }
+        }
+    }
+    (hanika, naive)
+}
+
+#[test]
+fn the_faceted_terminator_does_not_shadow_a_smooth_icosphere() {
+    // A convex body cannot shadow itself: every lit point must see the whole sun. With the naive origin the
+    // facets below the smooth normals' horizon occlude; Hanika's origin lifts the point onto the smooth surface.
+    let mut totals = ((0, 0), (0, 0));
+    for l in [DVec3::new(0.3, 1.0, 0.5), DVec3::new(1.0, 0.05, 0.0), DVec3::new(-0.2, 0.3, 1.0)] {
+        let (h, n) = terminator_counts(l);
+        eprintln!("sun {l}: darkened lit points: Hanika {} of {}, naive {} of {}", h.1, h.0, n.1, n.0);
+        totals.0 .0 += h.0;
+        totals.0 .1 += h.1;
+        totals.1 .0 += n.0;
+        totals.1 .1 += n.1;
+    }
+    let ((lit, hanika), (_, naive)) = totals;
+    assert!(naive > 20 * hanika.max(1), "the naive origin should show the terminator: {naive} vs {hanika}");
+    assert!(hanika * 1000 <= lit, "Hanika's origin darkened {hanika} of {lit} lit points");
+}
+
+#[test]
+fn auto_skips_a_convex_body_and_forced_rays_leave_it_unchanged_where_lit() {
+    // `auto` on the convex icosphere renders bitwise like `none`; `ray` forced shadows at most a few terminator
+    // pixels, which are counted.
+    let ico = icosphere(Vec3::ZERO, 1.0, 1);
+    let scene = scene(&[ico]);
+    let camera = Camera::looking(
+        DVec3::new(0.0, 0.0, 4.0),
+        -DVec3::Z,
+        DVec3::Y,
+        Projection::Perspective { yfov: 0.6, znear: 1.0, zfar: Some(10.0) },
+    )
+    .unwrap();
+    let lights = sun_lights(DVec3::new(1.0, 0.4, 0.6), 0.53);
+    let none = cpu::render(&scene, &settings(96, 96, camera, lights.clone(), Shadows::None, 8), &Default::default());
+    let auto = cpu::render(&scene, &settings(96, 96, camera, lights.clone(), Shadows::Auto, 8), &Default::default());
+    let ray = cpu::render(&scene, &settings(96, 96, camera, lights, Shadows::Ray, 8), &Default::default());
+    assert_eq!(common::bits(&none), common::bits(&auto), "auto must skip the shadow pass on a convex body");
+    let (mut lit, mut darkened) = (0, 0);
+    for (a, b) in none.pixels().iter().zip(ray.pixels()) {
+        if a[0] > 0.0 {
+            lit += 1;
+            darkened += usize::from(b[0] < a[0]);
+        }
+    }
+    eprintln!("icosphere, forced rays: {darkened} of {lit} lit pixels darkened");
+    assert!(darkened * 200 <= lit, "{darkened} of {lit} lit pixels darkened");
+}
+
+#[test]
+fn no_acne_on_a_plane_at_grazing_sun() {
+    // A plane alone lit at 1° and 0.1°: every shadow ray leaves it; the image is bitwise the unshadowed one.
+    let scene = scene(&[floor(10.0)]);
+    let camera = camera_down(DVec3::ZERO, 8.0, 20.0);
+    for elevation in [1.0f64, 0.1] {
+        let e = elevation.to_radians();
+        let l = DVec3::new(e.cos(), e.sin(), 0.0);
+        let none =
+            cpu::render(&scene, &settings(64, 64, camera, sun_lights(l, 0.05), Shadows::None, 4), &Default::default());
+        let ray =
+            cpu::render(&scene, &settings(64, 64, camera, sun_lights(l, 0.05), Shadows::Ray, 4), &Default::default());
+        assert!(none.pixels().iter().any(|p| p[0] > 0.0), "{elevation}°: nothing lit");
+        assert_eq!(common::bits(&none), common::bits(&ray), "acne at {elevation}°");
+    }
+}
+
+/// The visible fraction of a delta sun from `(x, 0, z)` on the floor of `scene`, by a shadow ray from the floor
+/// triangle's origin rule (as the reference casts it).
+fn floor_sun_visible(scene: &Scene, floor_half: f64, p: DVec3, l: DVec3) -> f64 {
+    let bvh = cpu::occluder_bvh(scene);
+    let corners = [
+        DVec3::new(-floor_half, 0.0, -floor_half),
+        DVec3::new(floor_half, 0.0, -floor_half),
+        DVec3::new(0.0, 0.0, floor_half),
+    ];
+    let origin = shadow_ray_origin(&corners, &[DVec3::Y; 3], [1.0 / 3.0; 3], p, DVec3::Y);
+    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 1 };
+    f64::from(u8::from(sh.visible_along(l.normalize())))
+}
+
+/// A 1 m box standing on a floor of half-size `floor_half` [m] and a 1 mm plate at 0.3 m centred at x = 3,
+/// everything multiplied by `scale`.
+fn blocks_scene(scale: f32, floor_half: f32) -> Scene {
+    let b = placed(&cube(0.5), scale, Vec3::new(0.0, 0.5, 0.0) * scale);
+    let plate = placed(&cube(0.5), scale, Vec3::ZERO);
+    let plate = MeshData {
+        positions: plate.positions.iter().map(|p| [p[0] + 3.0 * scale, p[1] * 0.001 + 0.3 * scale, p[2]]).collect(),
+        ..plate
+    };
+    scene(&[placed(&floor(floor_half), scale, Vec3::ZERO), b, plate])
+}
+
+#[test]
+fn contact_shadows_and_thin_plates_at_every_scale() {
+    // The scene at 1 mm, 1 m and 10 km (a 10 m floor, everything multiplied by 1e-3, 1 and 1e3): a box standing
+    // on the floor casts a shadow that starts at its base (no peter-panning: the push along the normal is
+    // 2^-16 of the coordinates, 76 µm at scale 1); a plate 1 mm thick × scale shadows the floor under it.
+    for scale in [1e-3f32, 1.0, 1e3] {
+        let s = scale as f64;
+        let floor_half = 5.0;
+        let scene = blocks_scene(scale, floor_half);
+        let half = floor_half as f64 * s;
+        // Towards the sun: up and to −x, so the box's shadow falls on +x from its base (x = 0.5) to x = 1.5.
+        let l = DVec3::new(-1.0, 1.0, 0.0);
+        let near = (0.5 + 1e-3) * s;
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(near, 0.0, 0.0), l), 0.0, "scale {scale}: contact");
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(-near, 0.0, 0.0), l), 1.0, "scale {scale}: lit side");
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(1.45 * s, 0.0, 0.0), l), 0.0, "scale {scale}");
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(1.55 * s, 0.0, 0.0), l), 1.0, "scale {scale}");
+        let up = DVec3::Y;
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(3.0 * s, 0.0, 0.0), up), 0.0, "scale {scale}: plate");
+        assert_eq!(floor_sun_visible(&scene, half, DVec3::new(3.6 * s, 0.0, 0.0), up), 1.0, "scale {scale}: plate");
+    }
+}
+
+#[test]
+fn the_sun_at_the_horizon_throws_long_shadows() {
+    // The sun 0.5° above the horizon from +x over a 800 m floor: the 1 m box shadows it out to
+    // 1 / tan(0.5°) = 114.6 m on −x.
+    let scene = blocks_scene(1.0, 400.0);
+    let low = DVec3::new(0.5f64.to_radians().cos(), 0.5f64.to_radians().sin(), 0.0);
+    for (x, want) in [(-0.6, 0.0), (-50.0, 0.0), (-110.0, 0.0), (-120.0, 1.0), (-300.0, 1.0), (0.6, 1.0)] {
+        assert_eq!(floor_sun_visible(&scene, 400.0, DVec3::new(x, 0.0, 0.0), low), want, "x = {x}");
+    }
+}
+
+#[test]
+fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
+    // Every scene of models/ with its own lights, shadows by ray queries against the f64 reference, to the
+    // tolerance of `render --check`.
+    let Some(mut gpu) = ray_query_renderer() else { return };
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let mut checked = 0;
+    for name in ["room.gltf", "teapot.glb", "spheres.glb", "cube.glb", "brdfs.glb", "overcast.glb", "sunset.glb"] {
+        let scene = common::load(&dir.join(name));
+        let mut s = sunshade::settings::resolve(
+            &scene,
+            96,
+            72,
+            &Default::default(),
+            &sunshade::settings::SunOptions::default(),
+        )
+        .unwrap();
+        s.shading.shadows = Shadows::Ray;
+        let g = gpu.render(&scene, &s);
+        let c = cpu::render(&scene, &s, &gpu.reference_options());
+        let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+        assert!(report.pass, "{name}: {}", report.text("gpu", "reference"));
+        checked += 1;
+    }
+    assert_eq!(checked, 7);
+}
