@@ -19,6 +19,7 @@
 // Shadows (VARIANT_SHADOWS); values match gpu::layout.
 #define SHADOWS_NONE 0u
 #define SHADOWS_RAY 1u
+#define SHADOWS_MAP 2u
 
 // The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
 // material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
@@ -28,7 +29,7 @@ layout(constant_id = 0) const uint VARIANT_BRDF = 0u;  // BRDF_*
 layout(constant_id = 1) const uint VARIANT_SUN = 0u;   // LIGHT_ABSENT, SUN_DISK or SUN_DELTA
 layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EXACT or DISKS_SMALL_SOURCE
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
-layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
+layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 
 struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
@@ -57,6 +58,8 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
     uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
     uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions)
+    mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
+    vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 1 if rendered
     DiskGpu disks[];
 } lights;
 
@@ -70,6 +73,9 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
 layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
     float vertex_data[];
 };
+
+// The sun's shadow map (depth, read texel by texel with texelFetch: no filtering by the device).
+layout(set = 0, binding = 5) uniform sampler2D shadow_map;
 
 layout(push_constant) uniform PushConstants {
     mat4 clip_from_world;   // world -> Vulkan clip space (f32, column-major)

@@ -69,7 +69,8 @@ void main() {
     frame.bitangent = (tangent.w < 0.0 ? -1.0 : 1.0) * cross(normal, frame.tangent);
     frame.to_viewer = to_viewer;
     frame.shadow_origin = position;
-    if (SHADOWS_ON) {
+    frame.face_normal = normal;
+    if (SHADOWS_ON || SHADOWS_MAP_ON) {
         // The shadow rays' origin from the triangle's corners and vertex normals on the side being shaded, at the
         // fragment's own barycentrics (visibility.glsl; with device interpolation they are computed here too).
         uint first_s = pc.first_index + 3u * uint(gl_PrimitiveID);
@@ -83,6 +84,9 @@ void main() {
         vec3 n1 = side * safe_normalize(vertex_vec3(j1, 3u));
         vec3 n2 = side * safe_normalize(vertex_vec3(j2, 3u));
         frame.shadow_origin = shadow_ray_origin(q0, q1, q2, n0, n1, n2, b, position, normal);
+        vec3 face = cross(q1 - q0, q2 - q0);
+        face = dot(face, normal) < 0.0 ? -face : face;
+        frame.face_normal = safe_normalize(face);
     }
     out_radiance = vec4(radiance_out(material, frame), 1.0);
 }

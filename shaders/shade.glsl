@@ -6,9 +6,15 @@
 #include "bindings.glsl"
 #include "brdf.glsl"
 #include "visibility.glsl"
+#include "shadow_map.glsl"
 
 // Whether this pipeline casts shadow rays (the pipeline variant; only modules built with SUNSHADE_RAY_QUERY can).
 const bool SHADOWS_ON = VARIANT_SHADOWS == SHADOWS_RAY;
+// Whether it looks the sun up in its shadow map (disk lights and the sky are then unoccluded).
+const bool SHADOWS_MAP_ON = VARIANT_SHADOWS == SHADOWS_MAP;
+
+// The sun's visible fraction from the map, found by irradiance_visible and reused for the specular part.
+float sun_map_fraction = 1.0;
 
 // Which shadow rays a lobe integral's samples cast (Rust: Option<SampleRays>).
 #define RAYS_NONE 0u
@@ -29,6 +35,7 @@ struct Frame {
     vec3 bitangent;
     vec3 to_viewer;
     vec3 shadow_origin; // the shadow rays' origin [m] (visibility.glsl's shadow_ray_origin)
+    vec3 face_normal;   // the triangle's unit normal on the shaded side (shadow-map bias)
 };
 
 // Irradiance [W/m^2] per channel from the visible part of every light (which, and their models: the pipeline
@@ -53,6 +60,10 @@ vec3 irradiance_visible(Frame p) {
         if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
             v = VARIANT_SUN == SUN_DELTA ? (visible_along(p.shadow_origin, l) ? 1.0 : 0.0)
                                          : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+        }
+        if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
+            v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, VARIANT_SUN != SUN_DELTA);
+            sun_map_fraction = v;
         }
         e += unoccluded * v;
     }
@@ -301,6 +312,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             if (SHADOWS_ON && factor > 0.0 && !visible_along(p.shadow_origin, l)) {
                 factor = 0.0;
             }
+            if (SHADOWS_MAP_ON) {
+                factor *= sun_map_fraction;
+            }
             specular += factor * lights.sun.irradiance.rgb;
         } else {
             float delta = lights.sun.direction.w;
@@ -308,6 +322,11 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float radius = tan(0.5 * delta);
             float integral = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
                 SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
+            // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the
+            // sun is wholly visible or wholly hidden).
+            if (SHADOWS_MAP_ON) {
+                integral *= sun_map_fraction;
+            }
             specular += integral * lights.sun.irradiance.rgb / (PI * s * s);
         }
     }

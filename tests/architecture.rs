@@ -111,3 +111,36 @@ fn shaders_avoid_inaccurate_builtins() {
     }
     assert!(checked >= 6, "only {checked} shader files");
 }
+
+/// Every shader file is mirrored by Rust (its functions have twins of the same name, checked here) or declared
+/// GPU-only with the reason, so that a new file cannot slip past the mirror.
+#[test]
+fn every_shader_file_is_mirrored_or_declared_gpu_only() {
+    let mirrored: &[(&str, &str)] = &[
+        ("radiometry.glsl", "src/shading"),
+        ("brdf.glsl", "src/shading"),
+        ("shade.glsl", "src/shading"),
+        ("visibility.glsl", "src/shading"),
+        ("transform.glsl", "src/cpu"),
+    ];
+    // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
+    // replacements for lavapipe's inaccurate built-ins (Rust uses f64's); the shadow map (the reference casts rays,
+    // docs/accuracy.md measures the map against them); the entry points.
+    let gpu_only = ["bindings.glsl", "math.glsl", "shadow_map.glsl", "scene.vert", "scene.frag"];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if gpu_only.contains(&name.as_str()) {
+            continue;
+        }
+        let (_, rust_dir) = mirrored
+            .iter()
+            .find(|(f, _)| *f == name)
+            .unwrap_or_else(|| panic!("shaders/{name} is neither mirrored nor declared GPU-only"));
+        let rust: String = sources(rust_dir).into_iter().map(|(_, t)| t).collect();
+        let text = std::fs::read_to_string(dir.join(&name)).unwrap();
+        for f in glsl_functions(&text) {
+            assert!(rust.contains(&format!("fn {f}(")), "shaders/{name}: `{f}` has no Rust function in {rust_dir}");
+        }
+    }
+}

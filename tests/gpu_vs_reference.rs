@@ -36,6 +36,12 @@ fn check_with(
     min_covered: usize,
     max_mismatches: usize,
 ) -> (usize, f64) {
+    // Rasterization, interpolation and shading agreement, unshadowed on every device (tests/shadows.rs checks the
+    // shadows: on a device with ray queries the sliver soup below differs at rays grazing the slivers' edges,
+    // 5.9e-2 at its worst pixel at 512², which is not what these tests measure).
+    let mut s = s.clone();
+    s.shading.shadows = sunshade::shading::Shadows::None;
+    let s = &s;
     let g = gpu.render(scene, s);
     let options = gpu.reference_options();
     let c = cpu::render(scene, s, &options);

@@ -20,8 +20,12 @@ use sunshade::Image;
 
 const ALBEDO: f32 = 0.5;
 
-/// The GPU and the CPU image of the same settings.
+/// The GPU and the CPU image of the same settings, unshadowed: the expectations here are the lights' closed forms
+/// for unoccluded surfaces (tests/shadows.rs checks shadows).
 fn both(gpu: &mut CheckedRenderer, scene: &Scene, s: &RenderSettings) -> [(&'static str, Image); 2] {
+    let mut s = s.clone();
+    s.shading.shadows = sunshade::shading::Shadows::None;
+    let s = &s;
     let g = gpu.render(scene, s);
     let c = cpu::render(scene, s, &gpu.reference_options());
     [("gpu", g), ("cpu", c)]

@@ -10,8 +10,8 @@ use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{
-    DiskModel, ShadingOptions, Shadows, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
-    DEFAULT_SUN_SAMPLES_PER_AXIS,
+    DiskModel, ShadingOptions, Shadows, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SHADOW_MAP_SIZE,
+    DEFAULT_SHADOW_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 
 /// `x,y,z` → a finite vector.
@@ -226,8 +226,9 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
 
-    /// Shadows: `auto` (ray queries where the device has them, else shadow maps; none where nothing can occlude
-    /// a light), `none`, `ray` or `map`. The reference casts rays for every technique but `none`.
+    /// Shadows: `auto` (shadow rays where the device has ray queries, else none, with a warning; none where
+    /// nothing can occlude a light), `none`, `ray`, or `map` (the sun's shadow map, any device; disk lights and
+    /// the sky unoccluded). The reference casts rays for every technique but `none`.
     #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
     pub shadows: Shadows,
 
@@ -235,6 +236,10 @@ pub struct SceneArgs {
     /// rounded up to a square; 1: the light's centre alone, a hard shadow).
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_SAMPLES_PER_AXIS * DEFAULT_SHADOW_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub shadow_samples: u32,
+
+    /// Side of the sun's shadow map [texels] (`--shadows map`): an orthographic depth map fitted to the scene.
+    #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_MAP_SIZE, value_parser = clap::value_parser!(u32).range(16..=16384))]
+    pub shadow_map_size: u32,
 }
 
 /// The side of the smallest square grid with at least `samples` cells.
@@ -276,6 +281,7 @@ impl SceneArgs {
                 samples_per_axis: per_axis(self.samples),
                 shadows: self.shadows,
                 shadow_samples_per_axis: per_axis(self.shadow_samples),
+                shadow_map_size: self.shadow_map_size,
             },
         }
     }

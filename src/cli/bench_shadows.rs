@@ -1,8 +1,9 @@
 //! `sunshade bench --shadows`: speed against error of the shadow techniques, on shadowed scenes (the teapot on a
-//! floor under the sun; the room under its skylight). Each row is a technique and sample count: the GPU frame
-//! time (median), the CPU reference's time, and the error against a converged reference, measured as the
-//! visible-fraction error `|L − L_conv| / L_unshadowed` (exact for a Lambertian surface under one light) over
-//! the pixels the converged reference finds shadowed at all.
+//! floor under the sun; the room under its skylight). Each row is a technique and sample count or map size: the
+//! GPU frame time (median; the map's pass included), the CPU reference's time, and the error against a converged
+//! reference, measured as the visible-fraction error `|L − L_conv| / L_unshadowed` (exact for a Lambertian
+//! surface under one light) over the pixels the converged reference finds shadowed at all. The last column counts
+//! the GPU's pixels over the `render --check` tolerance against the reference's rays with the same samples.
 
 use std::time::{Duration, Instant};
 
@@ -17,7 +18,7 @@ use crate::film::Image;
 use crate::gpu::{ContextOptions, Renderer};
 use crate::scene::{self, LoadOptions, Mesh, Scene};
 use crate::settings::{self, CameraOptions, LightOptions, RenderSettings, SunOptions};
-use crate::shading::Shadows;
+use crate::shading::{Shadows, DEFAULT_SHADOW_SAMPLES_PER_AXIS};
 
 /// Samples per axis of the converged reference, and of its refinement check (about twice the rays).
 const CONVERGED: u32 = 32;
@@ -136,18 +137,28 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             refinement.max,
             refinement.mean
         );
-        out += "| technique | rays per light and pixel | GPU frame [ms] | CPU reference [ms] | max error | mean error | px > 1e-2 | px > 1e-3 | GPU vs CPU px over tolerance |\n";
+        out += "| technique | rays (or filter samples) per light and pixel | GPU frame [ms] | CPU reference [ms] | max error | mean error | px > 1e-2 | px > 1e-3 | GPU vs CPU rays, px over tolerance |\n";
         out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         let gpu_scene = renderer.upload(&scene)?;
-        let mut rows: Vec<(Shadows, u32)> = vec![(Shadows::None, 1)];
-        rows.extend([1u32, 2, 4, 8, 16].map(|k| (Shadows::Ray, k)));
-        for (technique, k) in rows {
-            let sk = with(&s, technique, k);
+        // (technique, samples per axis, map size): none; rays at 1 to 256 per light; the sun's map at 512² to 4096²
+        // with the default 8² samples for its filter.
+        let mut rows: Vec<(Shadows, u32, u32)> = vec![(Shadows::None, 1, 0)];
+        rows.extend([1u32, 2, 4, 8, 16].map(|k| (Shadows::Ray, k, 0)));
+        rows.extend([512u32, 1024, 2048, 4096].map(|n| (Shadows::Map, DEFAULT_SHADOW_SAMPLES_PER_AXIS, n)));
+        for (technique, k, map_size) in rows {
+            let mut sk = with(&s, technique, k);
+            if technique == Shadows::Map {
+                sk.shading.shadow_map_size = map_size;
+            }
+            // The reference of the row: itself, or for the map the rays with the same samples.
             let t = Instant::now();
-            let cpu_image = cpu::render(&scene, &sk, &reference);
+            let cpu_image = cpu::render(
+                &scene,
+                &with(&s, if technique == Shadows::Map { Shadows::Ray } else { technique }, k),
+                &reference,
+            );
             let cpu_time = t.elapsed();
-            let err = fraction_error(&cpu_image, &converged, &unshadowed);
-            let (gpu_time, agreement) = if info.ray_query || technique == Shadows::None {
+            let gpu = if info.ray_query || technique != Shadows::Ray {
                 let (g, _) = renderer.render(&gpu_scene, &sk)?; // warm-up: pipelines
                 let mut times: Vec<Duration> = Vec::new();
                 for _ in 0..a.repeat {
@@ -155,21 +166,32 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
                 }
                 let (report, _) = compare::diff(&g, &cpu_image, &DiffOptions::default())
                     .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-                (format!("{:.1}", ms(median(times))), report.over_tolerance.total.to_string())
+                Some((g, median(times), report.over_tolerance.total))
             } else {
-                ("–".into(), "–".into())
+                None
+            };
+            // The map's error is its own image's; the rays' the reference's (the GPU's agrees with it).
+            let err = match (&gpu, technique) {
+                (Some((g, _, _)), Shadows::Map) => fraction_error(g, &converged, &unshadowed),
+                _ => fraction_error(&cpu_image, &converged, &unshadowed),
+            };
+            let (gpu_time, agreement) = match &gpu {
+                Some((_, t, n)) => (format!("{:.1}", ms(*t)), n.to_string()),
+                None => ("–".into(), "–".into()),
+            };
+            let (label, cpu_time) = match technique {
+                Shadows::Map => (format!("map {map_size}²"), "–".to_string()),
+                t => (t.name().to_string(), format!("{:.1}", ms(cpu_time))),
             };
             out += &format!(
-                "| {} | {} | {gpu_time} | {:.1} | {:.2e} | {:.2e} | {} | {} | {agreement} |\n",
-                technique.name(),
+                "| {label} | {} | {gpu_time} | {cpu_time} | {:.2e} | {:.2e} | {} | {} | {agreement} |\n",
                 if technique == Shadows::None { 0 } else { k * k },
-                ms(cpu_time),
                 err.max,
                 err.mean,
                 err.over_1e2,
                 err.over_1e3,
             );
-            eprintln!("sunshade bench: {title}: {} {k} done", technique.name());
+            eprintln!("sunshade bench: {title}: {label} {k} done");
         }
         out += "\n";
     }

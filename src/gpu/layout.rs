@@ -5,6 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::scene::{Brdf, Lights, Material};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadingOptions, SunModel};
+use crate::visibility::shadow_map::SunMapFrame;
 
 pub const BRDF_LAMBERT: u32 = 0;
 pub const BRDF_PHONG: u32 = 1;
@@ -18,6 +19,7 @@ pub const DISKS_SMALL_SOURCE: u32 = 2;
 pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
+pub const SHADOWS_MAP: u32 = 2;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
 /// `shaders/bindings.glsl`, constant ids 0 to 4). The shader keeps only the code these select; `shadows` also
@@ -32,13 +34,13 @@ pub struct ShaderVariant {
     pub disks: u32,
     /// `LIGHT_ABSENT` or `SKY_PRESENT`.
     pub sky: u32,
-    /// `SHADOWS_NONE` or `SHADOWS_RAY`.
+    /// `SHADOWS_NONE`, `SHADOWS_RAY` or `SHADOWS_MAP`.
     pub shadows: u32,
 }
 
 impl ShaderVariant {
     /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights.
-    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions, shadow_rays: bool) -> Self {
+    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions, shadows: u32) -> Self {
         let sun = match (&lights.sun, shading.sun) {
             (None, _) => LIGHT_ABSENT,
             (Some(_), SunModel::Disk) => SUN_DISK,
@@ -50,7 +52,6 @@ impl ShaderVariant {
             (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
         };
         let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
-        let shadows = if shadow_rays { SHADOWS_RAY } else { SHADOWS_NONE };
         Self { brdf, sun, disks, sky, shadows }
     }
 
@@ -104,6 +105,10 @@ pub struct LightsHeader {
     pub counts: [u32; 4],
     /// Samples per axis over the sun's disk, shadow samples per axis (visible fractions); the rest unused.
     pub sampling: [u32; 4],
+    /// World → the sun's shadow map (column-major), `visibility::shadow_map`.
+    pub sun_map_from_world: [f32; 16],
+    /// Texel side [m], depth extent [m], size [texels], 1 if the map was rendered this frame.
+    pub sun_map: [f32; 4],
 }
 
 #[repr(C)]
@@ -135,7 +140,7 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
 }
 
 /// The light buffer's bytes.
-pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
+pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions, sun_map: Option<(&SunMapFrame, u32)>) -> Vec<u8> {
     let sun = match &lights.sun {
         Some(s) => SunGpu {
             direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
@@ -152,6 +157,8 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions) -> Vec<u8> {
         sky,
         counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
         sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, 0, 0],
+        sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
+        sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
@@ -198,6 +205,7 @@ mod tests {
             ("SKY_PRESENT", SKY_PRESENT),
             ("SHADOWS_NONE", SHADOWS_NONE),
             ("SHADOWS_RAY", SHADOWS_RAY),
+            ("SHADOWS_MAP", SHADOWS_MAP),
         ];
         for (name, value) in constants {
             assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
@@ -215,7 +223,8 @@ mod tests {
     #[test]
     fn sizes_match_std430() {
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
-        assert_eq!(std::mem::size_of::<LightsHeader>(), 80);
+        assert_eq!(std::mem::size_of::<LightsHeader>(), 160);
+        assert_eq!(std::mem::offset_of!(LightsHeader, sun_map_from_world), 80);
         assert_eq!(std::mem::size_of::<DiskGpu>(), 48);
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);

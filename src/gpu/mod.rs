@@ -9,6 +9,7 @@
 //! - `pipeline`: the graphics pipeline (dynamic rendering, RGBA32F + D32);
 //! - `commands`: record, submit, wait;
 //! - `accel`: acceleration structures for the shadow rays (ray queries);
+//! - `shadow_map`: the sun's shadow-map pass;
 //! - `renderer`: upload, draw, readback.
 
 mod accel;
@@ -22,6 +23,7 @@ mod pipeline;
 pub mod pipeline_cache;
 mod renderer;
 pub mod shaders;
+mod shadow_map;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;

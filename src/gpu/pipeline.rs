@@ -33,6 +33,8 @@ pub(crate) struct ScenePipeline {
     ray_query_module: vk::ShaderModule,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
+    /// The depth-only pipeline of the sun's shadow map (vertex stage only), created at first use.
+    shadow: vk::Pipeline,
     cache: Option<DiskPipelineCache>,
     /// Variants created since the cache was last saved.
     unsaved: bool,
@@ -61,6 +63,7 @@ impl ScenePipeline {
             ray_query_module: vk::ShaderModule::null(),
             with_normals,
             variants: HashMap::new(),
+            shadow: vk::Pipeline::null(),
             cache: None,
             unsaved: false,
         };
@@ -77,6 +80,14 @@ impl ScenePipeline {
                         .stage_flags(vk::ShaderStageFlags::FRAGMENT)
                 })
                 .to_vec();
+            // 5: the sun's shadow map (always bound: a 1 × 1 map until a shadow pass ran).
+            bindings.push(
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(5)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+            );
             if ray_query_spirv.is_some() {
                 bindings.push(
                     vk::DescriptorSetLayoutBinding::default()
@@ -154,6 +165,27 @@ impl ScenePipeline {
         self.cache.as_ref().map_or(Ok(()), |c| unsafe { c.save(&self.dev.device) })
     }
 
+    /// The depth-only pipeline of the sun's shadow map, created on first use.
+    pub fn shadow_pipeline(&mut self) -> Result<vk::Pipeline, GpuError> {
+        if self.shadow == vk::Pipeline::null() {
+            let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
+            // SAFETY: valid device, layout, module and cache owned by self.
+            self.shadow = unsafe {
+                create_pipeline(
+                    &self.dev.device,
+                    cache,
+                    self.layout,
+                    self.vertex_module,
+                    vk::ShaderModule::null(),
+                    self.with_normals,
+                    None,
+                )?
+            };
+            self.unsaved = true;
+        }
+        Ok(self.shadow)
+    }
+
     /// Whether pipelines with shadow rays can be made (the device has ray queries).
     pub fn has_ray_queries(&self) -> bool {
         self.ray_query_module != vk::ShaderModule::null()
@@ -177,7 +209,7 @@ impl ScenePipeline {
                 self.vertex_module,
                 if variant.shadows == SHADOWS_RAY { self.ray_query_module } else { self.fragment_module },
                 self.with_normals,
-                variant,
+                Some(variant),
             )?
         };
         self.variants.insert(variant, p);
@@ -193,17 +225,19 @@ unsafe fn create_pipeline(
     vs: vk::ShaderModule,
     fs: vk::ShaderModule,
     with_normals: bool,
-    variant: ShaderVariant,
+    variant: Option<ShaderVariant>,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.
     unsafe {
-        let constants = variant.constants();
+        // `None`: the shadow map's depth-only pipeline (no fragment stage, no colour attachment).
+        let depth_only = variant.is_none();
+        let constants = variant.map_or([0; 5], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();
         let specialization =
             vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(&constants));
-        let stages = [
+        let all_stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main"),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
@@ -211,6 +245,7 @@ unsafe fn create_pipeline(
                 .name(c"main")
                 .specialization_info(&specialization),
         ];
+        let stages = &all_stages[..if depth_only { 1 } else { 2 }];
         let vertex_bindings = [vk::VertexInputBindingDescription {
             binding: 0,
             stride: std::mem::size_of::<Vertex>() as u32,
@@ -245,15 +280,17 @@ unsafe fn create_pipeline(
             .depth_compare_op(vk::CompareOp::LESS);
         let blend_attachments =
             [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-        let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+        let blend = vk::PipelineColorBlendStateCreateInfo::default()
+            .attachments(&blend_attachments[..if depth_only { 0 } else { 1 }]);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR, vk::DynamicState::CULL_MODE];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-        let color_formats = [COLOR_FORMAT];
+        let all_formats = [COLOR_FORMAT];
+        let color_formats = &all_formats[..if depth_only { 0 } else { 1 }];
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
-            .color_attachment_formats(&color_formats)
+            .color_attachment_formats(color_formats)
             .depth_attachment_format(DEPTH_FORMAT);
         let info = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
+            .stages(stages)
             .vertex_input_state(&vertex_input)
             .input_assembly_state(&input_assembly)
             .viewport_state(&viewport)
@@ -278,6 +315,7 @@ impl Drop for ScenePipeline {
             for (_, p) in self.variants.drain() {
                 d.destroy_pipeline(p, None);
             }
+            d.destroy_pipeline(self.shadow, None);
             d.destroy_shader_module(self.vertex_module, None);
             d.destroy_shader_module(self.fragment_module, None);
             d.destroy_shader_module(self.ray_query_module, None);

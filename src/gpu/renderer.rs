@@ -11,14 +11,19 @@ use super::commands::Commands;
 use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
-use super::layout::{lights_bytes, material_gpu, push_constants, ShaderVariant, Vertex};
+use super::layout::{
+    lights_bytes, material_gpu, push_constants, PushConstants, ShaderVariant, Vertex, SHADOWS_MAP, SHADOWS_NONE,
+    SHADOWS_RAY,
+};
 use super::memory::{subresource_range, Buffer, Image2d};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
+use super::shadow_map::SunShadowMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;
+use crate::visibility::shadow_map::fit_sun_map;
 use crate::visibility::ShadowChoice;
 
 /// Wall-clock time of the set-up phases [s].
@@ -53,6 +58,8 @@ pub struct GpuScene {
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
+    /// The scene's bounds (the sun's shadow map is fitted to them).
+    bounds: Option<crate::scene::Aabb>,
 }
 
 impl GpuScene {
@@ -83,6 +90,7 @@ pub struct Renderer {
     // Field order is drop order: everything that uses the device goes before `dev`.
     target: Option<Target>,
     lights: Option<Buffer>,
+    sun_map: SunShadowMap,
     pipeline: ScenePipeline,
     commands: Commands,
     setup: SetupTimings,
@@ -157,9 +165,11 @@ impl Renderer {
         )?;
         let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
+        let sun_map = SunShadowMap::new(&dev, 1)?;
         let renderer = Self {
             target: None,
             lights: None,
+            sun_map,
             pipeline,
             commands,
             setup: SetupTimings { instance, shader_compile },
@@ -313,12 +323,14 @@ impl Renderer {
             )?,
             draws,
             can_occlude: crate::visibility::can_occlude(scene),
+            bounds: scene.bounds(),
         })
     }
 
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
-    /// the device has ray queries; without them shadow maps would be used, which sunshade does not have yet, so
-    /// the lights stay unoccluded and the choice carries a warning. `ray` without ray queries and `map` are
+    /// the device has ray queries; without them it renders every light unoccluded with a warning (the shadow map
+    /// is not yet the default there: `--shadows map` asks for it). `map` shadows the sun from its map and leaves
+    /// disk lights and the sky unoccluded, with a warning where the scene has them. `ray` without ray queries is
     /// refused.
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
         let rq = self.pipeline.has_ray_queries();
@@ -327,26 +339,25 @@ impl Renderer {
         if choice.technique == Shadows::Ray && !rq {
             return Err(GpuError::Unsupported(format!(
                 "{} has no ray queries (VK_KHR_ray_query) for --shadows ray: use the lavapipe of \
-                 scripts/lavapipe-rt.sh, or --shadows none",
+                 scripts/lavapipe-rt.sh, --shadows map (the sun only), or --shadows none",
                 self.dev.info.name
             )));
         }
-        if choice.technique == Shadows::Map {
-            if requested == Shadows::Map {
-                return Err(GpuError::Unsupported(
-                    "--shadows map: shadow maps are not implemented yet; use --shadows ray on a device with ray \
-                     queries, or --shadows none"
-                        .into(),
-                ));
-            }
+        if choice.technique == Shadows::Map && requested == Shadows::Auto {
             choice = ShadowChoice {
                 technique: Shadows::None,
                 reason: format!(
-                    "{}; shadow maps are not implemented yet, so every light is unoccluded (no shadows)",
+                    "{}; every light is unoccluded (no shadows); --shadows map gives the sun's shadows from a \
+                     shadow map",
                     choice.reason
                 ),
                 warning: true,
             };
+        } else if choice.technique == Shadows::Map
+            && (!settings.lights.disks.is_empty() || settings.lights.sky.is_some())
+        {
+            choice.reason += "; only the sun has a shadow map: disk lights and the sky are unoccluded";
+            choice.warning = true;
         }
         Ok(choice)
     }
@@ -396,20 +407,37 @@ impl Renderer {
             });
         }
         self.lights = None;
+        let technique = self.shadow_choice(scene, settings)?.technique;
+        // The sun's shadow map, where `map` is the technique and there is a sun and geometry.
+        let sun_map = match (technique, &settings.lights.sun, scene.bounds) {
+            (Shadows::Map, Some(sun), Some(bounds)) => {
+                let size = settings.shading.shadow_map_size;
+                if self.sun_map.size != size {
+                    self.sun_map = SunShadowMap::new(&self.dev, size)?;
+                }
+                Some(fit_sun_map(bounds, sun.direction.as_dvec3(), size))
+            }
+            _ => None,
+        };
         let lights = Buffer::with_data(
             &self.dev,
-            &lights_bytes(&settings.lights, &settings.shading),
+            &lights_bytes(&settings.lights, &settings.shading, sun_map.as_ref().map(|f| (f, self.sun_map.size))),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             "lights",
         )?;
+        let shadows = match technique {
+            Shadows::Ray if scene.accel.is_some() => SHADOWS_RAY,
+            Shadows::Map if sun_map.is_some() => SHADOWS_MAP,
+            _ => SHADOWS_NONE,
+        };
         // The pipeline variant of each draw, created now if this is its first frame.
-        let shadow_rays = self.shadow_choice(scene, settings)?.technique == Shadows::Ray && scene.accel.is_some();
         let t_pipelines = Instant::now();
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
         for draw in &scene.draws {
-            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading, shadow_rays);
+            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading, shadows);
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
+        let shadow_pipeline = if sun_map.is_some() { Some(self.pipeline.shadow_pipeline()?) } else { None };
         let pipelines = t_pipelines.elapsed();
         let target = self.target.as_ref().expect("created above");
         let d = &self.dev.device;
@@ -436,6 +464,20 @@ impl Renderer {
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
             }
+            // Binding 5: the sun's shadow map (a valid image in every frame; read only by SHADOWS_MAP pipelines).
+            let map_info = [vk::DescriptorImageInfo {
+                sampler: self.sun_map.sampler,
+                image_view: self.sun_map.image.view,
+                image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            }];
+            d.update_descriptor_sets(
+                &[vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(5)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .image_info(&map_info)],
+                &[],
+            );
             // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
             if let Some(accel) = &scene.accel {
                 let structures = [accel.top_level()];
@@ -451,6 +493,31 @@ impl Renderer {
             }
 
             let cb = self.commands.begin(&self.dev)?;
+            if let (Some(frame), Some(shadow_pipeline), Some(vb), Some(ib)) =
+                (&sun_map, shadow_pipeline, &scene.vertices, &scene.indices)
+            {
+                let layout = self.pipeline.layout;
+                let map_from_world = frame.map_from_world.as_mat4().to_cols_array();
+                self.sun_map.record(cb, |cb| {
+                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, shadow_pipeline);
+                    d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
+                    d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
+                    for draw in &scene.draws {
+                        let pc = PushConstants {
+                            clip_from_world: map_from_world,
+                            ..push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
+                        };
+                        d.cmd_push_constants(
+                            cb,
+                            layout,
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytemuck::bytes_of(&pc),
+                        );
+                        d.cmd_draw_indexed(cb, draw.index_count, 1, draw.first_index, draw.vertex_offset, 0);
+                    }
+                });
+            }
             let to_attachment = [
                 image_barrier(
                     target.color.image,

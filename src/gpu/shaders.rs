@@ -13,6 +13,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
+    ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),

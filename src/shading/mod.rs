@@ -15,4 +15,6 @@ pub use shade::{
     radiance_out_visible, safe_normalize, sky_lobe_integral, specular_lobe, sun_lobe_integral, DiskModel,
     ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
-pub use visibility::{Occlusion, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_SAMPLES_PER_AXIS};
+pub use visibility::{
+    Occlusion, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+};

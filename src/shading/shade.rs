@@ -25,7 +25,7 @@ use super::radiometry::{
     sun_irradiance_disk, DiskGeometry,
 };
 use super::visibility::{
-    disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, Shadowing, Shadows,
+    disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, Shadowing, Shadows, DEFAULT_SHADOW_MAP_SIZE,
     DEFAULT_SHADOW_SAMPLES_PER_AXIS,
 };
 use crate::scene::{Brdf, DiskLight, Lights, Material};
@@ -67,6 +67,8 @@ pub struct ShadingOptions {
     pub shadows: Shadows,
     /// Grid side of each light's visible-fraction grid (`n²` shadow rays per light and pixel).
     pub shadow_samples_per_axis: u32,
+    /// Side of the sun's shadow map [texels] (`--shadows map`).
+    pub shadow_map_size: u32,
 }
 
 impl Default for ShadingOptions {
@@ -78,6 +80,7 @@ impl Default for ShadingOptions {
             samples_per_axis: DEFAULT_SAMPLES_PER_AXIS,
             shadows: Shadows::Auto,
             shadow_samples_per_axis: DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+            shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
         }
     }
 }

@@ -48,6 +48,9 @@ use super::shade::orthonormal_to;
 /// Default samples per axis of the visibility grids (`k² = 64` shadow rays per light and pixel).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 8;
 
+/// Default side of the sun's shadow map [texels] (`--shadow-map-size`; GPU, `--shadows map`).
+pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 2048;
+
 /// How far along a ray to a point on a disk light the ray is tested: `t < 1 − 2⁻¹²`.
 pub const SEGMENT_T_MAX: f64 = 1.0 - 1.0 / 4096.0;
 

@@ -8,6 +8,7 @@
 pub mod bvh;
 pub mod occluders;
 pub mod ray_triangle;
+pub mod shadow_map;
 pub mod technique;
 
 pub use bvh::Bvh;
