@@ -148,16 +148,59 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
         Shadows::None => None,
         _ => Some(occluder_bvh(scene)),
     };
-    render_with(scene, settings, options, occluders.as_ref().map(|b| b as &dyn Occlusion))
+    render_inner(scene, settings, options, occluders.as_ref(), false).0
 }
 
-/// Renders with these occluders (`None`: every light unoccluded).
-pub fn render_with(
+/// How near a shadow ray may pass an occluder's edge before its answer counts as fragile: `2⁻¹⁸` of the
+/// coordinates' magnitude, several times the f32 rounding of the GPU's positions and directions (2⁻²³).
+pub const FRAGILE_RAY_RELATIVE: f64 = 1.0 / 262144.0;
+
+/// [`render`], and for each pixel whether any of its shadow rays is *fragile*: it passes within
+/// [`FRAGILE_RAY_RELATIVE`] of the scene's size from an occluder's boundary, so that the GPU's f32 geometry could
+/// answer it the other way ([`Bvh::occluded_with_margin`]). Image-diff tests count GPU/reference differences at
+/// those pixels apart, as coverage mismatches at triangle edges are. Slower than [`render`] (every ray traverses
+/// with padded boxes and tests edge distances).
+pub fn render_with_fragile_rays(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
-    occluders: Option<&dyn Occlusion>,
-) -> Image {
+) -> (Image, Vec<bool>) {
+    let occluders = match shadow_choice(scene, settings, options).technique {
+        Shadows::None => None,
+        _ => Some(occluder_bvh(scene)),
+    };
+    let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true);
+    let n = image.pixels().len();
+    (image, fragile.unwrap_or_else(|| vec![false; n]))
+}
+
+/// A BVH that remembers whether any ray it answered was fragile (one per pixel).
+struct Recording<'a> {
+    bvh: &'a Bvh,
+    eps: f64,
+    fragile: std::sync::atomic::AtomicBool,
+}
+
+impl Occlusion for Recording<'_> {
+    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
+        let Some(ray) = crate::visibility::WatertightRay::new(origin, direction) else { return false };
+        let (occluded, fragile) = self.bvh.occluded_with_margin(&ray, 0.0, t_max, self.eps);
+        if fragile {
+            self.fragile.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        occluded
+    }
+}
+
+/// The render, with these occluders (`None`: every light unoccluded), and with `fragile` the per-pixel mask of
+/// fragile shadow rays.
+fn render_inner(
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+    occluders: Option<&Bvh>,
+    fragile: bool,
+) -> (Image, Option<Vec<bool>>) {
     let (width, height) = (settings.width, settings.height);
     let triangles = prepare(scene, settings, options);
 
@@ -172,8 +215,15 @@ pub fn render_with(
 
     let viewer = settings.viewer();
     let mut image = Image::new(width, height);
-    image.pixels_mut().par_chunks_mut((BAND_ROWS * width) as usize).zip(bins.par_iter()).enumerate().for_each(
-        |(band, (pixels, bin))| {
+    let mut mask = vec![false; if fragile { (width * height) as usize } else { 0 }];
+    let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
+    let band_pixels = (BAND_ROWS * width) as usize;
+    // Without the mask its bands are empty slices, one per band all the same.
+    let mut no_mask = vec![[false; 0]; band_count];
+    let mask_bands: Vec<&mut [bool]> =
+        if fragile { mask.chunks_mut(band_pixels).collect() } else { no_mask.iter_mut().map(|m| &mut m[..]).collect() };
+    image.pixels_mut().par_chunks_mut(band_pixels).zip(mask_bands).zip(bins.par_iter()).enumerate().for_each(
+        |(band, ((pixels, flagged), bin))| {
             let y0 = band as u32 * BAND_ROWS;
             let rows = pixels.len() as u32 / width;
             // Visibility: the nearest triangle per pixel, then shade each pixel once.
@@ -198,12 +248,22 @@ pub fn render_with(
                 let (x, y) = (k as u32 % width, y0 + k as u32 / width);
                 let t = &triangles[ti as usize];
                 let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
-                let radiance = shade(scene, settings, t, w.to_array(), viewer, occluders);
+                let radiance = match (occluders, fragile) {
+                    (Some(bvh), true) => {
+                        let rec = Recording { bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
+                        let r = shade(scene, settings, t, w.to_array(), viewer, Some(&rec));
+                        if rec.fragile.load(std::sync::atomic::Ordering::Relaxed) {
+                            flagged[k] = true;
+                        }
+                        r
+                    }
+                    (o, _) => shade(scene, settings, t, w.to_array(), viewer, o.map(|b| b as &dyn Occlusion)),
+                };
                 pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
             }
         },
     );
-    image
+    (image, fragile.then_some(mask))
 }
 
 /// For each pixel, the distance [pixels] from its sample to the nearest edge of any triangle whose bounds

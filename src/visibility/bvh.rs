@@ -150,6 +150,48 @@ impl crate::shading::Occlusion for Bvh {
     }
 }
 
+impl Bvh {
+    /// Whether the ray is occluded for `t_min < t < t_max`, and whether that answer is *fragile*: no triangle is
+    /// hit farther than `eps` [m] inside its boundary, but one is hit, or missed, within `eps` of it, so that a
+    /// few ulps of f32 geometry (the GPU's) could flip it. Boxes are padded by `eps` for this traversal.
+    pub fn occluded_with_margin(&self, ray: &WatertightRay, t_min: f64, t_max: f64, eps: f64) -> (bool, bool) {
+        if self.order.is_empty() {
+            return (false, false);
+        }
+        let inv = ray.direction.recip();
+        let (mut fragile_hit, mut near_miss) = (false, false);
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            let padded = Node { min: node.min - DVec3::splat(eps), max: node.max + DVec3::splat(eps), ..*node };
+            if !slab(&padded, ray.origin, inv, t_min, t_max) {
+                continue;
+            }
+            if node.count == 0 {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+                continue;
+            }
+            for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                match ray.edge_margin(self.triangles[i as usize], t_min, t_max) {
+                    Some(d) if d > eps => return (true, false),
+                    Some(d) if d >= 0.0 => fragile_hit = true,
+                    Some(d) if d >= -eps => near_miss = true,
+                    _ => {}
+                }
+            }
+        }
+        if fragile_hit {
+            (true, true)
+        } else {
+            (false, near_miss)
+        }
+    }
+}
+
 /// The slab test of a padded box. An axis with a zero direction component gives ±inf or NaN products: the
 /// comparisons are written so that a NaN (origin on the slab's plane) keeps the box rather than dropping it.
 fn slab(node: &Node, origin: DVec3, inv: DVec3, t_min: f64, t_max: f64) -> bool {
@@ -217,6 +259,29 @@ mod tests {
             }
         }
         assert!(!Bvh::new(Vec::new()).any_hit(&WatertightRay::new(DVec3::ZERO, DVec3::X).unwrap(), 0.0, 1.0));
+    }
+
+    #[test]
+    fn fragile_rays_are_those_near_an_edge() {
+        // One triangle 5 m away: rays through its middle are robust hits, rays far outside robust misses; rays
+        // within eps inside or outside an edge, and through a vertex, are fragile, and their answers are any_hit's.
+        let tri = [DVec3::new(0.0, 0.0, 5.0), DVec3::new(1.0, 0.0, 5.0), DVec3::new(0.0, 1.0, 5.0)];
+        let bvh = Bvh::new(vec![tri]);
+        let eps = 1e-6;
+        let at = |x: f64, y: f64| {
+            let ray = WatertightRay::new(DVec3::ZERO, DVec3::new(x, y, 5.0)).unwrap();
+            let answer = bvh.occluded_with_margin(&ray, 0.0, f64::INFINITY, eps);
+            assert_eq!(answer.0, bvh.any_hit(&ray, 0.0, f64::INFINITY), "({x}, {y})");
+            answer
+        };
+        assert_eq!(at(0.25, 0.25), (true, false));
+        assert_eq!(at(2.0, 2.0), (false, false));
+        assert_eq!(at(0.5, 0.5 - 1e-7), (true, true)); // just inside the hypotenuse
+        assert_eq!(at(0.5, 0.5 + 1e-7), (false, true)); // just outside it
+        assert_eq!(at(0.5, -1e-7), (false, true));
+        assert_eq!(at(0.0, 0.0), (true, true)); // a vertex
+        assert_eq!(at(0.5, 0.5 - 1e-4), (true, false)); // far enough inside
+        assert_eq!(at(0.5, -1e-4), (false, false)); // far enough outside
     }
 
     #[test]

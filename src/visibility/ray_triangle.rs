@@ -77,6 +77,40 @@ impl WatertightRay {
         let t = (u * az + v * bz + w * cz) / det;
         (t > t_min && t < t_max).then_some(t)
     }
+
+    /// How far the ray passes from the boundary of the triangle `(a, b, c)`, where it meets the triangle's plane
+    /// with `t_min < t < t_max` (`None` otherwise, or for a ray in the plane): in the sheared plane of the test,
+    /// each edge function over its edge's length is the distance from the ray to that edge's line [m]; positive
+    /// inside (the smallest of the three, a hit exactly when [`WatertightRay::intersect`] hits), negative outside
+    /// (the largest violation). Used to find rays whose visibility a few ulps of geometry could flip.
+    pub fn edge_margin(&self, [a, b, c]: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.shear;
+        let (a, b, c) = (a - self.origin, b - self.origin, c - self.origin);
+        let project = |v: DVec3| (v[kx] - sx * v[kz], v[ky] - sy * v[kz]);
+        let ((ax, ay), (bx, by), (cx, cy)) = (project(a), project(b), project(c));
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let t = (u * az + v * bz + w * cz) / det;
+        if !(t > t_min && t < t_max) {
+            return None;
+        }
+        let len = |(x0, y0): (f64, f64), (x1, y1): (f64, f64)| ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
+        let s = det.signum();
+        let d = [s * u / len((bx, by), (cx, cy)), s * v / len((cx, cy), (ax, ay)), s * w / len((ax, ay), (bx, by))];
+        let inside = d.iter().all(|&x| x >= 0.0);
+        Some(if inside {
+            d.iter().copied().fold(f64::INFINITY, f64::min)
+        } else {
+            -d.iter().filter(|&&x| x < 0.0).map(|x| -x).fold(0.0, f64::max)
+        })
+    }
 }
 
 #[cfg(test)]
