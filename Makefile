@@ -44,16 +44,18 @@ bench-batch: build
 docs: build
 	$(SUNSHADE) albedo --update docs/brdf.md
 
-# Regenerates the pictures in README.md: one scene per kind of light, and the BRDF spheres under each light.
+# Regenerates the pictures in README.md: one scene per kind of light, and the BRDF spheres under each light; with
+# shadows where Mesa 25's lavapipe (ray queries) can be installed (scripts/lavapipe-rt.sh), else without.
 images: build
 	mkdir -p docs/images
+	@if rt="$$(./scripts/lavapipe-rt.sh)"; then eval "$$rt"; else echo "make images: no ray queries: no shadows"; fi; \
 	for m in teapot.glb room.gltf overcast.glb sunset.glb; do \
 		$(SUNSHADE) render models/$$m -o docs/images/$${m%.*}.png --width 640 --height 480 || exit 1; \
-	done
+	done; \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sun.png --width 640 --height 300 \
-		--sun-elevation 35 --sun-azimuth 20
+		--sun-elevation 35 --sun-azimuth 20 && \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-disk.png --width 640 --height 300 \
-		--disk-light 0,3,2:0,-1,0:0.8:2000
+		--disk-light 0,3,2:0,-1,0:0.8:2000 && \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sky.png --width 640 --height 300 --sky-radiance 300
 
 # Regenerates the generated scenes in models/.
