@@ -501,24 +501,12 @@ fn shadow_map_misses_an_occluder_smaller_than_a_texel_but_never_invents_shadow()
     }
 }
 
-/// Pixels over the `render --check` tolerance (relative 1e-5 and absolute 8 f32 units of the peak), and how many
-/// of them the reference flags as having a fragile shadow ray.
+/// Pixels over the `render --check` tolerance, and how many of them the reference flags as having a fragile
+/// shadow ray.
 fn over_tolerance_and_fragile(g: &Image, c: &Image, fragile: &[bool]) -> (usize, usize) {
-    let peak = c.pixels().iter().flat_map(|p| p[..3].iter().copied()).fold(0.0f32, f32::max) as f64;
-    let floor = sunshade::compare::F32_SHADING_PEAK_FRACTION * peak;
-    let (mut over, mut flagged) = (0, 0);
-    for ((a, b), &f) in g.pixels().iter().zip(c.pixels()).zip(fragile) {
-        let bad = (0..3).any(|k| {
-            let (a, b) = (a[k] as f64, b[k] as f64);
-            let abs = (a - b).abs();
-            abs > floor && abs > 1e-5 * a.abs().max(b.abs())
-        });
-        if bad {
-            over += 1;
-            flagged += usize::from(f);
-        }
-    }
-    (over, flagged)
+    let (report, _) = compare::diff(g, c, &DiffOptions::default()).unwrap();
+    let flagged = report.over_tolerance_pixels.iter().filter(|&&(x, y)| fragile[(y * c.width() + x) as usize]).count();
+    (report.over_tolerance_pixels.len(), flagged)
 }
 
 #[test]

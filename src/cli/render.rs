@@ -12,6 +12,7 @@ use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
 use crate::settings::RenderSettings;
+use crate::shading::Shadows;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -125,13 +126,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
 /// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
 pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> Image {
+    let options = reference_options(session, a, job);
+    cpu::render(session.scene_ref(job.scene), &job.settings, &options)
+}
+
+/// The reference options that mirror the device that rendered `job`.
+fn reference_options(session: &mut Session, a: &RenderArgs, job: &Rendered) -> ReferenceOptions {
     let info = session.renderer_mut(job.renderer).device_info();
-    let options = ReferenceOptions {
+    ReferenceOptions {
         sub_pixel_bits: info.sub_pixel_precision_bits,
         fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
         device_ray_queries: info.ray_query,
-    };
-    cpu::render(session.scene_ref(job.scene), &job.settings, &options)
+    }
 }
 
 /// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
@@ -150,10 +156,21 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
         a.json,
     )?;
     if report.pass {
-        Ok(())
-    } else {
-        Err(CliError::Quiet(1))
+        return Ok(());
     }
+    if job.settings.shading.shadows == Shadows::Ray && !report.over_tolerance_pixels.is_empty() && !a.json {
+        // Which of the differences lie at shadow rays the GPU's f32 geometry may answer the other way.
+        let options = reference_options(session, a, job);
+        let (_, fragile) = cpu::render_with_fragile_rays(session.scene_ref(job.scene), &job.settings, &options);
+        let width = job.image.width();
+        let at = report.over_tolerance_pixels.iter().filter(|&&(x, y)| fragile[(y * width + x) as usize]).count();
+        println!(
+            "of the {} pixels over tolerance, {at} have a fragile shadow ray (within 2^-18 of the scene's size from \
+             an occluder's edge, where f32 geometry may answer the other way)",
+            report.over_tolerance_pixels.len()
+        );
+    }
+    Err(CliError::Quiet(1))
 }
 
 /// The pipeline-cache folder the command line uses: the default one unless `--no-cache`.

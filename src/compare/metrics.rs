@@ -131,6 +131,9 @@ pub struct DiffReport {
     /// The floor used in the relative error [W/(m²·sr)].
     pub floor: f64,
     pub over_tolerance: Split,
+    /// Where the pixels over tolerance are, `(x, y)` in scan order (to classify them further, e.g. against the
+    /// reference's fragile shadow rays).
+    pub over_tolerance_pixels: Vec<(u32, u32)>,
     /// Pixels over the warn level.
     pub over_warn: Split,
     /// Pixels over `hard_fail`.
@@ -196,6 +199,7 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
         peak,
         floor,
         over_tolerance: Split::default(),
+        over_tolerance_pixels: Vec::new(),
         over_warn: Split::default(),
         hard_failures: 0,
         allowed_over: options.fail_count,
@@ -256,6 +260,7 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
             let over = given.peek().is_some() && given.all(|&over| over);
             if over {
                 report.over_tolerance.add(edge);
+                report.over_tolerance_pixels.push((x, y));
             }
             let warn_checks = [options.warn_rel.map(|t| rel > t), options.warn_abs.map(|t| abs > t)];
             let mut warn_given = warn_checks.iter().flatten().peekable();
