@@ -95,6 +95,21 @@ pub(crate) fn warn(message: &str) {
     }
 }
 
+/// [`warn`], once per process for each distinct message (a batch of many jobs repeats the same ones).
+pub(crate) fn warn_once(message: &str) {
+    static SEEN: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let first = SEEN.lock().map_or(true, |mut seen| {
+        let new = !seen.iter().any(|m| m == message);
+        if new {
+            seen.push(message.to_string());
+        }
+        new
+    });
+    if first {
+        warn(message);
+    }
+}
+
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
 #[derive(Debug)]
 pub enum CliError {

@@ -114,7 +114,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let (_, gpu_scene, r) = session.parts(scene, renderer);
     let choice = r.shadow_choice(gpu_scene, &settings)?;
     if choice.warning {
-        super::warn(&format!("shadows: {}", choice.reason));
+        super::warn_once(&format!("shadows: {}", choice.reason));
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
