@@ -44,6 +44,8 @@ pub fn choose_reference(requested: Shadows, lights: &Lights, can_occlude: bool) 
     let mut choice = choose(requested, lights, can_occlude, true);
     if choice.technique == Shadows::Map {
         choice = ShadowChoice::new(Shadows::Ray, "the reference casts rays for --shadows map");
+    } else if requested == Shadows::Auto && choice.technique == Shadows::Ray {
+        choice = ShadowChoice::new(Shadows::Ray, "auto: the scene can shadow itself; the reference casts f64 rays");
     }
     choice
 }
