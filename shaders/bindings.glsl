@@ -59,7 +59,7 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
     uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions)
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
-    vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 1 if rendered
+    vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 0 none, 1 PCSS, 2 nearest
     DiskGpu disks[];
 } lights;
 

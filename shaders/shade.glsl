@@ -62,7 +62,8 @@ vec3 irradiance_visible(Frame p) {
                                          : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
         }
         if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
-            v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, VARIANT_SUN != SUN_DELTA);
+            bool pcss = VARIANT_SUN != SUN_DELTA && lights.sun_map.w == 1.0;
+            v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, pcss);
             sun_map_fraction = v;
         }
         e += unoccluded * v;

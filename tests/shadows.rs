@@ -426,6 +426,17 @@ fn shadow_map_agrees_with_rays_away_from_penumbrae() {
         eprintln!("{name}: map vs rays: {} of {} pixels over tolerance", report.over_tolerance.total, report.covered_b);
         assert_eq!(report.coverage_mismatches.total, 0);
         assert!(report.over_tolerance.total * 200 <= report.covered_b, "{name}: {}", report.text("map", "rays"));
+        // The nearest texel alone against the one ray to the sun's centre: hard shadows both.
+        let mut hard = s.clone();
+        hard.shading.shadow_map_filter = sunshade::shading::ShadowMapFilter::Nearest;
+        hard.shading.shadow_samples_per_axis = 1;
+        let g = gpu.render(&scene, &hard);
+        let mut r = hard.clone();
+        r.shading.shadows = Shadows::Ray;
+        let c = cpu::render(&scene, &r, &gpu.reference_options());
+        let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+        eprintln!("{name}: nearest map vs one ray: {} pixels over tolerance", report.over_tolerance.total);
+        assert!(report.over_tolerance.total * 200 <= report.covered_b, "{name}: {}", report.text("map", "rays"));
     }
 }
 

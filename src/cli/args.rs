@@ -10,7 +10,7 @@ use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{
-    DiskModel, ShadingOptions, Shadows, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SHADOW_MAP_SIZE,
+    DiskModel, ShadingOptions, ShadowMapFilter, Shadows, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SHADOW_MAP_SIZE,
     DEFAULT_SHADOW_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 
@@ -240,6 +240,11 @@ pub struct SceneArgs {
     /// Side of the sun's shadow map [texels] (`--shadows map`): an orthographic depth map fitted to the scene.
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_MAP_SIZE, value_parser = clap::value_parser!(u32).range(16..=16384))]
     pub shadow_map_size: u32,
+
+    /// The shadow map's filter: `pcss` (the sun's disk: blocker search and filter, a penumbra) or `nearest`
+    /// (the texel under the point: hard shadows).
+    #[arg(help_heading = "Shadows", long, default_value = "pcss", value_name = "pcss|nearest")]
+    pub shadow_map_filter: ShadowMapFilter,
 }
 
 /// The side of the smallest square grid with at least `samples` cells.
@@ -282,6 +287,7 @@ impl SceneArgs {
                 shadows: self.shadows,
                 shadow_samples_per_axis: per_axis(self.shadow_samples),
                 shadow_map_size: self.shadow_map_size,
+                shadow_map_filter: self.shadow_map_filter,
             },
         }
     }

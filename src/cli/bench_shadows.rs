@@ -18,7 +18,7 @@ use crate::film::Image;
 use crate::gpu::{ContextOptions, Renderer};
 use crate::scene::{self, LoadOptions, Mesh, Scene};
 use crate::settings::{self, CameraOptions, LightOptions, RenderSettings, SunOptions};
-use crate::shading::{Shadows, DEFAULT_SHADOW_SAMPLES_PER_AXIS};
+use crate::shading::{ShadowMapFilter, Shadows, DEFAULT_SHADOW_SAMPLES_PER_AXIS};
 
 /// Samples per axis of the converged reference, and of its refinement check (about twice the rays).
 const CONVERGED: u32 = 32;
@@ -140,15 +140,20 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         out += "| technique | rays (or filter samples) per light and pixel | GPU frame [ms] | CPU reference [ms] | max error | mean error | px > 1e-2 | px > 1e-3 | GPU vs CPU rays, px over tolerance |\n";
         out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         let gpu_scene = renderer.upload(&scene)?;
-        // (technique, samples per axis, map size): none; rays at 1 to 256 per light; the sun's map at 512² to 4096²
-        // with the default 8² samples for its filter.
-        let mut rows: Vec<(Shadows, u32, u32)> = vec![(Shadows::None, 1, 0)];
-        rows.extend([1u32, 2, 4, 8, 16].map(|k| (Shadows::Ray, k, 0)));
-        rows.extend([512u32, 1024, 2048, 4096].map(|n| (Shadows::Map, DEFAULT_SHADOW_SAMPLES_PER_AXIS, n)));
-        for (technique, k, map_size) in rows {
+        // (technique, samples per axis, map size, filter): none; rays at 1 to 256 per light; the sun's map at 512²
+        // to 4096² with the default 8² samples for its PCSS filter, and at 2048² with the nearest texel alone.
+        let mut rows: Vec<(Shadows, u32, u32, ShadowMapFilter)> = vec![(Shadows::None, 1, 0, ShadowMapFilter::Pcss)];
+        rows.extend([1u32, 2, 4, 8, 16].map(|k| (Shadows::Ray, k, 0, ShadowMapFilter::Pcss)));
+        rows.extend(
+            [512u32, 1024, 2048, 4096]
+                .map(|n| (Shadows::Map, DEFAULT_SHADOW_SAMPLES_PER_AXIS, n, ShadowMapFilter::Pcss)),
+        );
+        rows.push((Shadows::Map, 1, 2048, ShadowMapFilter::Nearest));
+        for (technique, k, map_size, filter) in rows {
             let mut sk = with(&s, technique, k);
             if technique == Shadows::Map {
                 sk.shading.shadow_map_size = map_size;
+                sk.shading.shadow_map_filter = filter;
             }
             // The reference of the row: itself, or for the map the rays with the same samples.
             let t = Instant::now();
@@ -180,6 +185,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
                 None => ("–".into(), "–".into()),
             };
             let (label, cpu_time) = match technique {
+                Shadows::Map if filter == ShadowMapFilter::Nearest => {
+                    (format!("map {map_size}², nearest"), "–".to_string())
+                }
                 Shadows::Map => (format!("map {map_size}²"), "–".to_string()),
                 t => (t.name().to_string(), format!("{:.1}", ms(cpu_time))),
             };

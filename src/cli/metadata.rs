@@ -7,7 +7,7 @@ use serde_json::json;
 
 use crate::film::Metadata;
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, SunModel};
+use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
 
 /// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference").
 pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
@@ -38,6 +38,8 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "samples": sh.samples_per_axis * sh.samples_per_axis,
         "shadows": sh.shadows.name(),
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
+        "shadow_map_size": sh.shadow_map_size,
+        "shadow_map_filter": match sh.shadow_map_filter { ShadowMapFilter::Pcss => "pcss", ShadowMapFilter::Nearest => "nearest" },
         "camera": { "eye": cam.eye.to_array(), "forward": cam.forward.to_array(), "up": cam.up.to_array(),
                     "orthographic": cam.is_orthographic() },
         "worldToNDC": "Vulkan clip space before the divide by w: x right, y down, depth in [0, 1]",

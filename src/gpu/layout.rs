@@ -4,7 +4,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::scene::{Brdf, Lights, Material};
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, ShadingOptions, SunModel};
+use crate::shading::{DiskModel, ShadingOptions, ShadowMapFilter, SunModel};
 use crate::visibility::shadow_map::SunMapFrame;
 
 pub const BRDF_LAMBERT: u32 = 0;
@@ -107,7 +107,8 @@ pub struct LightsHeader {
     pub sampling: [u32; 4],
     /// World → the sun's shadow map (column-major), `visibility::shadow_map`.
     pub sun_map_from_world: [f32; 16],
-    /// Texel side [m], depth extent [m], size [texels], 1 if the map was rendered this frame.
+    /// Texel side [m], depth extent [m], size [texels], and 0 if no map was rendered this frame, 1 for the PCSS
+    /// filter, 2 for the nearest texel.
     pub sun_map: [f32; 4],
 }
 
@@ -158,7 +159,13 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions, sun_map: Option<(
         counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
         sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, 0, 0],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
-        sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
+        sun_map: sun_map.map_or([0.0; 4], |(f, size)| {
+            let filter = match shading.shadow_map_filter {
+                ShadowMapFilter::Pcss => 1.0,
+                ShadowMapFilter::Nearest => 2.0,
+            };
+            [f.texel as f32, f.depth_extent as f32, size as f32, filter]
+        }),
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {

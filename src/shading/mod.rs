@@ -16,5 +16,6 @@ pub use shade::{
     ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{
-    Occlusion, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+    Occlusion, ShadowMapFilter, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
+    DEFAULT_SHADOW_SAMPLES_PER_AXIS,
 };

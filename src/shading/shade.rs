@@ -25,8 +25,8 @@ use super::radiometry::{
     sun_irradiance_disk, DiskGeometry,
 };
 use super::visibility::{
-    disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, Shadowing, Shadows, DEFAULT_SHADOW_MAP_SIZE,
-    DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+    disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, ShadowMapFilter, Shadowing, Shadows,
+    DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
 };
 use crate::scene::{Brdf, DiskLight, Lights, Material};
 
@@ -69,6 +69,8 @@ pub struct ShadingOptions {
     pub shadow_samples_per_axis: u32,
     /// Side of the sun's shadow map [texels] (`--shadows map`).
     pub shadow_map_size: u32,
+    /// Its filter.
+    pub shadow_map_filter: ShadowMapFilter,
 }
 
 impl Default for ShadingOptions {
@@ -81,6 +83,7 @@ impl Default for ShadingOptions {
             shadows: Shadows::Auto,
             shadow_samples_per_axis: DEFAULT_SHADOW_SAMPLES_PER_AXIS,
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
+            shadow_map_filter: ShadowMapFilter::Pcss,
         }
     }
 }

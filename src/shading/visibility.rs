@@ -48,6 +48,27 @@ use super::shade::orthonormal_to;
 /// Default samples per axis of the visibility grids (`k² = 64` shadow rays per light and pixel).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 8;
 
+/// How the sun's shadow map is filtered (`--shadow-map-filter`; GPU, `--shadows map`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ShadowMapFilter {
+    /// The sun's disk: a blocker search and a filter on the visible-fraction grid (PCSS): a penumbra.
+    #[default]
+    Pcss,
+    /// The texel under the point alone: hard shadows (as for a delta sun).
+    Nearest,
+}
+
+impl std::str::FromStr for ShadowMapFilter {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "pcss" => Ok(ShadowMapFilter::Pcss),
+            "nearest" => Ok(ShadowMapFilter::Nearest),
+            _ => Err(format!("'{s}' is not a shadow-map filter (pcss, nearest)")),
+        }
+    }
+}
+
 /// Default side of the sun's shadow map [texels] (`--shadow-map-size`; GPU, `--shadows map`).
 pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 2048;
 
