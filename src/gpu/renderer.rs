@@ -322,9 +322,9 @@ impl Renderer {
                 "materials",
             )?,
             draws,
-            // Only `auto` on a device with ray queries asks (without them `auto` renders unshadowed either way):
-            // elsewhere the test's cost (24 ms for 20k triangles) is saved.
-            can_occlude: !rq || crate::visibility::can_occlude(scene),
+            // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
+            // ray queries warns that `auto` has no shadows for this scene.
+            can_occlude: crate::visibility::can_occlude(scene),
             bounds: scene.bounds(),
         })
     }
