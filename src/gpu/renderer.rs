@@ -23,7 +23,7 @@ use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;
-use crate::visibility::shadow_map::fit_sun_map;
+use crate::visibility::shadow_map::{fit_sun_map, SunMapFrame};
 use crate::visibility::ShadowChoice;
 
 /// Wall-clock time of the set-up phases [s].
@@ -374,40 +374,12 @@ impl Renderer {
         self.render(&gpu_scene, settings)
     }
 
-    /// Draws an uploaded scene and reads the radiance back.
+    /// Draws an uploaded scene and reads the radiance back: the sun's shadow-map pass where the technique is
+    /// `map`, the scene pass, the readback.
     pub fn render(&mut self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Image, FrameTimings), GpuError> {
         let (width, height) = (settings.width, settings.height);
         self.check_size(width, height)?;
-        if self.target.as_ref().is_none_or(|t| t.color.width != width || t.color.height != height) {
-            self.target = None;
-            self.target = Some(Target {
-                color: Image2d::new(
-                    &self.dev,
-                    width,
-                    height,
-                    COLOR_FORMAT,
-                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-                    vk::ImageAspectFlags::COLOR,
-                    "colour target",
-                )?,
-                depth: Image2d::new(
-                    &self.dev,
-                    width,
-                    height,
-                    DEPTH_FORMAT,
-                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-                    vk::ImageAspectFlags::DEPTH,
-                    "depth target",
-                )?,
-                readback: Buffer::new(
-                    &self.dev,
-                    rgba32f_bytes(width, height).expect("checked"),
-                    vk::BufferUsageFlags::TRANSFER_DST,
-                    MemoryLocation::GpuToCpu,
-                    "readback",
-                )?,
-            });
-        }
+        self.ensure_target(width, height)?;
         self.lights = None;
         let technique = self.shadow_choice(scene, settings)?.technique;
         // The sun's shadow map, where `map` is the technique and there is a sun and geometry.
@@ -441,12 +413,66 @@ impl Renderer {
         }
         let shadow_pipeline = if sun_map.is_some() { Some(self.pipeline.shadow_pipeline()?) } else { None };
         let pipelines = t_pipelines.elapsed();
-        let target = self.target.as_ref().expect("created above");
-        let d = &self.dev.device;
-
         let t_render = Instant::now();
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
+        unsafe {
+            self.write_descriptors(scene, &lights);
+            let cb = self.commands.begin(&self.dev)?;
+            if let (Some(frame), Some(shadow_pipeline)) = (&sun_map, shadow_pipeline) {
+                self.record_sun_map_pass(cb, scene, settings, frame, shadow_pipeline);
+            }
+            self.record_scene_pass(cb, scene, settings, &draw_pipelines);
+            self.commands.submit_and_wait(&self.dev, cb)?;
+        }
+        let render = t_render.elapsed();
+        let t_readback = Instant::now();
+        let image = self.read_back(width, height)?;
+        let readback = t_readback.elapsed();
+        self.lights = Some(lights);
+        self.check_validation()?;
+        Ok((image, FrameTimings { pipelines, render, readback }))
+    }
+
+    /// The colour and depth targets and the readback buffer, (re)made for this size.
+    fn ensure_target(&mut self, width: u32, height: u32) -> Result<(), GpuError> {
+        if self.target.as_ref().is_none_or(|t| t.color.width != width || t.color.height != height) {
+            self.target = None;
+            self.target = Some(Target {
+                color: Image2d::new(
+                    &self.dev,
+                    width,
+                    height,
+                    COLOR_FORMAT,
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                    vk::ImageAspectFlags::COLOR,
+                    "colour target",
+                )?,
+                depth: Image2d::new(
+                    &self.dev,
+                    width,
+                    height,
+                    DEPTH_FORMAT,
+                    vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                    vk::ImageAspectFlags::DEPTH,
+                    "depth target",
+                )?,
+                readback: Buffer::new(
+                    &self.dev,
+                    rgba32f_bytes(width, height).expect("checked"),
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                    "readback",
+                )?,
+            });
+        }
+        Ok(())
+    }
+
+    /// Bindings 0 materials, 1 lights, 2 indices, 3 vertices, 4 the acceleration structure, 5 the sun's map.
+    unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer) {
+        let d = &self.dev.device;
+        // SAFETY: the caller guarantees the GPU is idle; every handle belongs to this renderer.
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
@@ -493,11 +519,22 @@ impl Renderer {
                     .push_next(&mut info);
                 d.update_descriptor_sets(&[write], &[]);
             }
+        }
+    }
 
-            let cb = self.commands.begin(&self.dev)?;
-            if let (Some(frame), Some(shadow_pipeline), Some(vb), Some(ib)) =
-                (&sun_map, shadow_pipeline, &scene.vertices, &scene.indices)
-            {
+    /// Records the sun's shadow-map pass: every draw, depth only, through the map's frame.
+    unsafe fn record_sun_map_pass(
+        &self,
+        cb: vk::CommandBuffer,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        frame: &SunMapFrame,
+        shadow_pipeline: vk::Pipeline,
+    ) {
+        let d = &self.dev.device;
+        // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer.
+        unsafe {
+            if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 let layout = self.pipeline.layout;
                 let map_from_world = frame.map_from_world.as_mat4().to_cols_array();
                 self.sun_map.record(cb, |cb| {
@@ -520,6 +557,22 @@ impl Renderer {
                     }
                 });
             }
+        }
+    }
+
+    /// Records the scene pass: targets cleared, every draw with its pipeline variant.
+    unsafe fn record_scene_pass(
+        &self,
+        cb: vk::CommandBuffer,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        draw_pipelines: &[vk::Pipeline],
+    ) {
+        let d = &self.dev.device;
+        let target = self.target.as_ref().expect("made by ensure_target");
+        let (width, height) = (settings.width, settings.height);
+        // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer.
+        unsafe {
             let to_attachment = [
                 image_barrier(
                     target.color.image,
@@ -586,7 +639,7 @@ impl Renderer {
                 d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
                 d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
                 let mut bound = vk::Pipeline::null();
-                for (draw, &pipeline) in scene.draws.iter().zip(&draw_pipelines) {
+                for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
                     if pipeline != bound {
                         d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
                         bound = pipeline;
@@ -607,12 +660,14 @@ impl Renderer {
                 }
             }
             d.cmd_end_rendering(cb);
-            self.commands.submit_and_wait(&self.dev, cb)?;
         }
-        let render = t_render.elapsed();
+    }
 
-        let t_readback = Instant::now();
-        // SAFETY: as above; the colour image is in COLOR_ATTACHMENT_OPTIMAL after the render submission.
+    /// Copies the colour target into an [`Image`].
+    fn read_back(&self, width: u32, height: u32) -> Result<Image, GpuError> {
+        let d = &self.dev.device;
+        let target = self.target.as_ref().expect("made by ensure_target");
+        // SAFETY: the GPU is idle (every submission is waited for); the colour image is in COLOR_ATTACHMENT_OPTIMAL after the render submission.
         unsafe {
             let cb = self.commands.begin(&self.dev)?;
             let to_transfer = [image_barrier(
@@ -659,10 +714,7 @@ impl Renderer {
         }
         let pixels = copy_pixels(target.readback.mapped());
         let image = Image::from_pixels(width, height, pixels).expect("readback buffer sized for the image");
-        let readback = t_readback.elapsed();
-        self.lights = Some(lights);
-        self.check_validation()?;
-        Ok((image, FrameTimings { pipelines, render, readback }))
+        Ok(image)
     }
 
     fn check_validation(&self) -> Result<(), GpuError> {
