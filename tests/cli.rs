@@ -600,3 +600,38 @@ fn info_says_whether_the_device_has_ray_queries_on_both_lavapipes() {
     assert_eq!(lavapipe["ray_query"], true, "{lavapipe}");
     assert!(lavapipe["driver_info"].as_str().unwrap().contains("Mesa 25"), "{lavapipe}");
 }
+
+#[test]
+fn shadow_flags_warnings_and_refusals() {
+    let dir = TempDir::new("cli-shadows");
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let room = models.join("room.gltf");
+    let out = dir.path("room.exr");
+    // A technique that does not exist is a usage error naming the choices.
+    let o = sunshade(&["render", s(&room), "-o", s(&out), "--shadows", "soft"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("auto") && stderr(&o).contains("map"), "{}", stderr(&o));
+    // The map shadows the sun only: the room's disk light stays unoccluded, and a warning says so; the image's
+    // metadata records the technique used.
+    let o = sunshade(&["render", s(&room), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "map"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("disk lights and the sky are unoccluded"), "{}", stderr(&o));
+    let exr = std::fs::read(&out).unwrap();
+    let needle = b"\"shadows\":\"map\"";
+    assert!(exr.windows(needle.len()).any(|w| w == needle), "the EXR names the technique");
+    // The reference says what it did and why.
+    let o = sunshade(&["reference", s(&room), "-o", s(&out), "--width", "32", "--height", "24", "-v"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("shadows: ray (auto: the scene can shadow itself"), "{}", stderr(&o));
+    // Rays on the GPU need ray queries: refused with a way out on a device without them.
+    let info: serde_json::Value = serde_json::from_slice(&sunshade(&["info", "--json"]).stdout).unwrap();
+    let chosen = info["chosen"].as_u64().map(|i| i as usize);
+    let rq = chosen.and_then(|i| info["devices"][i]["ray_query"].as_bool()).unwrap_or(false);
+    let o = sunshade(&["render", s(&room), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "ray"]);
+    if rq {
+        assert!(o.status.success(), "{}", stderr(&o));
+    } else {
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("no ray queries") && stderr(&o).contains("lavapipe-rt.sh"), "{}", stderr(&o));
+    }
+}
