@@ -31,6 +31,10 @@ layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EX
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
 layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 
+// Disk lights with a shadow map of their own (`--shadows map`); the others stay unoccluded. Matches
+// gpu::layout::MAX_DISK_MAPS.
+#define MAX_DISK_MAPS 4u
+
 struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
     vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
@@ -57,9 +61,14 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
     uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
-    uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions)
+    uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions);
+                    // z: shadow-map filter, 1 PCSS, 2 nearest
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
     vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 0 none, 1 PCSS, 2 nearest
+    // The first MAX_DISK_MAPS disk lights' perspective maps (visibility/shadow_map.rs, fit_disk_map): world -> map
+    // clip space, and (tan of the half field of view, near [m], far [m], size [texels] or 0 if not rendered).
+    mat4 disk_map_from_world[MAX_DISK_MAPS];
+    vec4 disk_map[MAX_DISK_MAPS];
     DiskGpu disks[];
 } lights;
 
@@ -76,6 +85,8 @@ layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
 
 // The sun's shadow map (depth, read texel by texel with texelFetch: no filtering by the device).
 layout(set = 0, binding = 5) uniform sampler2D shadow_map;
+// The disk lights' shadow maps, the same way.
+layout(set = 0, binding = 6) uniform sampler2D disk_shadow_maps[MAX_DISK_MAPS];
 
 layout(push_constant) uniform PushConstants {
     mat4 clip_from_world;   // world -> Vulkan clip space (f32, column-major)

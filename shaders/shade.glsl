@@ -13,8 +13,10 @@ const bool SHADOWS_ON = VARIANT_SHADOWS == SHADOWS_RAY;
 // Whether it looks the sun up in its shadow map (disk lights and the sky are then unoccluded).
 const bool SHADOWS_MAP_ON = VARIANT_SHADOWS == SHADOWS_MAP;
 
-// The sun's visible fraction from the map, found by irradiance_visible and reused for the specular part.
+// The sun's and the first disks' visible fractions from their maps, found by irradiance_visible and reused for the
+// specular part.
 float sun_map_fraction = 1.0;
+float disk_map_fraction[MAX_DISK_MAPS] = float[](1.0, 1.0, 1.0, 1.0);
 
 // Which shadow rays a lobe integral's samples cast (Rust: Option<SampleRays>).
 #define RAYS_NONE 0u
@@ -62,7 +64,7 @@ vec3 irradiance_visible(Frame p) {
                                          : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
         }
         if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
-            bool pcss = VARIANT_SUN != SUN_DELTA && lights.sun_map.w == 1.0;
+            bool pcss = VARIANT_SUN != SUN_DELTA && lights.sampling.z == 1u;
             v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, pcss);
             sun_map_fraction = v;
         }
@@ -78,6 +80,12 @@ vec3 irradiance_visible(Frame p) {
             v = VARIANT_DISKS == DISKS_SMALL_SOURCE
                 ? (visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0)
                 : disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        }
+        if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
+            bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;
+            v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal, d.center_radius.xyz,
+                d.direction.xyz, d.center_radius.w, pcss);
+            disk_map_fraction[i] = v;
         }
         omega = omega * v;
         e += d.radiance.rgb * omega;
@@ -344,6 +352,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         } else {
             integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
                 d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE);
+        }
+        if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
+            integral *= disk_map_fraction[i];
         }
         specular += integral * d.radiance.rgb;
     }

@@ -104,4 +104,96 @@ float sun_visible_fraction_map(vec3 origin, uint k, vec3 n, vec3 face, vec3 l, f
     return fraction(visible, total);
 }
 
+// Linear depth [m] along the disk's axis of the nearest surface in texel `tc` of disk map i, far beyond anything
+// outside the map or where the texel holds nothing. (Constant indices: no dynamic indexing of the array needed.)
+float disk_map_depth(uint i, vec2 tc) {
+    vec4 m = lights.disk_map[i];
+    if (tc.x < 0.0 || tc.y < 0.0 || tc.x >= m.w || tc.y >= m.w) {
+        return RAY_T_INFINITE;
+    }
+    ivec2 t = ivec2(tc);
+    float z = i == 0u ? texelFetch(disk_shadow_maps[0], t, 0).r
+            : i == 1u ? texelFetch(disk_shadow_maps[1], t, 0).r
+            : i == 2u ? texelFetch(disk_shadow_maps[2], t, 0).r
+                      : texelFetch(disk_shadow_maps[3], t, 0).r;
+    // Perspective depth back to linear: z = f n / (f - z_ndc (f - n)).
+    return z < 1.0 ? m.z * m.y / (m.z - z * (m.z - m.y)) : RAY_T_INFINITE;
+}
+
+// The visible fraction of disk light i (centre, emission direction d, radius) from the point x with normal n and
+// face normal `face`, by its map (PCSS for an area light, Fernando 2005): the receiver's depth z along the axis,
+// a blocker search, the mean blocker depth z_b, then every sample of the same k x k grid as the rays looked up
+// where its ray crosses depth z_b, and weighted as the rays are. Outside the map's field of view (more than 80
+// degrees off the axis) the light is unoccluded. The comparison allows one texel at the receiver's distance times
+// (1 + tan of the face's angle to the light), plus the tangent plane's depth change out to each lookup.
+float disk_visible_fraction_map(uint i, vec3 origin, uint k, vec3 x, vec3 n, vec3 face, vec3 center, vec3 d, float radius, bool pcss) {
+    vec4 m = lights.disk_map[i];
+    vec4 q = lights.disk_map_from_world[i] * vec4(origin, 1.0);
+    float z = q.w;
+    if (!(z > m.y) || abs(q.x) > z || abs(q.y) > z) {
+        return 1.0;
+    }
+    float size = m.w;
+    vec2 tc = (q.xy / z * 0.5 + 0.5) * size;
+    // The side of one texel at the receiver's distance [m], and per metre of depth at the near plane.
+    float texel_at = 2.0 * z * m.x / size;
+    vec3 toward = center - origin;
+    float len2 = dot(toward, toward);
+    vec3 to_light = len2 > 0.0 ? toward * inversesqrt(len2) : -d;
+    float c = abs(dot(face, to_light));
+    float t = c > 1e-3 ? sqrt(max(1.0 - c * c, 0.0)) / c : 1e3;
+    float bias = texel_at * (1.0 + t);
+    // A lookup r texels away meets the receiver's own (tangent) plane up to r texel_at tan(theta) nearer: allowed
+    // for, so that a curved or tilted receiver does not shadow itself through the filter's offsets.
+    float slope = texel_at * min(t, 1e3);
+    if (!pcss) {
+        return disk_map_depth(i, tc) < z - bias ? 0.0 : 1.0;
+    }
+    // The ray from x to the disk point c + R (a, b) crosses depth z' at the map position of x plus
+    // R (a, b) (z - z') / (z' z) in tan units, size / (2 tan) texels each: the search covers blockers from halfway
+    // to the disk (z' = z / 2: R / z tan units, R / texel_at texels); nearer ones are found only in part.
+    float search = min(radius / texel_at, 0.5 * size);
+    float blockers = 0.0;
+    float depth_sum = 0.0;
+    for (uint a = 0u; a < k; ++a) {
+        for (uint b = 0u; b < k; ++b) {
+            vec2 o = disk_grid_point(a, b, k);
+            float dz = disk_map_depth(i, tc + search * o);
+            if (dz < z - bias - slope * search * length(o)) {
+                blockers += 1.0;
+                depth_sum += dz;
+            }
+        }
+    }
+    if (blockers == 0.0 && !(disk_map_depth(i, tc) < z - bias)) {
+        return 1.0;
+    }
+    float zb = blockers > 0.0 ? depth_sum / blockers : disk_map_depth(i, tc);
+    // The offset of the disk's rim at the mean blocker depth: R (z - z_b) / (z_b z) tan units, in texels.
+    float spread = min(radius * max(z - zb, 0.0) / max(zb, m.y) / texel_at, 0.5 * size);
+    vec3 ax = orthonormal_to(d);
+    vec3 ay = cross(d, ax);
+    float visible = 0.0;
+    float total = 0.0;
+    for (uint a = 0u; a < k; ++a) {
+        for (uint b = 0u; b < k; ++b) {
+            vec2 o = disk_grid_point(a, b, k);
+            vec3 y = center + radius * (o.x * ax + o.y * ay);
+            vec3 to = y - x;
+            float dist2 = dot(to, to);
+            vec3 omega = to / sqrt(dist2);
+            float cos_r = dot(n, omega);
+            float cos_d = -dot(d, omega);
+            if (cos_r > 0.0 && cos_d > 0.0) {
+                float w = cos_r * cos_d / dist2;
+                total += w;
+                if (!(disk_map_depth(i, tc + spread * o) < z - bias - slope * spread * length(o))) {
+                    visible += w;
+                }
+            }
+        }
+    }
+    return fraction(visible, total);
+}
+
 #endif

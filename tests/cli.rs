@@ -611,11 +611,15 @@ fn shadow_flags_warnings_and_refusals() {
     let o = sunshade(&["render", s(&room), "-o", s(&out), "--shadows", "soft"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("auto") && stderr(&o).contains("map"), "{}", stderr(&o));
-    // The map shadows the sun only: the room's disk light stays unoccluded, and a warning says so; the image's
-    // metadata records the technique used.
+    // The maps shadow the sun and disk lights, not the sky: the overcast scene's sky stays unoccluded and a
+    // warning says so, the room's disk light is mapped without one; the image's metadata records the technique.
+    let overcast = models.join("overcast.glb");
+    let o = sunshade(&["render", s(&overcast), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "map"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the sky has no shadow map"), "{}", stderr(&o));
     let o = sunshade(&["render", s(&room), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "map"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("disk lights and the sky are unoccluded"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
     let exr = std::fs::read(&out).unwrap();
     let needle = b"\"shadows\":\"map\"";
     assert!(exr.windows(needle.len()).any(|w| w == needle), "the EXR names the technique");

@@ -227,8 +227,8 @@ pub struct SceneArgs {
     pub sun_samples: Option<u32>,
 
     /// Shadows: `auto` (shadow rays where the device has ray queries, else none, with a warning; none where
-    /// nothing can occlude a light), `none`, `ray`, or `map` (the sun's shadow map, any device; disk lights and
-    /// the sky unoccluded). The reference casts rays for every technique but `none`.
+    /// nothing can occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk
+    /// lights, any device; the sky unoccluded). The reference casts rays for every technique but `none`.
     #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
     pub shadows: Shadows,
 
@@ -237,7 +237,7 @@ pub struct SceneArgs {
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_SAMPLES_PER_AXIS * DEFAULT_SHADOW_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub shadow_samples: u32,
 
-    /// Side of the sun's shadow map [texels] (`--shadows map`): an orthographic depth map fitted to the scene.
+    /// Side of each shadow map [texels] (`--shadows map`).
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_MAP_SIZE, value_parser = clap::value_parser!(u32).range(16..=16384))]
     pub shadow_map_size: u32,
 

@@ -49,9 +49,9 @@ pub struct ReferenceOptions {
     /// JIT does where the host CPU has FMA: measured on a dense lattice of isolated triangles at 1000×1000, the
     /// fused mirror matched lavapipe's coverage exactly and the unfused one did not.
     pub fused_viewport: bool,
-    /// Whether the device has ray queries, for `--shadows auto`: a device without them would use shadow maps,
-    /// which sunshade does not have yet, and renders every light unoccluded; the reference then does the same,
-    /// so that it mirrors what the device computed. (An explicit `ray` or `map` always gets rays.)
+    /// Whether the device has ray queries, for `--shadows auto`: a device without them renders every light
+    /// unoccluded under `auto` (shadow maps are asked for with `map`); the reference then does the same, so that
+    /// it mirrors what the device computed. (An explicit `ray` or `map` always gets rays.)
     pub device_ray_queries: bool,
 }
 

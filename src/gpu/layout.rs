@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::scene::{Brdf, Lights, Material};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadingOptions, ShadowMapFilter, SunModel};
-use crate::visibility::shadow_map::SunMapFrame;
+use crate::visibility::shadow_map::{DiskMapFrame, SunMapFrame};
 
 pub const BRDF_LAMBERT: u32 = 0;
 pub const BRDF_PHONG: u32 = 1;
@@ -20,6 +20,8 @@ pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
+/// Disk lights with a shadow map of their own (`MAX_DISK_MAPS` in the shaders).
+pub const MAX_DISK_MAPS: usize = 4;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
 /// `shaders/bindings.glsl`, constant ids 0 to 4). The shader keeps only the code these select; `shadows` also
@@ -103,13 +105,17 @@ pub struct LightsHeader {
     pub sky: [f32; 4],
     /// Disk count, unused, unused, samples per axis for disks and the sky.
     pub counts: [u32; 4],
-    /// Samples per axis over the sun's disk, shadow samples per axis (visible fractions); the rest unused.
+    /// Samples per axis over the sun's disk, shadow samples per axis (visible fractions), the shadow maps'
+    /// filter (1 PCSS, 2 nearest); the rest unused.
     pub sampling: [u32; 4],
     /// World → the sun's shadow map (column-major), `visibility::shadow_map`.
     pub sun_map_from_world: [f32; 16],
-    /// Texel side [m], depth extent [m], size [texels], and 0 if no map was rendered this frame, 1 for the PCSS
-    /// filter, 2 for the nearest texel.
+    /// Texel side [m], depth extent [m], size [texels], 1 if the map was rendered this frame (else 0).
     pub sun_map: [f32; 4],
+    /// World → each of the first disks' shadow maps (column-major), `visibility::shadow_map::fit_disk_map`.
+    pub disk_map_from_world: [[f32; 16]; MAX_DISK_MAPS],
+    /// tan of the half field of view, near [m], far [m], size [texels] (0: no map this frame).
+    pub disk_map: [[f32; 4]; MAX_DISK_MAPS],
 }
 
 #[repr(C)]
@@ -141,7 +147,24 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
 }
 
 /// The light buffer's bytes.
-pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions, sun_map: Option<(&SunMapFrame, u32)>) -> Vec<u8> {
+pub fn lights_bytes(
+    lights: &Lights,
+    shading: &ShadingOptions,
+    sun_map: Option<(&SunMapFrame, u32)>,
+    disk_maps: &[Option<(DiskMapFrame, u32)>],
+) -> Vec<u8> {
+    let filter = match shading.shadow_map_filter {
+        ShadowMapFilter::Pcss => 1,
+        ShadowMapFilter::Nearest => 2,
+    };
+    let mut disk_map_from_world = [[0.0f32; 16]; MAX_DISK_MAPS];
+    let mut disk_map = [[0.0f32; 4]; MAX_DISK_MAPS];
+    for (i, m) in disk_maps.iter().enumerate().take(MAX_DISK_MAPS) {
+        if let Some((f, size)) = m {
+            disk_map_from_world[i] = f.map_from_world.as_mat4().to_cols_array();
+            disk_map[i] = [f.tan_half as f32, f.near as f32, f.far as f32, *size as f32];
+        }
+    }
     let sun = match &lights.sun {
         Some(s) => SunGpu {
             direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
@@ -157,15 +180,11 @@ pub fn lights_bytes(lights: &Lights, shading: &ShadingOptions, sun_map: Option<(
         sun,
         sky,
         counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
-        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, 0, 0],
+        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, 0],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
-        sun_map: sun_map.map_or([0.0; 4], |(f, size)| {
-            let filter = match shading.shadow_map_filter {
-                ShadowMapFilter::Pcss => 1.0,
-                ShadowMapFilter::Nearest => 2.0,
-            };
-            [f.texel as f32, f.depth_extent as f32, size as f32, filter]
-        }),
+        sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
+        disk_map_from_world,
+        disk_map,
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
@@ -217,6 +236,7 @@ mod tests {
         for (name, value) in constants {
             assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
         }
+        assert!(glsl.contains(&format!("#define MAX_DISK_MAPS {MAX_DISK_MAPS}u\n")));
         for (id, name) in
             ["VARIANT_BRDF", "VARIANT_SUN", "VARIANT_DISKS", "VARIANT_SKY", "VARIANT_SHADOWS"].iter().enumerate()
         {
@@ -230,7 +250,9 @@ mod tests {
     #[test]
     fn sizes_match_std430() {
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
-        assert_eq!(std::mem::size_of::<LightsHeader>(), 160);
+        assert_eq!(std::mem::size_of::<LightsHeader>(), 480);
+        assert_eq!(std::mem::offset_of!(LightsHeader, disk_map_from_world), 160);
+        assert_eq!(std::mem::offset_of!(LightsHeader, disk_map), 416);
         assert_eq!(std::mem::offset_of!(LightsHeader, sun_map_from_world), 80);
         assert_eq!(std::mem::size_of::<DiskGpu>(), 48);
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);

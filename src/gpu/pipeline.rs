@@ -15,7 +15,7 @@ use ash::vk;
 
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::layout::{PushConstants, ShaderVariant, Vertex, SHADOWS_RAY};
+use super::layout::{PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY};
 use super::pipeline_cache::{self, DiskPipelineCache};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -80,14 +80,16 @@ impl ScenePipeline {
                         .stage_flags(vk::ShaderStageFlags::FRAGMENT)
                 })
                 .to_vec();
-            // 5: the sun's shadow map (always bound: a 1 × 1 map until a shadow pass ran).
-            bindings.push(
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(5)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-            );
+            // 5: the sun's shadow map, 6: the first disks' (always bound: 1 × 1 maps until a shadow pass ran).
+            for (binding, count) in [(5, 1), (6, MAX_DISK_MAPS as u32)] {
+                bindings.push(
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(binding)
+                        .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                        .descriptor_count(count)
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+                );
+            }
             if ray_query_spirv.is_some() {
                 bindings.push(
                     vk::DescriptorSetLayoutBinding::default()

@@ -12,18 +12,18 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, push_constants, PushConstants, ShaderVariant, Vertex, SHADOWS_MAP, SHADOWS_NONE,
-    SHADOWS_RAY,
+    lights_bytes, material_gpu, push_constants, PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_MAP,
+    SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{subresource_range, Buffer, Image2d};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
-use super::shadow_map::SunShadowMap;
+use super::shadow_map::DepthMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;
-use crate::visibility::shadow_map::{fit_sun_map, SunMapFrame};
+use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
 
 /// Wall-clock time of the set-up phases [s].
@@ -90,7 +90,9 @@ pub struct Renderer {
     // Field order is drop order: everything that uses the device goes before `dev`.
     target: Option<Target>,
     lights: Option<Buffer>,
-    sun_map: SunShadowMap,
+    sun_map: DepthMap,
+    /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
+    disk_maps: Vec<DepthMap>,
     pipeline: ScenePipeline,
     commands: Commands,
     setup: SetupTimings,
@@ -165,11 +167,13 @@ impl Renderer {
         )?;
         let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
-        let sun_map = SunShadowMap::new(&dev, 1)?;
+        let sun_map = DepthMap::new(&dev, 1)?;
+        let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
         let renderer = Self {
             target: None,
             lights: None,
             sun_map,
+            disk_maps,
             pipeline,
             commands,
             setup: SetupTimings { instance, shader_compile },
@@ -331,9 +335,9 @@ impl Renderer {
 
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
     /// the device has ray queries; without them it renders every light unoccluded with a warning (the shadow map
-    /// is not yet the default there: `--shadows map` asks for it). `map` shadows the sun from its map and leaves
-    /// disk lights and the sky unoccluded, with a warning where the scene has them. `ray` without ray queries is
-    /// refused.
+    /// is not yet the default there: `--shadows map` asks for it). `map` shadows the sun and the first
+    /// `MAX_DISK_MAPS` disk lights from their maps and leaves the sky (and further disks) unoccluded, with a
+    /// warning where the scene has them. `ray` without ray queries is refused.
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
         let rq = self.pipeline.has_ray_queries();
         let requested = settings.shading.shadows;
@@ -341,7 +345,7 @@ impl Renderer {
         if choice.technique == Shadows::Ray && !rq {
             return Err(GpuError::Unsupported(format!(
                 "{} has no ray queries (VK_KHR_ray_query) for --shadows ray: use the lavapipe of \
-                 scripts/lavapipe-rt.sh, --shadows map (the sun only), or --shadows none",
+                 scripts/lavapipe-rt.sh, --shadows map (the sun and disk lights), or --shadows none",
                 self.dev.info.name
             )));
         }
@@ -349,17 +353,24 @@ impl Renderer {
             choice = ShadowChoice {
                 technique: Shadows::None,
                 reason: format!(
-                    "{}; every light is unoccluded (no shadows); --shadows map gives the sun's shadows from a \
-                     shadow map",
+                    "{}; every light is unoccluded (no shadows); --shadows map gives the sun's and the disk \
+                     lights' shadows from shadow maps",
                     choice.reason
                 ),
                 warning: true,
             };
-        } else if choice.technique == Shadows::Map
-            && (!settings.lights.disks.is_empty() || settings.lights.sky.is_some())
-        {
-            choice.reason += "; only the sun has a shadow map: disk lights and the sky are unoccluded";
-            choice.warning = true;
+        } else if choice.technique == Shadows::Map {
+            if settings.lights.disks.len() > MAX_DISK_MAPS {
+                choice.reason += &format!(
+                    "; only the first {MAX_DISK_MAPS} disk lights have shadow maps: the other {} are unoccluded",
+                    settings.lights.disks.len() - MAX_DISK_MAPS
+                );
+                choice.warning = true;
+            }
+            if settings.lights.sky.is_some() {
+                choice.reason += "; the sky has no shadow map: it is unoccluded";
+                choice.warning = true;
+            }
         }
         Ok(choice)
     }
@@ -387,21 +398,39 @@ impl Renderer {
             (Shadows::Map, Some(sun), Some(bounds)) => {
                 let size = settings.shading.shadow_map_size;
                 if self.sun_map.size != size {
-                    self.sun_map = SunShadowMap::new(&self.dev, size)?;
+                    self.sun_map = DepthMap::new(&self.dev, size)?;
                 }
                 Some(fit_sun_map(bounds, sun.direction.as_dvec3(), size))
             }
             _ => None,
         };
+        // The first disks' maps, likewise.
+        let size = settings.shading.shadow_map_size;
+        let mut disk_maps: Vec<Option<(DiskMapFrame, u32)>> = Vec::new();
+        if let (Shadows::Map, Some(bounds)) = (technique, scene.bounds) {
+            for (i, disk) in settings.lights.disks.iter().take(MAX_DISK_MAPS).enumerate() {
+                let frame = fit_disk_map(bounds, disk.center.as_dvec3(), disk.direction.as_dvec3());
+                if frame.is_some() && self.disk_maps[i].size != size {
+                    self.disk_maps[i] = DepthMap::new(&self.dev, size)?;
+                }
+                disk_maps.push(frame.map(|f| (f, size)));
+            }
+        }
         let lights = Buffer::with_data(
             &self.dev,
-            &lights_bytes(&settings.lights, &settings.shading, sun_map.as_ref().map(|f| (f, self.sun_map.size))),
+            &lights_bytes(
+                &settings.lights,
+                &settings.shading,
+                sun_map.as_ref().map(|f| (f, self.sun_map.size)),
+                &disk_maps,
+            ),
             vk::BufferUsageFlags::STORAGE_BUFFER,
             "lights",
         )?;
+        let any_map = sun_map.is_some() || disk_maps.iter().any(Option::is_some);
         let shadows = match technique {
             Shadows::Ray if scene.accel.is_some() => SHADOWS_RAY,
-            Shadows::Map if sun_map.is_some() => SHADOWS_MAP,
+            Shadows::Map if any_map => SHADOWS_MAP,
             _ => SHADOWS_NONE,
         };
         // The pipeline variant of each draw, created now if this is its first frame.
@@ -411,7 +440,7 @@ impl Renderer {
             let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading, shadows);
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
-        let shadow_pipeline = if sun_map.is_some() { Some(self.pipeline.shadow_pipeline()?) } else { None };
+        let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
         let pipelines = t_pipelines.elapsed();
         let t_render = Instant::now();
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
@@ -419,8 +448,15 @@ impl Renderer {
         unsafe {
             self.write_descriptors(scene, &lights);
             let cb = self.commands.begin(&self.dev)?;
-            if let (Some(frame), Some(shadow_pipeline)) = (&sun_map, shadow_pipeline) {
-                self.record_sun_map_pass(cb, scene, settings, frame, shadow_pipeline);
+            if let Some(pipeline) = shadow_pipeline {
+                if let Some(frame) = &sun_map {
+                    self.record_depth_pass(cb, scene, settings, &self.sun_map, frame.map_from_world, pipeline);
+                }
+                for (map, (frame, _)) in
+                    self.disk_maps.iter().zip(&disk_maps).filter_map(|(m, f)| Some((m, f.as_ref()?)))
+                {
+                    self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, pipeline);
+                }
             }
             self.record_scene_pass(cb, scene, settings, &draw_pipelines);
             self.commands.submit_and_wait(&self.dev, cb)?;
@@ -506,6 +542,24 @@ impl Renderer {
                     .image_info(&map_info)],
                 &[],
             );
+            // Binding 6: the first disks' shadow maps, likewise.
+            let disk_infos: Vec<vk::DescriptorImageInfo> = self
+                .disk_maps
+                .iter()
+                .map(|m| vk::DescriptorImageInfo {
+                    sampler: m.sampler,
+                    image_view: m.image.view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                })
+                .collect();
+            d.update_descriptor_sets(
+                &[vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(6)
+                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                    .image_info(&disk_infos)],
+                &[],
+            );
             // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
             if let Some(accel) = &scene.accel {
                 let structures = [accel.top_level()];
@@ -522,13 +576,14 @@ impl Renderer {
         }
     }
 
-    /// Records the sun's shadow-map pass: every draw, depth only, through the map's frame.
-    unsafe fn record_sun_map_pass(
+    /// Records a shadow-map pass into `map`: every draw, depth only, through the map's frame.
+    unsafe fn record_depth_pass(
         &self,
         cb: vk::CommandBuffer,
         scene: &GpuScene,
         settings: &RenderSettings,
-        frame: &SunMapFrame,
+        map: &DepthMap,
+        map_from_world: glam::DMat4,
         shadow_pipeline: vk::Pipeline,
     ) {
         let d = &self.dev.device;
@@ -536,8 +591,8 @@ impl Renderer {
         unsafe {
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 let layout = self.pipeline.layout;
-                let map_from_world = frame.map_from_world.as_mat4().to_cols_array();
-                self.sun_map.record(cb, |cb| {
+                let map_from_world = map_from_world.as_mat4().to_cols_array();
+                map.record(cb, |cb| {
                     d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, shadow_pipeline);
                     d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
                     d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);

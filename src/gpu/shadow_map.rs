@@ -1,5 +1,6 @@
-//! The sun's shadow-map pass: a depth-only render of every triangle (both faces) through the orthographic frame of
-//! `visibility::shadow_map`, into a D32 image the fragment shader then reads texel by texel (binding 5).
+//! The shadow-map passes: a depth-only render of every triangle (both faces) through a map's frame
+//! (`visibility::shadow_map`: orthographic for the sun, perspective for a disk light), into a D32 image the
+//! fragment shader then reads texel by texel (bindings 5 and 6).
 
 use std::sync::Arc;
 
@@ -12,14 +13,14 @@ use super::memory::{subresource_range, Image2d};
 use super::pipeline::DEPTH_FORMAT;
 
 /// The depth image and the sampler the fragment shader reads it through (nearest; lookups are texelFetch).
-pub(crate) struct SunShadowMap {
+pub(crate) struct DepthMap {
     dev: Arc<Device>,
     pub image: Image2d,
     pub sampler: vk::Sampler,
     pub size: u32,
 }
 
-impl SunShadowMap {
+impl DepthMap {
     /// A `size` × `size` map, left in SHADER_READ_ONLY_OPTIMAL (cleared to the far plane), so that binding 5 is
     /// valid before any shadow pass ran.
     pub fn new(dev: &Arc<Device>, size: u32) -> Result<Self, GpuError> {
@@ -32,7 +33,7 @@ impl SunShadowMap {
                 | vk::ImageUsageFlags::SAMPLED
                 | vk::ImageUsageFlags::TRANSFER_DST,
             vk::ImageAspectFlags::DEPTH,
-            "sun shadow map",
+            "shadow map",
         )?;
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::NEAREST)
@@ -131,7 +132,7 @@ impl SunShadowMap {
     }
 }
 
-impl Drop for SunShadowMap {
+impl Drop for DepthMap {
     fn drop(&mut self) {
         // SAFETY: the GPU is done with the sampler (every submission is waited for).
         unsafe { self.dev.device.destroy_sampler(self.sampler, None) }

@@ -83,4 +83,77 @@ mod tests {
         let b = f.map_from_world.project_point3(orthonormal_to(l) * f.texel);
         assert!(((b.x - a.x) - 2.0 / 1024.0).abs() < 1e-12);
     }
+
+    #[test]
+    fn a_disk_map_sees_what_lies_in_front_of_the_disk() {
+        // A disk at 2.5 m facing down over a 4 m room: the floor's corners project inside the map, with depth
+        // growing away from the disk; linear depth is recovered from the stored one.
+        let bounds = Aabb { min: DVec3::new(-2.0, 0.0, -2.0), max: DVec3::new(2.0, 2.5, 2.0) };
+        let (c, d) = (DVec3::new(0.0, 2.5, 0.0), -DVec3::Y);
+        let f = fit_disk_map(bounds, c, d).unwrap();
+        for p in [DVec3::new(-2.0, 0.0, -2.0), DVec3::new(2.0, 0.0, 1.0), DVec3::new(0.3, 1.0, -0.2)] {
+            let q = f.map_from_world.project_point3(p);
+            assert!(q.x.abs() <= 1.0 && q.y.abs() <= 1.0 && (0.0..=1.0).contains(&q.z), "{p} -> {q}");
+            let z = f.far * f.near / (f.far - q.z * (f.far - f.near));
+            assert!((z - (2.5 - p.y)).abs() < 1e-9, "{p}: linear depth {z}");
+        }
+        assert!(fit_disk_map(bounds, DVec3::new(0.0, -1.0, 0.0), -DVec3::Y).is_none());
+    }
+}
+
+/// A disk light's perspective shadow map: from the disk's centre, looking along its emission direction `d`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskMapFrame {
+    /// World → map clip space (perspective; depth in [0, 1] between `near` and `far`).
+    pub map_from_world: DMat4,
+    /// Tangent of the half field of view (both axes).
+    pub tan_half: f64,
+    /// Near and far planes [m] along `d`.
+    pub near: f64,
+    pub far: f64,
+}
+
+/// The widest half field of view a disk's map takes: 80° (what lies farther from the axis is unoccluded).
+pub const DISK_MAP_MAX_HALF_ANGLE_DEGREES: f64 = 80.0;
+
+/// The map of a disk light centred at `center` emitting along the unit `d`, over `bounds`: view axes
+/// `x = orthonormal_to(d)`, `y = d × x`, depth `z = d·(p − center)`; the field of view fitted to the bounds'
+/// corners in front of the disk (capped at [`DISK_MAP_MAX_HALF_ANGLE_DEGREES`]), near `10⁻⁴` of the bounds'
+/// diagonal, far past the farthest corner. `None` when nothing of the bounds lies in front of the disk.
+pub fn fit_disk_map(bounds: Aabb, center: DVec3, d: DVec3) -> Option<DiskMapFrame> {
+    let x = orthonormal_to(d);
+    let y = d.cross(x);
+    let diagonal = (bounds.max - bounds.min).length().max(1e-30);
+    let near = 1e-4 * diagonal;
+    let (mut far, mut tan_half) = (0.0f64, 0.0f64);
+    for i in 0..8 {
+        let c = DVec3::new(
+            if i & 1 == 0 { bounds.min.x } else { bounds.max.x },
+            if i & 2 == 0 { bounds.min.y } else { bounds.max.y },
+            if i & 4 == 0 { bounds.min.z } else { bounds.max.z },
+        ) - center;
+        let z = d.dot(c);
+        far = far.max(z);
+        if z > near {
+            tan_half = tan_half.max(x.dot(c).abs() / z).max(y.dot(c).abs() / z);
+        }
+    }
+    if far <= near {
+        return None;
+    }
+    let tan_half = (tan_half * 1.01).clamp(1e-3, DISK_MAP_MAX_HALF_ANGLE_DEGREES.to_radians().tan());
+    let far = far * 1.01 + near;
+    // Vulkan perspective: x, y over z tan_half; depth (f (z − n)) / (z (f − n)) in [0, 1].
+    let (a, b) = (far / (far - near), -far * near / (far - near));
+    let o = -center;
+    let view = |v: DVec3| DVec4::new(v.x, v.y, v.z, 0.0);
+    let rows = [x / tan_half, y / tan_half, d * a, d];
+    let offsets = [rows[0].dot(o), rows[1].dot(o), rows[2].dot(o) + b, rows[3].dot(o)];
+    let m = DMat4::from_cols(
+        view(DVec3::new(rows[0].x, rows[1].x, rows[2].x)) + DVec4::new(0.0, 0.0, 0.0, rows[3].x),
+        view(DVec3::new(rows[0].y, rows[1].y, rows[2].y)) + DVec4::new(0.0, 0.0, 0.0, rows[3].y),
+        view(DVec3::new(rows[0].z, rows[1].z, rows[2].z)) + DVec4::new(0.0, 0.0, 0.0, rows[3].z),
+        DVec4::new(offsets[0], offsets[1], offsets[2], offsets[3]),
+    );
+    Some(DiskMapFrame { map_from_world: m, tan_half, near, far })
 }
