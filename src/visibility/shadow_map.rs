@@ -145,15 +145,10 @@ pub fn fit_disk_map(bounds: Aabb, center: DVec3, d: DVec3) -> Option<DiskMapFram
     let far = far * 1.01 + near;
     // Vulkan perspective: x, y over z tan_half; depth (f (z − n)) / (z (f − n)) in [0, 1].
     let (a, b) = (far / (far - near), -far * near / (far - near));
-    let o = -center;
-    let view = |v: DVec3| DVec4::new(v.x, v.y, v.z, 0.0);
+    // Rows of the matrix acting on (p, 1): clip = (x·(p − c)/tan, y·(p − c)/tan, a z + b, z), z = d·(p − c).
     let rows = [x / tan_half, y / tan_half, d * a, d];
-    let offsets = [rows[0].dot(o), rows[1].dot(o), rows[2].dot(o) + b, rows[3].dot(o)];
-    let m = DMat4::from_cols(
-        view(DVec3::new(rows[0].x, rows[1].x, rows[2].x)) + DVec4::new(0.0, 0.0, 0.0, rows[3].x),
-        view(DVec3::new(rows[0].y, rows[1].y, rows[2].y)) + DVec4::new(0.0, 0.0, 0.0, rows[3].y),
-        view(DVec3::new(rows[0].z, rows[1].z, rows[2].z)) + DVec4::new(0.0, 0.0, 0.0, rows[3].z),
-        DVec4::new(offsets[0], offsets[1], offsets[2], offsets[3]),
-    );
+    let offsets = [-rows[0].dot(center), -rows[1].dot(center), -rows[2].dot(center) + b, -rows[3].dot(center)];
+    let column = |k: usize| DVec4::new(rows[0][k], rows[1][k], rows[2][k], rows[3][k]);
+    let m = DMat4::from_cols(column(0), column(1), column(2), DVec4::from_array(offsets));
     Some(DiskMapFrame { map_from_world: m, tan_half, near, far })
 }
