@@ -212,22 +212,6 @@ float segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, floa
     return sum / (k * k);
 }
 
-// segment_lobe_integral_visible without shadow rays.
-float segment_lobe_integral(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis) {
-    return segment_lobe_integral_visible(m, p, q, d, radius, per_axis, RAYS_NONE);
-}
-
-// integral of lobe (n.w)+ over the part of a disk light above the horizon, per unit radiance.
-float disk_lobe_integral(MaterialGpu m, Frame p, vec3 center, vec3 d, float radius, uint per_axis) {
-    return segment_lobe_integral(m, p, center - p.position, d, radius, per_axis);
-}
-
-// integral of lobe (n.w)+ over the sun's cap, per unit radiance: the cap is the disk of radius tan(delta/2) one
-// unit away, facing back (see the Rust).
-float sun_lobe_integral(MaterialGpu m, Frame p, vec3 direction, float angular_diameter, uint per_axis) {
-    return segment_lobe_integral(m, p, direction, -direction, tan(0.5 * angular_diameter), per_axis);
-}
-
 // A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
 // (t, b) about it: the inverse CDF of the pdf (e+1)/(2 pi) cos^e a. 1 - cos a as -expm1(log1p(-xi1)/(e+1)), which
 // keeps its digits for large e (see the Rust).
@@ -295,11 +279,6 @@ float sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shad
         }
     }
     return sum / (k * k);
-}
-
-// sky_lobe_integral_visible without shadow rays.
-float sky_lobe_integral(MaterialGpu m, Frame p, uint per_axis) {
-    return sky_lobe_integral_visible(m, p, per_axis, false);
 }
 
 // Outgoing radiance [W/(m^2 sr)] per channel from the visible part of each light. `p.normal` is unit (or 0) on
