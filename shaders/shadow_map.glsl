@@ -89,11 +89,9 @@ float sun_visible_fraction_map(vec3 origin, uint k, vec3 n, vec3 face, vec3 l, f
     for (uint i = 0u; i < k; ++i) {
         for (uint j = 0u; j < k; ++j) {
             vec2 ab = disk_grid_point(i, j, k);
-            vec3 p = l + radius * (ab.x * t + ab.y * b);
-            float len = length(p);
-            float c = dot(n, p / len);
-            if (c > 0.0) {
-                float w = c / (len * len * len);
+            vec3 omega;
+            float w = sun_sample(n, l, t, b, radius, ab, omega);
+            if (w > 0.0) {
                 total += w;
                 if (!sun_map_occludes(q.xy + spread * ab, q, gradient)) {
                     visible += w;
@@ -178,14 +176,9 @@ float disk_visible_fraction_map(uint i, vec3 origin, uint k, vec3 x, vec3 n, vec
     for (uint a = 0u; a < k; ++a) {
         for (uint b = 0u; b < k; ++b) {
             vec2 o = disk_grid_point(a, b, k);
-            vec3 y = center + radius * (o.x * ax + o.y * ay);
-            vec3 to = y - x;
-            float dist2 = dot(to, to);
-            vec3 omega = to / sqrt(dist2);
-            float cos_r = dot(n, omega);
-            float cos_d = -dot(d, omega);
-            if (cos_r > 0.0 && cos_d > 0.0) {
-                float w = cos_r * cos_d / dist2;
+            vec3 y;
+            float w = disk_sample(x, n, center, d, ax, ay, radius, o, y);
+            if (w > 0.0) {
                 total += w;
                 if (!(disk_map_depth(i, tc + spread * o) < z - bias - slope * spread * length(o))) {
                     visible += w;

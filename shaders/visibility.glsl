@@ -74,6 +74,28 @@ float fraction(float visible, float total) {
     return (visible == total || total <= 0.0) ? 1.0 : visible / total;
 }
 
+// The sun's sample through the point xy of the unit disk, in the frame (t, b) about l: its direction (omega) and
+// weight (n.omega)+ / |p|^3, 0 below the horizon. Shared by the rays and the shadow map.
+float sun_sample(vec3 n, vec3 l, vec3 t, vec3 b, float radius, vec2 xy, out vec3 omega) {
+    vec3 p = l + radius * (xy.x * t + xy.y * b);
+    float len = length(p);
+    omega = p / len;
+    float c = dot(n, omega);
+    return c > 0.0 ? c / (len * len * len) : 0.0;
+}
+
+// A disk light's sample at the point uv of the unit disk, in the frame (a, b) of its plane: the point y [m] and
+// its weight (n.omega)+ (-d.omega)+ / |y - x|^2 from x. Shared by the rays and the shadow maps.
+float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float radius, vec2 uv, out vec3 y) {
+    y = center + radius * (uv.x * a + uv.y * b);
+    vec3 to = y - x;
+    float dist2 = dot(to, to);
+    vec3 omega = to / sqrt(dist2);
+    float cos_r = dot(n, omega);
+    float cos_d = -dot(d, omega);
+    return cos_r > 0.0 && cos_d > 0.0 ? cos_r * cos_d / dist2 : 0.0;
+}
+
 // The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]).
 float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
     float radius = tan(0.5 * angular_diameter);
@@ -83,13 +105,9 @@ float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_di
     float total = 0.0;
     for (uint i = 0u; i < k; ++i) {
         for (uint j = 0u; j < k; ++j) {
-            vec2 xy = disk_grid_point(i, j, k);
-            vec3 p = l + radius * (xy.x * t + xy.y * b);
-            float len = length(p);
-            vec3 omega = p / len;
-            float c = dot(n, omega);
-            if (c > 0.0) {
-                float w = c / (len * len * len);
+            vec3 omega;
+            float w = sun_sample(n, l, t, b, radius, disk_grid_point(i, j, k), omega);
+            if (w > 0.0) {
                 total += w;
                 if (visible_along(origin, omega)) {
                     visible += w;
@@ -108,15 +126,9 @@ float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, ve
     float total = 0.0;
     for (uint i = 0u; i < k; ++i) {
         for (uint j = 0u; j < k; ++j) {
-            vec2 uv = disk_grid_point(i, j, k);
-            vec3 y = center + radius * (uv.x * a + uv.y * b);
-            vec3 to = y - x;
-            float dist2 = dot(to, to);
-            vec3 omega = to / sqrt(dist2);
-            float cos_r = dot(n, omega);
-            float cos_d = -dot(d, omega);
-            if (cos_r > 0.0 && cos_d > 0.0) {
-                float w = cos_r * cos_d / dist2;
+            vec3 y;
+            float w = disk_sample(x, n, center, d, a, b, radius, disk_grid_point(i, j, k), y);
+            if (w > 0.0) {
                 total += w;
                 if (visible_to(origin, y)) {
                     visible += w;

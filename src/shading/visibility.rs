@@ -181,31 +181,77 @@ fn fraction(visible: f64, total: f64) -> f64 {
     }
 }
 
-/// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ [rad]) from a point
-/// with unit normal `n`.
-pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
-    let radius = (0.5 * angular_diameter).tan();
-    let t = orthonormal_to(l);
-    let b = l.cross(t);
+/// A grid sample's shadow ray: along a direction (a light at infinity) or to a point (on a disk light).
+enum SampleRay {
+    Along(DVec3),
+    To(DVec3),
+}
+
+/// `Σ wᵢ vᵢ / Σ wᵢ` over the `k × k` grid ([`fraction`]): `sample` gives a grid point's weight and shadow ray,
+/// and the ray is cast only where the weight is positive.
+fn grid_fraction(s: &Shadowing, mut sample: impl FnMut((f64, f64)) -> (f64, SampleRay)) -> f64 {
     let (mut visible, mut total) = (0.0, 0.0);
     let k = s.samples_per_axis;
     for i in 0..k {
         for j in 0..k {
-            let (x, y) = disk_grid_point(i, j, k);
-            let p = l + radius * (x * t + y * b);
-            let len = p.length();
-            let omega = p / len;
-            let cos = n.dot(omega);
-            if cos > 0.0 {
-                let w = cos / (len * len * len);
+            let (w, ray) = sample(disk_grid_point(i, j, k));
+            if w > 0.0 {
                 total += w;
-                if s.visible_along(omega) {
+                let seen = match ray {
+                    SampleRay::Along(omega) => s.visible_along(omega),
+                    SampleRay::To(y) => s.visible_to(y),
+                };
+                if seen {
                     visible += w;
                 }
             }
         }
     }
     fraction(visible, total)
+}
+
+/// The sun's sample through the point `(x, y)` of the unit disk, in the frame `(t, b)` about `l`: its direction
+/// and weight `(n·ω)⁺ cos³γ = (n·ω)⁺ / |p|³` (0 below the horizon). Shared by the rays and the shadow map.
+pub fn sun_sample(n: DVec3, l: DVec3, t: DVec3, b: DVec3, radius: f64, (x, y): (f64, f64)) -> (DVec3, f64) {
+    let p = l + radius * (x * t + y * b);
+    let len = p.length();
+    let omega = p / len;
+    let cos = n.dot(omega);
+    (omega, if cos > 0.0 { cos / (len * len * len) } else { 0.0 })
+}
+
+/// A disk light's sample at the point `(u, v)` of the unit disk, in the frame `(a, b)` of its plane: the point
+/// `y` [m] and its weight `(n·ω)⁺ (−d·ω)⁺ / |y − x|²` from `x` (0 where either cosine is not positive). Shared by
+/// the rays and the shadow maps.
+#[allow(clippy::too_many_arguments)]
+pub fn disk_sample(
+    x: DVec3,
+    n: DVec3,
+    center: DVec3,
+    d: DVec3,
+    a: DVec3,
+    b: DVec3,
+    radius: f64,
+    (u, v): (f64, f64),
+) -> (DVec3, f64) {
+    let y = center + radius * (u * a + v * b);
+    let to = y - x;
+    let dist2 = to.length_squared();
+    let omega = to / dist2.sqrt();
+    let (cos_r, cos_d) = (n.dot(omega), -d.dot(omega));
+    (y, if cos_r > 0.0 && cos_d > 0.0 { cos_r * cos_d / dist2 } else { 0.0 })
+}
+
+/// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ [rad]) from a point
+/// with unit normal `n`.
+pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
+    let radius = (0.5 * angular_diameter).tan();
+    let t = orthonormal_to(l);
+    let b = l.cross(t);
+    grid_fraction(s, |xy| {
+        let (omega, w) = sun_sample(n, l, t, b, radius, xy);
+        (w, SampleRay::Along(omega))
+    })
 }
 
 /// The visible fraction of a disk light (centre [m], unit emission direction `d`, radius [m]), weighted by
@@ -213,26 +259,10 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
 pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
     let a = orthonormal_to(d);
     let b = d.cross(a);
-    let (mut visible, mut total) = (0.0, 0.0);
-    let k = s.samples_per_axis;
-    for i in 0..k {
-        for j in 0..k {
-            let (u, v) = disk_grid_point(i, j, k);
-            let y = center + radius * (u * a + v * b);
-            let to = y - x;
-            let dist2 = to.length_squared();
-            let omega = to / dist2.sqrt();
-            let (cos_r, cos_d) = (n.dot(omega), -d.dot(omega));
-            if cos_r > 0.0 && cos_d > 0.0 {
-                let w = cos_r * cos_d / dist2;
-                total += w;
-                if s.visible_to(y) {
-                    visible += w;
-                }
-            }
-        }
-    }
-    fraction(visible, total)
+    grid_fraction(s, |uv| {
+        let (y, w) = disk_sample(x, n, center, d, a, b, radius, uv);
+        (w, SampleRay::To(y))
+    })
 }
 
 /// The visible fraction of the sky (the directions with `ω_y > 0`), cosine-weighted, from a point with unit
@@ -240,24 +270,13 @@ pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d
 pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
     let t = orthonormal_to(n);
     let b = n.cross(t);
-    let (mut visible, mut total) = (0.0, 0.0);
-    let k = s.samples_per_axis;
-    for i in 0..k {
-        for j in 0..k {
-            let (x, y) = disk_grid_point(i, j, k);
-            // Malley's method: the disk lifted onto the hemisphere is cosine-distributed. 1 − x² − y² ≥ 0 up to
-            // rounding, which max() removes (a grazing direction, weight 0 in the cosine anyway).
-            let z = (1.0 - x * x - y * y).max(0.0).sqrt();
-            let omega = x * t + y * b + z * n;
-            if omega.y > 0.0 {
-                total += 1.0;
-                if s.visible_along(omega) {
-                    visible += 1.0;
-                }
-            }
-        }
-    }
-    fraction(visible, total)
+    grid_fraction(s, |(x, y)| {
+        // Malley's method: the disk lifted onto the hemisphere is cosine-distributed. 1 − x² − y² ≥ 0 up to
+        // rounding, which max() removes (a grazing direction, weight 0 in the cosine anyway).
+        let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+        let omega = x * t + y * b + z * n;
+        (if omega.y > 0.0 { 1.0 } else { 0.0 }, SampleRay::Along(omega))
+    })
 }
 
 /// The push along the face normal for a triangle with these corners [m]: `2⁻¹⁶ max |pᵢ|∞` (see the module docs).
