@@ -108,12 +108,36 @@ impl Bvh {
         self.traverse(ray, t_min, t_max, false)
     }
 
-    fn traverse(&self, ray: &WatertightRay, t_min: f64, mut t_max: f64, any: bool) -> Option<(f64, usize)> {
+    fn traverse(&self, ray: &WatertightRay, t_min: f64, t_max: f64, any: bool) -> Option<(f64, usize)> {
+        let mut best = None;
+        self.walk(ray, t_min, t_max, 0.0, |i, t_max| {
+            if let Some(t) = ray.intersect(self.triangles[i], t_min, *t_max) {
+                best = Some((t, i));
+                if any {
+                    return true;
+                }
+                *t_max = t;
+            }
+            false
+        });
+        best
+    }
+
+    /// Visits the triangles of every leaf whose box, widened by `pad` [m], the ray meets within `(t_min, t_max)`,
+    /// nearest boxes not necessarily first. `triangle(i, &mut t_max)` may shorten the ray (boxes beyond are then
+    /// skipped) and returns whether to stop.
+    fn walk(
+        &self,
+        ray: &WatertightRay,
+        t_min: f64,
+        mut t_max: f64,
+        pad: f64,
+        mut triangle: impl FnMut(usize, &mut f64) -> bool,
+    ) {
         if self.order.is_empty() {
-            return None;
+            return;
         }
         let inv = ray.direction.recip();
-        let mut best = None;
         // Median splits halve the triangles per level, so the depth is at most log2(2^32) = 32 and the stack
         // holds at most one pending sibling per level: 64 entries are plenty, on the stack, no allocation.
         let mut stack = [0u32; 64];
@@ -121,7 +145,7 @@ impl Bvh {
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if !slab(node, ray.origin, inv, t_min, t_max) {
+            if !slab(node, pad, ray.origin, inv, t_min, t_max) {
                 continue;
             }
             if node.count == 0 {
@@ -131,16 +155,11 @@ impl Bvh {
                 continue;
             }
             for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                if let Some(t) = ray.intersect(self.triangles[i as usize], t_min, t_max) {
-                    best = Some((t, i as usize));
-                    if any {
-                        return best;
-                    }
-                    t_max = t;
+                if triangle(i as usize, &mut t_max) {
+                    return;
                 }
             }
         }
-        best
     }
 }
 
@@ -155,36 +174,19 @@ impl Bvh {
     /// hit farther than `eps` [m] inside its boundary, but one is hit, or missed, within `eps` of it, so that a
     /// few ulps of f32 geometry (the GPU's) could flip it. Boxes are padded by `eps` for this traversal.
     pub fn occluded_with_margin(&self, ray: &WatertightRay, t_min: f64, t_max: f64, eps: f64) -> (bool, bool) {
-        if self.order.is_empty() {
-            return (false, false);
-        }
-        let inv = ray.direction.recip();
-        let (mut fragile_hit, mut near_miss) = (false, false);
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            let padded = Node { min: node.min - DVec3::splat(eps), max: node.max + DVec3::splat(eps), ..*node };
-            if !slab(&padded, ray.origin, inv, t_min, t_max) {
-                continue;
+        let (mut robust_hit, mut fragile_hit, mut near_miss) = (false, false, false);
+        self.walk(ray, t_min, t_max, eps, |i, _| {
+            match ray.edge_margin(self.triangles[i], t_min, t_max) {
+                Some(d) if d > eps => robust_hit = true,
+                Some(d) if d >= 0.0 => fragile_hit = true,
+                Some(d) if d >= -eps => near_miss = true,
+                _ => {}
             }
-            if node.count == 0 {
-                stack[top] = node.first;
-                stack[top + 1] = node.first + 1;
-                top += 2;
-                continue;
-            }
-            for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                match ray.edge_margin(self.triangles[i as usize], t_min, t_max) {
-                    Some(d) if d > eps => return (true, false),
-                    Some(d) if d >= 0.0 => fragile_hit = true,
-                    Some(d) if d >= -eps => near_miss = true,
-                    _ => {}
-                }
-            }
-        }
-        if fragile_hit {
+            robust_hit
+        });
+        if robust_hit {
+            (true, false)
+        } else if fragile_hit {
             (true, true)
         } else {
             (false, near_miss)
@@ -192,12 +194,13 @@ impl Bvh {
     }
 }
 
-/// The slab test of a padded box. An axis with a zero direction component gives ±inf or NaN products: the
-/// comparisons are written so that a NaN (origin on the slab's plane) keeps the box rather than dropping it.
-fn slab(node: &Node, origin: DVec3, inv: DVec3, t_min: f64, t_max: f64) -> bool {
+/// The slab test of a padded box, widened by `pad` more (0: the box as built; `min − 0` is `min` exactly). An
+/// axis with a zero direction component gives ±inf or NaN products: the comparisons are written so that a NaN
+/// (origin on the slab's plane) keeps the box rather than dropping it.
+fn slab(node: &Node, pad: f64, origin: DVec3, inv: DVec3, t_min: f64, t_max: f64) -> bool {
     let (mut lo, mut hi) = (t_min, t_max);
     for k in 0..3 {
-        let (a, b) = ((node.min[k] - origin[k]) * inv[k], (node.max[k] - origin[k]) * inv[k]);
+        let (a, b) = ((node.min[k] - pad - origin[k]) * inv[k], (node.max[k] + pad - origin[k]) * inv[k]);
         let (near, far) = if a <= b { (a, b) } else { (b, a) };
         if near > lo {
             lo = near;

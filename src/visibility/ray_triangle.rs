@@ -52,8 +52,9 @@ impl WatertightRay {
         Some(Self { origin, direction, k: [kx, ky, kz], shear })
     }
 
-    /// The ray parameter `t` of the hit with triangle `(a, b, c)` (either winding), if `t_min < t < t_max`.
-    pub fn intersect(&self, [a, b, c]: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
+    /// The triangle `(a, b, c)` in the ray's sheared frame: the projected corners, the edge functions `(u, v, w)`
+    /// and the sheared depths.
+    fn shear_triangle(&self, [a, b, c]: [DVec3; 3]) -> Sheared {
         let [kx, ky, kz] = self.k;
         let [sx, sy, sz] = self.shear;
         let (a, b, c) = (a - self.origin, b - self.origin, c - self.origin);
@@ -64,17 +65,22 @@ impl WatertightRay {
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
+        Sheared {
+            corners: [(ax, ay), (bx, by), (cx, cy)],
+            uvw: [u, v, w],
+            depths: [sz * a[kz], sz * b[kz], sz * c[kz]],
+        }
+    }
+
+    /// The ray parameter `t` of the hit with triangle `(a, b, c)` (either winding), if `t_min < t < t_max`.
+    pub fn intersect(&self, triangle: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
+        let tri = self.shear_triangle(triangle);
+        let [u, v, w] = tri.uvw;
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
         }
-        let det = u + v + w;
-        if det == 0.0 {
-            // The ray lies in the triangle's plane (or the triangle is degenerate): no proper hit.
-            return None;
-        }
-        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-        // The hit's distance along the ray, from the barycentric combination of the sheared depths.
-        let t = (u * az + v * bz + w * cz) / det;
+        // The ray lies in the triangle's plane (or the triangle is degenerate) where det is 0: no proper hit.
+        let t = tri.plane_t()?;
         (t > t_min && t < t_max).then_some(t)
     }
 
@@ -83,26 +89,16 @@ impl WatertightRay {
     /// each edge function over its edge's length is the distance from the ray to that edge's line [m]; positive
     /// inside (the smallest of the three, a hit exactly when [`WatertightRay::intersect`] hits), negative outside
     /// (the largest violation). Used to find rays whose visibility a few ulps of geometry could flip.
-    pub fn edge_margin(&self, [a, b, c]: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
-        let [kx, ky, kz] = self.k;
-        let [sx, sy, sz] = self.shear;
-        let (a, b, c) = (a - self.origin, b - self.origin, c - self.origin);
-        let project = |v: DVec3| (v[kx] - sx * v[kz], v[ky] - sy * v[kz]);
-        let ((ax, ay), (bx, by), (cx, cy)) = (project(a), project(b), project(c));
-        let u = cx * by - cy * bx;
-        let v = ax * cy - ay * cx;
-        let w = bx * ay - by * ax;
-        let det = u + v + w;
-        if det == 0.0 {
-            return None;
-        }
-        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
-        let t = (u * az + v * bz + w * cz) / det;
+    pub fn edge_margin(&self, triangle: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
+        let tri = self.shear_triangle(triangle);
+        let t = tri.plane_t()?;
         if !(t > t_min && t < t_max) {
             return None;
         }
+        let [u, v, w] = tri.uvw;
+        let [(ax, ay), (bx, by), (cx, cy)] = tri.corners;
         let len = |(x0, y0): (f64, f64), (x1, y1): (f64, f64)| ((x1 - x0).powi(2) + (y1 - y0).powi(2)).sqrt();
-        let s = det.signum();
+        let s = (u + v + w).signum();
         let d = [s * u / len((bx, by), (cx, cy)), s * v / len((cx, cy), (ax, ay)), s * w / len((ax, ay), (bx, by))];
         let inside = d.iter().all(|&x| x >= 0.0);
         Some(if inside {
@@ -110,6 +106,27 @@ impl WatertightRay {
         } else {
             -d.iter().filter(|&&x| x < 0.0).map(|x| -x).fold(0.0, f64::max)
         })
+    }
+}
+
+/// A triangle in a ray's sheared frame ([`WatertightRay`]).
+struct Sheared {
+    corners: [(f64, f64); 3],
+    uvw: [f64; 3],
+    depths: [f64; 3],
+}
+
+impl Sheared {
+    /// The ray parameter where the ray meets the triangle's plane, from the barycentric combination of the sheared
+    /// depths; `None` where `u + v + w` is 0 (the ray in the plane, or a degenerate triangle).
+    fn plane_t(&self) -> Option<f64> {
+        let [u, v, w] = self.uvw;
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let [az, bz, cz] = self.depths;
+        Some((u * az + v * bz + w * cz) / det)
     }
 }
 
