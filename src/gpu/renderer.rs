@@ -15,7 +15,7 @@ use super::layout::{
     lights_bytes, material_gpu, push_constants, PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_MAP,
     SHADOWS_NONE, SHADOWS_RAY,
 };
-use super::memory::{subresource_range, Buffer, Image2d};
+use super::memory::{image_barrier, Buffer, Image2d};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
 use super::shadow_map::DepthMap;
@@ -528,38 +528,23 @@ impl Renderer {
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
             }
-            // Binding 5: the sun's shadow map (a valid image in every frame; read only by SHADOWS_MAP pipelines).
-            let map_info = [vk::DescriptorImageInfo {
-                sampler: self.sun_map.sampler,
-                image_view: self.sun_map.image.view,
+            // Binding 5: the sun's shadow map, 6: the first disks' (valid images in every frame; read only by
+            // SHADOWS_MAP pipelines).
+            let info = |m: &DepthMap| vk::DescriptorImageInfo {
+                sampler: m.sampler,
+                image_view: m.image.view,
                 image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            }];
-            d.update_descriptor_sets(
-                &[vk::WriteDescriptorSet::default()
+            };
+            let sun_info = [info(&self.sun_map)];
+            let disk_infos: Vec<_> = self.disk_maps.iter().map(info).collect();
+            let writes = [(5, &sun_info[..]), (6, &disk_infos[..])].map(|(binding, infos)| {
+                vk::WriteDescriptorSet::default()
                     .dst_set(self.pipeline.descriptor_set)
-                    .dst_binding(5)
+                    .dst_binding(binding)
                     .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .image_info(&map_info)],
-                &[],
-            );
-            // Binding 6: the first disks' shadow maps, likewise.
-            let disk_infos: Vec<vk::DescriptorImageInfo> = self
-                .disk_maps
-                .iter()
-                .map(|m| vk::DescriptorImageInfo {
-                    sampler: m.sampler,
-                    image_view: m.image.view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                })
-                .collect();
-            d.update_descriptor_sets(
-                &[vk::WriteDescriptorSet::default()
-                    .dst_set(self.pipeline.descriptor_set)
-                    .dst_binding(6)
-                    .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-                    .image_info(&disk_infos)],
-                &[],
-            );
+                    .image_info(infos)
+            });
+            d.update_descriptor_sets(&writes, &[]);
             // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
             if let Some(accel) = &scene.accel {
                 let structures = [accel.top_level()];
@@ -819,25 +804,4 @@ fn interpolation_define(interpolation: Interpolation) -> &'static str {
         Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
         Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
     }
-}
-
-fn image_barrier(
-    image: vk::Image,
-    aspect: vk::ImageAspectFlags,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    old_layout: vk::ImageLayout,
-    new_layout: vk::ImageLayout,
-) -> vk::ImageMemoryBarrier2<'static> {
-    vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(src.0)
-        .src_access_mask(src.1)
-        .dst_stage_mask(dst.0)
-        .dst_access_mask(dst.1)
-        .old_layout(old_layout)
-        .new_layout(new_layout)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(subresource_range(aspect))
 }

@@ -9,7 +9,7 @@ use ash::vk;
 use super::commands::Commands;
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::memory::{subresource_range, Image2d};
+use super::memory::{image_barrier, subresource_range, Image2d};
 use super::pipeline::DEPTH_FORMAT;
 
 /// The depth image and the sampler the fragment shader reads it through (nearest; lookups are texelFetch).
@@ -50,8 +50,9 @@ impl DepthMap {
         unsafe {
             let commands = Commands::new(dev)?;
             let cb = commands.begin(dev)?;
-            let to_clear = [barrier(
+            let to_clear = [image_barrier(
                 map.image.image,
+                vk::ImageAspectFlags::DEPTH,
                 (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
                 (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
                 vk::ImageLayout::UNDEFINED,
@@ -65,8 +66,9 @@ impl DepthMap {
                 &vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 },
                 &[subresource_range(vk::ImageAspectFlags::DEPTH)],
             );
-            let to_read = [barrier(
+            let to_read = [image_barrier(
                 map.image.image,
+                vk::ImageAspectFlags::DEPTH,
                 (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
                 (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
@@ -84,8 +86,9 @@ impl DepthMap {
         let d = &self.dev.device;
         // SAFETY: the caller records into a command buffer of this device; the map is not in use by the GPU.
         unsafe {
-            let to_attachment = [barrier(
+            let to_attachment = [image_barrier(
                 self.image.image,
+                vk::ImageAspectFlags::DEPTH,
                 (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
                 (
                     vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
@@ -117,8 +120,9 @@ impl DepthMap {
             d.cmd_set_cull_mode(cb, vk::CullModeFlags::NONE);
             draw(cb);
             d.cmd_end_rendering(cb);
-            let to_read = [barrier(
+            let to_read = [image_barrier(
                 self.image.image,
+                vk::ImageAspectFlags::DEPTH,
                 (
                     vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
                     vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
@@ -137,24 +141,4 @@ impl Drop for DepthMap {
         // SAFETY: the GPU is done with the sampler (every submission is waited for).
         unsafe { self.dev.device.destroy_sampler(self.sampler, None) }
     }
-}
-
-fn barrier(
-    image: vk::Image,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    old_layout: vk::ImageLayout,
-    new_layout: vk::ImageLayout,
-) -> vk::ImageMemoryBarrier2<'static> {
-    vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(src.0)
-        .src_access_mask(src.1)
-        .dst_stage_mask(dst.0)
-        .dst_access_mask(dst.1)
-        .old_layout(old_layout)
-        .new_layout(new_layout)
-        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-        .image(image)
-        .subresource_range(subresource_range(vk::ImageAspectFlags::DEPTH))
 }
