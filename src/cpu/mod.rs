@@ -121,15 +121,7 @@ struct Prepared {
 pub fn shadow_choice(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> ShadowChoice {
     let requested = settings.shading.shadows;
     let can_occlude = requested != Shadows::Auto || crate::visibility::can_occlude(scene);
-    let choice = crate::visibility::choose_reference(requested, &settings.lights, can_occlude);
-    if requested == Shadows::Auto && choice.technique == Shadows::Ray && !options.device_ray_queries {
-        return ShadowChoice {
-            technique: Shadows::None,
-            reason: "auto, mirroring a device without ray queries (and so without shadows)".into(),
-            warning: true,
-        };
-    }
-    choice
+    crate::visibility::choose_reference(requested, &settings.lights, can_occlude, options.device_ray_queries)
 }
 
 /// Every triangle of the scene in world space, for the shadow rays.

@@ -349,17 +349,7 @@ impl Renderer {
                 self.dev.info.name
             )));
         }
-        if choice.technique == Shadows::Map && requested == Shadows::Auto {
-            choice = ShadowChoice {
-                technique: Shadows::None,
-                reason: format!(
-                    "{}; every light is unoccluded (no shadows); --shadows map gives the sun's and the disk \
-                     lights' shadows from shadow maps",
-                    choice.reason
-                ),
-                warning: true,
-            };
-        } else if choice.technique == Shadows::Map {
+        if choice.technique == Shadows::Map {
             if settings.lights.disks.len() > MAX_DISK_MAPS {
                 choice.reason += &format!(
                     "; only the first {MAX_DISK_MAPS} disk lights have shadow maps: the other {} are unoccluded",
