@@ -70,6 +70,8 @@ fn teapot_on_floor() -> Result<Scene, CliError> {
         positions: corners.to_vec(),
         normals: vec![Vec3::Y; 4],
         tangents: vec![glam::Vec4::new(1.0, 0.0, 0.0, 1.0); 4],
+        tex_coords: Default::default(),
+        colors: Vec::new(),
         // Counter-clockwise seen from above.
         indices: vec![0, 2, 1, 0, 3, 2],
         material: 0,

@@ -20,13 +20,15 @@ use serde_json::Value;
 
 use super::camera::{Camera, Projection};
 use super::gltf::accessor::AccessorReader;
-use super::gltf::document::{self, lookup, CameraDef, LightDef, MaterialDef, NodeDef, PrimitiveDef, Root};
+use super::gltf::document::{self, lookup, CameraDef, LightDef, NodeDef, PrimitiveDef, Root};
+use super::gltf::files::AssetFiles;
 use super::gltf::files::UriScope;
 use super::gltf::{self, SUPPORTED_EXTENSIONS};
 use super::light::{DiskLight, Sun, MAX_DISK_EXTENT_M};
-use super::material::{Brdf, Material, MetallicRoughness};
+use super::load_material::{rgb, sunshade_extras, MaterialReader};
+use super::material::Material;
 use super::tangent::{default_tangent, orthonormal_tangent, tangents_from_uv, triangle_tangent};
-use super::{Mesh, Scene};
+use super::{deform, Mesh, Scene};
 use crate::shading::radiometry::{degrees_to_radians, SUN_ANGULAR_DIAMETER_DEGREES};
 
 /// A glTF file that could not be loaded: `path: problem`, one line.
@@ -60,12 +62,16 @@ pub fn load(path: &Path) -> Result<Scene, LoadError> {
 pub fn load_with_options(path: &Path, options: &LoadOptions) -> Result<Scene, LoadError> {
     let fail = |message: String| LoadError { path: path.to_path_buf(), message };
     let file = gltf::read(path, &options.uris).map_err(fail)?;
-    Loader::new(&file.root, &file.buffers).load(options).map_err(fail)
+    Loader::new(&file.root, &file.buffers, &file.files).load(options).map_err(fail)
 }
 
 struct Loader<'a> {
     root: &'a Root,
     reader: AccessorReader<'a>,
+    files: &'a AssetFiles,
+    /// Every node's world matrix (`None` for nodes that no hierarchy walk from a parentless node reaches), for
+    /// skins' joints.
+    node_world: Vec<Option<DMat4>>,
     scene: Scene,
     /// Index of glTF's default material in `scene.materials`, once a primitive needs it.
     default_material: Option<usize>,
@@ -87,10 +93,12 @@ fn mode_name(mode: u64) -> String {
 }
 
 impl<'a> Loader<'a> {
-    fn new(root: &'a Root, buffers: &'a [Vec<u8>]) -> Self {
+    fn new(root: &'a Root, buffers: &'a [Vec<u8>], files: &'a AssetFiles) -> Self {
         Self {
             root,
             reader: AccessorReader { root, buffers },
+            files,
+            node_world: Vec::new(),
             scene: Scene::default(),
             default_material: None,
             vertex_count: 0,
@@ -116,17 +124,15 @@ impl<'a> Loader<'a> {
                 required.join(", ")
             ));
         }
+        let mut materials = MaterialReader::new(root, self.reader.buffers, self.files);
         for (index, material) in root.materials.iter().enumerate() {
-            let m = read_material(index, material)?;
-            let ignored = ignored_material_features(material);
-            if !ignored.is_empty() {
-                self.scene.warnings.push(format!(
-                    "{}: {} not modelled; ignored (the surface is opaque, untextured and not emissive)",
-                    m.name,
-                    ignored.join(", ")
-                ));
-            }
+            let m = materials.read(index, material)?;
             self.scene.materials.push(m);
+        }
+        self.scene.textures = materials.textures;
+        self.scene.warnings.extend(materials.warnings);
+        if !root.skins.is_empty() {
+            self.node_world = node_world_matrices(root)?;
         }
         self.walk(&roots)?;
         Ok(self.scene)
@@ -166,7 +172,7 @@ impl<'a> Loader<'a> {
             return Ok(roots);
         };
         let owner = format!("scene {index}");
-        if let Some(sky) = sunshade_extras(&gscene.extras).map_err(|e| format!("{owner}: {e}"))? {
+        if let Some(sky) = sunshade_extras(&gscene.extras) {
             if let Some(v) = sky.get("sky_radiance") {
                 let radiance = rgb(v).map_err(|e| format!("{owner} extras: sky_radiance {e}"))?;
                 self.scene.lights.sky = Some(radiance);
@@ -214,8 +220,14 @@ impl<'a> Loader<'a> {
                 Some(n) => format!("mesh '{n}'"),
                 None => format!("mesh {m}"),
             };
+            let weights = node.weights.as_deref().or(mesh.weights.as_deref()).unwrap_or(&[]);
+            let joints = match node.skin {
+                Some(skin) => Some(self.joint_matrices(index, skin)?),
+                None => None,
+            };
             for (p, primitive) in mesh.primitives.iter().enumerate() {
-                self.add_primitive(index, &format!("{mesh_name} primitive {p}"), primitive, world)?;
+                let name = format!("{mesh_name} primitive {p}");
+                self.add_primitive(index, &name, primitive, world, weights, joints.as_deref())?;
             }
         }
         if let Some(c) = node.camera {
@@ -228,22 +240,27 @@ impl<'a> Loader<'a> {
             let light = lookup(lights, l.light, &format!("{owner} KHR_lights_punctual"), "light")?;
             self.add_light(index, l.light, light, world)?;
         }
-        if let Some(extras) = sunshade_extras(&node.extras).map_err(|e| format!("{owner}: {e}"))? {
+        if let Some(extras) = sunshade_extras(&node.extras) {
             self.add_extras_light(index, &extras, world)?;
         }
         Ok(())
     }
 
-    fn add_primitive(&mut self, node: u64, name: &str, primitive: &PrimitiveDef, world: &DMat4) -> Result<(), String> {
+    /// One primitive of a node's mesh: its vertex streams read (morphed by `weights`), carried to world space by
+    /// the node's transform or, for a skinned node, by each vertex's blend of `joints` (each joint's world matrix
+    /// times its inverse bind matrix; the node's own transform is then ignored, as glTF says), and flattened.
+    fn add_primitive(
+        &mut self,
+        node: u64,
+        name: &str,
+        primitive: &PrimitiveDef,
+        world: &DMat4,
+        weights: &[f64],
+        joints: Option<&[DMat4]>,
+    ) -> Result<(), String> {
         let mode = primitive.mode.unwrap_or(document::MODE_TRIANGLES);
         if mode != document::MODE_TRIANGLES {
             self.scene.warnings.push(format!("{name}: mode {} skipped (only TRIANGLES is rendered)", mode_name(mode)));
-            return Ok(());
-        }
-        let linear = DMat3::from_mat4(*world);
-        let det = linear.determinant();
-        if !det.is_finite() || det == 0.0 {
-            self.scene.warnings.push(format!("{name}: node {node} has a singular transform; skipped"));
             return Ok(());
         }
         let attribute = |semantic: &str| primitive.attributes.get(semantic).copied();
@@ -251,11 +268,66 @@ impl<'a> Loader<'a> {
             self.scene.warnings.push(format!("{name}: no POSITION; skipped (the glTF spec asks for that)"));
             return Ok(());
         };
-        let local_positions = self.reader.read(pos_acc, &format!("{name} POSITION"), "VEC3")?.values;
+        let mut local_positions = self.reader.read(pos_acc, &format!("{name} POSITION"), "VEC3")?.values;
         if let Some(i) = local_positions.iter().position(|c| !c.is_finite()) {
             return Err(format!("{name}: POSITION accessor {pos_acc} holds a non-finite value at vertex {}", i / 3));
         }
         let vertex_count = local_positions.len() / 3;
+        let per_vertex = |semantic: &str, kind: &str| -> Result<Option<Vec<f64>>, String> {
+            let Some(acc) = attribute(semantic) else { return Ok(None) };
+            let e = self.reader.read(acc, &format!("{name} {semantic}"), kind)?;
+            if e.count() != vertex_count {
+                return Err(format!("{name}: {semantic} has {} elements, POSITION {vertex_count}", e.count()));
+            }
+            Ok(Some(e.values))
+        };
+        let mut local_normals = per_vertex("NORMAL", "VEC3")?;
+        let mut local_tangents = per_vertex("TANGENT", "VEC4")?;
+        let (mut uv0, mut uv1) = (per_vertex("TEXCOORD_0", "VEC2")?, per_vertex("TEXCOORD_1", "VEC2")?);
+        let color_kind = attribute("COLOR_0").and_then(|a| self.root.accessors.get(a as usize)).map(|a| a.kind.clone());
+        let mut colors = match color_kind.as_deref() {
+            Some("VEC3") => per_vertex("COLOR_0", "VEC3")?
+                .map(|c| c.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 1.0]).collect::<Vec<f64>>()),
+            Some(_) => per_vertex("COLOR_0", "VEC4")?,
+            None => None,
+        };
+        // Morph targets with their default weights (the node's, else the mesh's); zero weights leave the streams
+        // bitwise as read.
+        for (t, target) in primitive.targets.iter().enumerate() {
+            let w = weights.get(t).copied().unwrap_or(0.0);
+            if w == 0.0 {
+                continue;
+            }
+            if !w.is_finite() {
+                return Err(format!("{name}: morph weight {t} is {w}"));
+            }
+            let streams: [(&str, &str, Option<&mut Vec<f64>>); 6] = [
+                ("POSITION", "VEC3", Some(&mut local_positions)),
+                ("NORMAL", "VEC3", local_normals.as_mut()),
+                ("TANGENT", "VEC3", local_tangents.as_mut()),
+                ("TEXCOORD_0", "VEC2", uv0.as_mut()),
+                ("TEXCOORD_1", "VEC2", uv1.as_mut()),
+                ("COLOR_0", "VEC4", colors.as_mut()),
+            ];
+            for (semantic, kind, base) in streams {
+                let (Some(acc), Some(base)) = (target.get(semantic), base) else { continue };
+                let owner = format!("{name} morph target {t} {semantic}");
+                let kind = if semantic == "COLOR_0" {
+                    self.root
+                        .accessors
+                        .get(*acc as usize)
+                        .map_or(kind, |a| if a.kind == "VEC3" { "VEC3" } else { "VEC4" })
+                } else {
+                    kind
+                };
+                let d = self.reader.read(*acc, &owner, kind)?;
+                if d.count() != vertex_count {
+                    return Err(format!("{owner}: {} elements, POSITION {vertex_count}", d.count()));
+                }
+                deform::morph(base, &d.values, d.n, w);
+            }
+        }
+        let mut uv_sets = [uv0, uv1];
         let mut indices = match primitive.indices {
             Some(acc) => self.reader.read_indices(acc, &format!("{name} indices"))?,
             None => (0..vertex_count as u32).collect(),
@@ -266,8 +338,28 @@ impl<'a> Loader<'a> {
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
             return Err(format!("{name}: index {bad} is out of range ({vertex_count} vertices)"));
         }
+        // Skinning: each vertex's own matrix.
+        let skin = match joints {
+            Some(joints) => {
+                let js = per_vertex("JOINTS_0", "VEC4")?;
+                let ws = per_vertex("WEIGHTS_0", "VEC4")?;
+                let (Some(js), Some(ws)) = (js, ws) else {
+                    return Err(format!(
+                        "{name}: node {node} has a skin but the primitive lacks JOINTS_0 or WEIGHTS_0"
+                    ));
+                };
+                Some(deform::skin_matrices(joints, &js, &ws).map_err(|e| format!("{name}: {e}"))?)
+            }
+            None => None,
+        };
+        let linear = DMat3::from_mat4(skin.as_ref().and_then(|s| s.first()).copied().unwrap_or(*world));
+        let det = linear.determinant();
+        if !det.is_finite() || det == 0.0 {
+            self.scene.warnings.push(format!("{name}: node {node} has a singular transform; skipped"));
+            return Ok(());
+        }
         // Flat normals un-index: three vertices a triangle.
-        let added = if attribute("NORMAL").is_some() { vertex_count } else { indices.len() };
+        let added = if local_normals.is_some() { vertex_count } else { indices.len() };
         self.vertex_count = self.vertex_count.saturating_add(added);
         if self.vertex_count > MAX_SCENE_VERTICES {
             return Err(format!(
@@ -280,9 +372,11 @@ impl<'a> Loader<'a> {
                 tri.swap(1, 2);
             }
         }
+        let matrix_of = |i: usize| skin.as_ref().map_or(*world, |s| s[i]);
         let positions: Vec<Vec3> = local_positions
             .chunks_exact(3)
-            .map(|p| world.transform_point3(DVec3::new(p[0], p[1], p[2])).as_vec3())
+            .enumerate()
+            .map(|(i, p)| matrix_of(i).transform_point3(DVec3::new(p[0], p[1], p[2])).as_vec3())
             .collect();
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("{name}: vertex {i} is not finite after the node transform"));
@@ -290,39 +384,49 @@ impl<'a> Loader<'a> {
 
         let mut out =
             Mesh { name: name.to_string(), material: self.material_index(name, primitive)?, ..Default::default() };
-        let per_vertex = |semantic: &str, kind: &str| -> Result<Option<Vec<f64>>, String> {
-            let Some(acc) = attribute(semantic) else { return Ok(None) };
-            let e = self.reader.read(acc, &format!("{name} {semantic}"), kind)?;
-            if e.count() != vertex_count {
-                return Err(format!("{name}: {semantic} has {} elements, POSITION {vertex_count}", e.count()));
+        let material_sets: Vec<u32> = self.scene.materials[out.material].textures().map(|t| t.tex_coord).collect();
+        for set in material_sets {
+            if uv_sets[set as usize].is_none() {
+                self.scene
+                    .warnings
+                    .push(format!("{name}: its material reads TEXCOORD_{set}, which the primitive lacks; (0, 0) used"));
+                uv_sets[set as usize] = Some(vec![0.0; 2 * vertex_count]);
             }
-            Ok(Some(e.values))
-        };
+        }
+        let uv_sets: [Option<Vec<[f32; 2]>>; 2] =
+            uv_sets.map(|s| s.map(|uv| uv.chunks_exact(2).map(|c| [c[0] as f32, c[1] as f32]).collect()));
+        let colors: Option<Vec<[f32; 4]>> =
+            colors.map(|c| c.chunks_exact(4).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32]).collect());
         // Tangent sources: TANGENT (transformed as a direction, handedness flipped by a mirroring node), else
         // TEXCOORD_0.
-        let file_tangents = per_vertex("TANGENT", "VEC4")?.map(|t| {
+        let file_tangents = local_tangents.map(|t| {
             let w_sign = det.signum();
             t.chunks_exact(4)
-                .map(|t| (linear * DVec3::new(t[0], t[1], t[2]), w_sign * t[3].signum()))
+                .enumerate()
+                .map(|(i, t)| (DMat3::from_mat4(matrix_of(i)) * DVec3::new(t[0], t[1], t[2]), w_sign * t[3].signum()))
                 .collect::<Vec<_>>()
         });
         let uvs = match file_tangents {
-            None => per_vertex("TEXCOORD_0", "VEC2")?
-                .map(|uv| uv.chunks_exact(2).map(|c| [c[0] as f32, c[1] as f32]).collect::<Vec<_>>()),
+            None => uv_sets[0].as_ref(),
             Some(_) => None,
         };
-        match per_vertex("NORMAL", "VEC3")? {
+        match local_normals {
             Some(normals) => {
                 // Normals transform by the inverse transpose of the linear part.
                 let normal_matrix = linear.inverse().transpose();
                 out.normals = normals
                     .chunks_exact(3)
-                    .map(|n| {
-                        let w = normal_matrix * DVec3::new(n[0], n[1], n[2]);
+                    .enumerate()
+                    .map(|(i, n)| {
+                        let m = match &skin {
+                            Some(s) => DMat3::from_mat4(s[i]).inverse().transpose(),
+                            None => normal_matrix,
+                        };
+                        let w = m * DVec3::new(n[0], n[1], n[2]);
                         w.try_normalize().unwrap_or(DVec3::ZERO).as_vec3()
                     })
                     .collect();
-                out.tangents = match (&file_tangents, &uvs) {
+                out.tangents = match (&file_tangents, uvs) {
                     (Some(t), _) => t
                         .iter()
                         .zip(&out.normals)
@@ -335,6 +439,8 @@ impl<'a> Loader<'a> {
                 };
                 out.positions = positions;
                 out.indices = indices;
+                out.tex_coords = uv_sets.map(Option::unwrap_or_default);
+                out.colors = colors.unwrap_or_default();
             }
             None => {
                 // Flat normals: every triangle gets its own three vertices carrying its face normal, computed from the
@@ -350,7 +456,15 @@ impl<'a> Loader<'a> {
                     out.positions.extend([a, b, c]);
                     out.normals.extend([n, n, n]);
                     out.indices.extend([base, base + 1, base + 2]);
-                    let tangents: [Vec4; 3] = match (&file_tangents, &uvs) {
+                    for (set, stream) in uv_sets.iter().enumerate() {
+                        if let Some(uv) = stream {
+                            out.tex_coords[set].extend(tri.iter().map(|&i| uv[i as usize]));
+                        }
+                    }
+                    if let Some(c) = &colors {
+                        out.colors.extend(tri.iter().map(|&i| c[i as usize]));
+                    }
+                    let tangents: [Vec4; 3] = match (&file_tangents, uvs) {
                         (Some(t), _) => [0, 1, 2].map(|k| {
                             let (t, w) = t[tri[k] as usize];
                             orthonormal_tangent(t, nd).as_vec3().extend(w as f32)
@@ -376,6 +490,40 @@ impl<'a> Loader<'a> {
             self.scene.meshes.push(out);
         }
         Ok(())
+    }
+
+    /// A skin's joint matrices `W(joint) · IBM` (glTF 2.0 §3.7.3), the bind pose as the file's node transforms
+    /// place the joints.
+    fn joint_matrices(&self, node: u64, skin: u64) -> Result<Vec<DMat4>, String> {
+        let owner = format!("node {node}");
+        let def = lookup(&self.root.skins, skin, &owner, "skin")?;
+        let what = format!("skin {skin}");
+        let ibms = match def.inverse_bind_matrices {
+            Some(acc) => {
+                let e = self.reader.read(acc, &format!("{what} inverseBindMatrices"), "MAT4")?;
+                if e.count() < def.joints.len() {
+                    return Err(format!("{what}: {} inverse bind matrices for {} joints", e.count(), def.joints.len()));
+                }
+                e.values.chunks_exact(16).map(|m| DMat4::from_cols_slice(&f32s_slice(m))).collect()
+            }
+            None => vec![DMat4::IDENTITY; def.joints.len()],
+        };
+        def.joints
+            .iter()
+            .zip(ibms)
+            .map(|(&j, ibm)| {
+                lookup(&self.root.nodes, j, &what, "joint node")?;
+                let w = self.node_world.get(j as usize).copied().flatten().ok_or_else(|| {
+                    format!("{what}: joint node {j} is in no node hierarchy (a cycle or a node with two parents)")
+                })?;
+                let m = w * ibm;
+                if m.is_finite() {
+                    Ok(m)
+                } else {
+                    Err(format!("{what}: joint node {j}'s matrix is not finite"))
+                }
+            })
+            .collect()
     }
 
     fn material_index(&mut self, name: &str, primitive: &PrimitiveDef) -> Result<usize, String> {
@@ -483,32 +631,44 @@ impl<'a> Loader<'a> {
     }
 }
 
-/// The `"sunshade"` object of an `extras` value, if any.
-fn sunshade_extras(extras: &Option<Value>) -> Result<Option<Value>, String> {
-    match extras {
-        None => Ok(None),
-        Some(v @ Value::Object(_)) => Ok(v.get("sunshade").cloned()),
-        Some(_) => Ok(None),
-    }
-}
-
-/// A radiance: `[r, g, b]` or one number for all three, finite and non-negative [W/(m²·sr)].
-fn rgb(v: &Value) -> Result<[f32; 3], String> {
-    let values: Vec<f64> = match v {
-        Value::Number(n) => vec![n.as_f64().unwrap_or(f64::NAN); 3],
-        Value::Array(a) if a.len() == 3 => a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
-        _ => return Err("must be a number or [r, g, b]".into()),
-    };
-    if values.iter().any(|x| !(x.is_finite() && *x >= 0.0 && *x <= f32::MAX as f64)) {
-        return Err(format!("{values:?} must be finite and non-negative"));
-    }
-    Ok([values[0] as f32, values[1] as f32, values[2] as f32])
-}
-
 /// glTF's matrix and TRS are single-precision floats: each is rounded to f32 (as the gltf crate and viewers read
 /// them), then composed in f64 and rounded to f32 once per vertex.
 fn f32s<const N: usize>(v: [f64; N]) -> [f64; N] {
     v.map(|x| x as f32 as f64)
+}
+
+/// A matrix's components rounded to f32, as glTF stores them (see [`f32s`]).
+fn f32s_slice(m: &[f64]) -> Vec<f64> {
+    m.iter().map(|&x| x as f32 as f64).collect()
+}
+
+/// Every node's world matrix, walked down from each node that is no node's child with an explicit stack; a node
+/// reached twice keeps its first matrix (the scene walk reports the malformed hierarchy if it draws it).
+fn node_world_matrices(root: &Root) -> Result<Vec<Option<DMat4>>, String> {
+    let n = root.nodes.len();
+    let mut is_child = vec![false; n];
+    for node in &root.nodes {
+        for &c in &node.children {
+            if let Some(flag) = is_child.get_mut(c as usize) {
+                *flag = true;
+            }
+        }
+    }
+    let mut world = vec![None; n];
+    let mut stack: Vec<(usize, DMat4)> = (0..n).filter(|&i| !is_child[i]).map(|i| (i, DMat4::IDENTITY)).collect();
+    while let Some((i, parent)) = stack.pop() {
+        if world[i].is_some() {
+            continue;
+        }
+        let m = parent * local_transform(i as u64, &root.nodes[i])?;
+        world[i] = Some(m);
+        for &c in &root.nodes[i].children {
+            if (c as usize) < n {
+                stack.push((c as usize, m));
+            }
+        }
+    }
+    Ok(world)
 }
 
 fn local_transform(index: u64, node: &NodeDef) -> Result<DMat4, String> {
@@ -528,82 +688,6 @@ fn local_transform(index: u64, node: &NodeDef) -> Result<DMat4, String> {
         return Err(format!("node {index} has a non-finite or zero-length transform"));
     }
     Ok(m)
-}
-
-/// The parts of a glTF material that sunshade does not model, by their glTF names: textures (the factors alone
-/// are used), emission, alpha modes other than OPAQUE, and material extensions (KHR_materials_*).
-fn ignored_material_features(material: &MaterialDef) -> Vec<String> {
-    let pbr = &material.pbr_metallic_roughness;
-    let mut ignored = Vec::new();
-    let textures = [
-        ("baseColorTexture", pbr.base_color_texture.is_some()),
-        ("metallicRoughnessTexture", pbr.metallic_roughness_texture.is_some()),
-        ("normalTexture", material.normal_texture.is_some()),
-        ("occlusionTexture", material.occlusion_texture.is_some()),
-        ("emissiveTexture", material.emissive_texture.is_some()),
-        ("emissiveFactor", material.emissive_factor != [0.0; 3]),
-    ];
-    ignored.extend(textures.iter().filter(|(_, present)| *present).map(|(name, _)| name.to_string()));
-    match material.alpha_mode.as_str() {
-        "OPAQUE" => {}
-        "MASK" | "BLEND" => ignored.push(format!("alphaMode {}", material.alpha_mode)),
-        other => ignored.push(format!("alphaMode '{other}' (not a glTF alpha mode)")),
-    }
-    ignored.extend(material.extensions.keys().map(|e| format!("extension {e}")));
-    ignored
-}
-
-fn read_material(index: usize, material: &MaterialDef) -> Result<Material, String> {
-    let name = material.name.as_ref().map_or_else(|| format!("material {index}"), |n| format!("material '{n}'"));
-    let pbr = &material.pbr_metallic_roughness;
-    let [r, g, b, _] = pbr.base_color_factor.map(|c| c as f32);
-    let albedo = [r, g, b];
-    if albedo.iter().any(|c| !(0.0..=1.0).contains(c)) {
-        return Err(format!("{name}: baseColorFactor {albedo:?} is outside [0, 1]"));
-    }
-    let metallic_roughness = MetallicRoughness {
-        base_color: albedo,
-        metallic: pbr.metallic_factor as f32,
-        roughness: pbr.roughness_factor as f32,
-    };
-    let extras = sunshade_extras(&material.extras).map_err(|e| format!("{name}: {e}"))?;
-    let brdf = match extras.as_ref().filter(|x| x.get("brdf").is_some()) {
-        Some(x) => brdf_from_extras(x, albedo).map_err(|e| format!("{name} extras: {e}"))?,
-        None => Brdf::Lambert { albedo },
-    };
-    brdf.validate().map_err(|e| format!("{name}: {e}"))?;
-    Ok(Material { name, double_sided: material.double_sided, brdf, pbr: metallic_roughness })
-}
-
-/// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
-/// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor).
-fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
-    let kind = x.get("brdf").and_then(|v| v.as_str()).ok_or("\"brdf\" must be a string")?;
-    let color = |key: &str| -> Result<[f32; 3], String> {
-        rgb(x.get(key).ok_or_else(|| format!("{kind} needs \"{key}\""))?).map_err(|e| format!("{key} {e}"))
-    };
-    let number = |key: &str| -> Result<f32, String> {
-        x.get(key)
-            .and_then(|v| v.as_f64())
-            .filter(|v| v.is_finite())
-            .map(|v| v as f32)
-            .ok_or_else(|| format!("{kind} needs \"{key}\": a number"))
-    };
-    Ok(match kind {
-        "lambert" => Brdf::Lambert { albedo: if x.get("albedo").is_some() { color("albedo")? } else { base_color } },
-        "phong" => Brdf::Phong { kd: color("kd")?, ks: color("ks")?, exponent: number("exponent")? },
-        "blinn-phong" => Brdf::BlinnPhong { kd: color("kd")?, ks: color("ks")?, exponent: number("exponent")? },
-        "ward" => {
-            let (alpha_x, alpha_y) = if x.get("alpha").is_some() {
-                let a = number("alpha")?;
-                (a, a)
-            } else {
-                (number("alpha_x")?, number("alpha_y")?)
-            };
-            Brdf::Ward { kd: color("kd")?, ks: color("ks")?, alpha_x, alpha_y }
-        }
-        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward")),
-    })
 }
 
 fn read_camera(index: u64, camera: &CameraDef, world: &DMat4) -> Result<Camera, String> {

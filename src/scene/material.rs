@@ -3,6 +3,8 @@
 //! Evaluation of the BRDFs lives in `shading::brdf`; this module holds the parameters a scene gives, checks them,
 //! and maps glTF's metallic-roughness parameters onto each model (`--brdf`).
 
+use super::texture::TextureRef;
+
 /// The reflectance model of a material and its parameters (dimensionless reflectances, linear RGB).
 /// `kd + ks ≤ 1` per channel for every model ([`Brdf::validate`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -127,6 +129,17 @@ impl Brdf {
     }
 }
 
+/// glTF `alphaMode`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    #[default]
+    Opaque,
+    /// Covered where the base colour's alpha is at least the cutoff (0.5 by default), else not drawn.
+    Mask(f32),
+    /// Drawn opaque (with a warning): sunshade does not blend.
+    Blend,
+}
+
 /// A surface material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -134,20 +147,74 @@ pub struct Material {
     pub name: String,
     /// glTF `doubleSided`: back faces are drawn with the normal reversed. Single-sided back faces are culled.
     pub double_sided: bool,
+    /// The BRDF from the factors alone (where the material has no textures and its mesh no vertex colours, the
+    /// BRDF of every pixel).
     pub brdf: Brdf,
     /// The glTF metallic-roughness parameters the material came with.
     pub pbr: MetallicRoughness,
+    /// How each pixel's BRDF follows the base colour (textures and vertex colours) and the metallic-roughness
+    /// texture: `Some(kind)`, the metallic-roughness mapping onto `kind` ([`Brdf::from_metallic_roughness`];
+    /// Lambert for glTF materials unless `--brdf` says otherwise); `None`, `brdf` as the `sunshade` extras give
+    /// it, untextured.
+    pub mapping: Option<BrdfKind>,
+    /// `baseColorFactor`'s alpha.
+    pub base_alpha: f32,
+    /// sRGB base colour (and alpha) texture, multiplied by the factor.
+    pub base_color_texture: Option<TextureRef>,
+    /// Linear texture whose B channel multiplies metallic and G roughness.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    /// Tangent-space normal map and its `scale` (on the map's x and y).
+    pub normal_texture: Option<(TextureRef, f32)>,
+    /// Emitted radiance [W/(m²·sr)] per channel: `emissiveFactor × KHR_materials_emissive_strength ×` the
+    /// material's `sunshade.emission_scale` (1 W/(m²·sr) per unit factor by default), times `emissive_texture`.
+    pub emission: [f32; 3],
+    /// sRGB emission texture.
+    pub emissive_texture: Option<TextureRef>,
+    pub alpha: AlphaMode,
 }
 
 impl Material {
     /// glTF's default material: single-sided, white Lambertian (albedo 1); metallic 1, roughness 1 as glTF says.
     pub fn default_material() -> Self {
+        Self::with_brdf("default material", Brdf::Lambert { albedo: [1.0; 3] })
+    }
+
+    /// An untextured, opaque, single-sided material of this BRDF (its factors as metallic-roughness parameters:
+    /// base colour kd, metallic 1, roughness 1).
+    pub fn with_brdf(name: &str, brdf: Brdf) -> Self {
+        let mapping = brdf.is_lambert().then_some(BrdfKind::Lambert);
         Self {
-            name: "default material".into(),
+            name: name.into(),
             double_sided: false,
-            brdf: Brdf::Lambert { albedo: [1.0; 3] },
-            pbr: MetallicRoughness { base_color: [1.0; 3], metallic: 1.0, roughness: 1.0 },
+            pbr: MetallicRoughness { base_color: brdf.kd(), metallic: 1.0, roughness: 1.0 },
+            brdf,
+            mapping,
+            base_alpha: 1.0,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            emission: [0.0; 3],
+            emissive_texture: None,
+            alpha: AlphaMode::Opaque,
         }
+    }
+
+    /// Whether a pixel's BRDF needs evaluating per pixel: the mapping follows a texture, or vertex colours
+    /// (`has_colors`: the mesh's COLOR_0).
+    pub fn varies_per_pixel(&self, has_colors: bool) -> bool {
+        match self.mapping {
+            None => false,
+            Some(BrdfKind::Lambert) => self.base_color_texture.is_some() || has_colors,
+            Some(_) => self.base_color_texture.is_some() || self.metallic_roughness_texture.is_some() || has_colors,
+        }
+    }
+
+    /// Every texture the material reads.
+    pub fn textures(&self) -> impl Iterator<Item = &TextureRef> {
+        [&self.base_color_texture, &self.metallic_roughness_texture, &self.emissive_texture]
+            .into_iter()
+            .flatten()
+            .chain(self.normal_texture.as_ref().map(|(t, _)| t))
     }
 }
 

@@ -8,11 +8,14 @@
 //! Axes are glTF's: right-handed, +Y up, metres.
 
 pub mod camera;
+pub mod deform;
 mod gltf;
 pub mod light;
 mod load;
+mod load_material;
 pub mod material;
 pub mod tangent;
+pub mod texture;
 
 use glam::{DVec3, Vec3, Vec4};
 
@@ -20,7 +23,8 @@ pub use camera::{Camera, Projection};
 pub use gltf::files::UriScope;
 pub use light::{DiskLight, Lights, Sun};
 pub use load::{load, load_with_options, LoadError, LoadOptions, MAX_SCENE_VERTICES};
-pub use material::{Brdf, BrdfKind, Material, MetallicRoughness};
+pub use material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
+pub use texture::{Texture, TextureRef};
 
 /// A loaded scene: everything both renderers need apart from the per-render settings.
 #[derive(Clone, Debug, Default)]
@@ -29,6 +33,8 @@ pub struct Scene {
     pub meshes: Vec<Mesh>,
     /// Materials; `Mesh::material` indexes this list.
     pub materials: Vec<Material>,
+    /// Textures (mip chains and samplers); `TextureRef::texture` indexes this list.
+    pub textures: Vec<Texture>,
     /// Cameras placed by the scene's nodes, in node order, each with the index of its glTF camera.
     pub cameras: Vec<(usize, Camera)>,
     /// Lights the scene defines (the CLI may override or add to them).
@@ -49,6 +55,11 @@ pub struct Mesh {
     /// Unit tangents (the αx direction of anisotropic BRDFs) orthogonal to the normals, w = handedness ±1:
     /// from TANGENT, else from TEXCOORD_0, else [`tangent::default_tangent`].
     pub tangents: Vec<Vec4>,
+    /// Texture coordinates per set (TEXCOORD_0, TEXCOORD_1), each empty or one per vertex; (0, 0) is the image's
+    /// top-left corner.
+    pub tex_coords: [Vec<[f32; 2]>; 2],
+    /// COLOR_0 as linear RGBA (alpha 1 where the file gives RGB), empty where the file has none.
+    pub colors: Vec<[f32; 4]>,
     /// Triangle list; counter-clockwise (seen from the front) in world space.
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`].
@@ -81,6 +92,7 @@ impl Scene {
     pub fn map_brdfs(&mut self, kind: BrdfKind) {
         for m in &mut self.materials {
             m.brdf = Brdf::from_metallic_roughness(kind, m.pbr);
+            m.mapping = Some(kind);
         }
     }
 

@@ -29,10 +29,10 @@ pub struct Root {
     pub buffers: Vec<BufferDef>,
     pub materials: Vec<MaterialDef>,
     pub textures: Vec<TextureDef>,
-    pub images: Vec<Value>,
-    pub samplers: Vec<Value>,
+    pub images: Vec<ImageDef>,
+    pub samplers: Vec<SamplerDef>,
     pub cameras: Vec<CameraDef>,
-    pub skins: Vec<Value>,
+    pub skins: Vec<SkinDef>,
     pub animations: Vec<Value>,
     pub extensions_used: Vec<String>,
     pub extensions_required: Vec<String>,
@@ -194,13 +194,14 @@ pub struct MaterialDef {
     pub name: Option<String>,
     #[serde(default)]
     pub pbr_metallic_roughness: PbrDef,
-    pub normal_texture: Option<Value>,
-    pub occlusion_texture: Option<Value>,
-    pub emissive_texture: Option<Value>,
+    pub normal_texture: Option<TextureInfo>,
+    pub occlusion_texture: Option<TextureInfo>,
+    pub emissive_texture: Option<TextureInfo>,
     #[serde(default)]
     pub emissive_factor: [f64; 3],
     #[serde(default = "opaque")]
     pub alpha_mode: String,
+    pub alpha_cutoff: Option<f64>,
     #[serde(default)]
     pub double_sided: bool,
     /// Extension name → its object; sunshade names the ones it does not model.
@@ -214,12 +215,80 @@ pub struct MaterialDef {
 pub struct PbrDef {
     #[serde(default = "white4")]
     pub base_color_factor: [f64; 4],
-    pub base_color_texture: Option<Value>,
+    pub base_color_texture: Option<TextureInfo>,
     #[serde(default = "one")]
     pub metallic_factor: f64,
     #[serde(default = "one")]
     pub roughness_factor: f64,
-    pub metallic_roughness_texture: Option<Value>,
+    pub metallic_roughness_texture: Option<TextureInfo>,
+}
+
+/// A material's reference to a texture (`textureInfo`, and the normal and occlusion variants' `scale` and
+/// `strength`).
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct TextureInfo {
+    pub index: Index,
+    #[serde(default)]
+    pub tex_coord: u64,
+    /// normalTextureInfo.scale (1 by default).
+    #[serde(default = "one")]
+    pub scale: f64,
+    #[serde(default)]
+    pub extensions: TextureInfoExtensions,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct TextureInfoExtensions {
+    #[serde(rename = "KHR_texture_transform")]
+    pub texture_transform: Option<TextureTransformDef>,
+}
+
+/// KHR_texture_transform: `uv' = T(offset) R(rotation) S(scale) uv`, and a texCoord override.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct TextureTransformDef {
+    #[serde(default)]
+    pub offset: [f64; 2],
+    /// Radians, counter-clockwise in UV space.
+    #[serde(default)]
+    pub rotation: f64,
+    #[serde(default = "one2")]
+    pub scale: [f64; 2],
+    pub tex_coord: Option<u64>,
+}
+
+/// An image: a URI (file or data), or a buffer view with a MIME type.
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase", default)]
+pub struct ImageDef {
+    pub name: Option<String>,
+    pub uri: Option<String>,
+    pub mime_type: Option<String>,
+    pub buffer_view: Option<Index>,
+}
+
+/// A sampler: glTF's (OpenGL's) filter and wrap codes; absent filters are the implementation's choice.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct SamplerDef {
+    pub mag_filter: Option<u64>,
+    pub min_filter: Option<u64>,
+    #[serde(default = "repeat")]
+    pub wrap_s: u64,
+    #[serde(default = "repeat")]
+    pub wrap_t: u64,
+}
+
+/// A skin: joints (nodes) and their inverse bind matrices (MAT4 accessor; identity when absent).
+#[derive(Debug, Default, Deserialize)]
+#[serde(rename_all = "camelCase", default)]
+pub struct SkinDef {
+    pub name: Option<String>,
+    pub inverse_bind_matrices: Option<Index>,
+    pub joints: Vec<Index>,
+    pub skeleton: Option<Index>,
 }
 
 impl Default for PbrDef {
@@ -240,6 +309,8 @@ impl Default for PbrDef {
 pub struct TextureDef {
     pub sampler: Option<Index>,
     pub source: Option<Index>,
+    /// Extension name → its object (KHR_texture_basisu, EXT_texture_webp... give another `source`).
+    pub extensions: BTreeMap<String, Value>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -268,6 +339,12 @@ pub struct OrthographicDef {
 
 fn one() -> f64 {
     1.0
+}
+fn one2() -> [f64; 2] {
+    [1.0; 2]
+}
+fn repeat() -> u64 {
+    10497
 }
 fn white() -> [f64; 3] {
     [1.0; 3]

@@ -61,7 +61,7 @@ impl AssetFiles {
 
     /// The first `needed` bytes of the file a percent-decoded relative URI names. `uri` is the URI as written, for
     /// messages.
-    pub fn read(&self, relative: &str, uri: &str, needed: u64) -> Result<Vec<u8>, String> {
+    pub fn read(&self, relative: &str, uri: &str, needed: Option<u64>) -> Result<Vec<u8>, String> {
         if relative.contains('\0') {
             return Err(format!("URI '{uri}' contains a NUL byte"));
         }
@@ -84,7 +84,7 @@ impl AssetFiles {
                 ));
             }
         }
-        read_regular_file(&canonical, Some(needed)).map_err(|e| format!("'{uri}': {e}"))
+        read_regular_file(&canonical, needed).map_err(|e| format!("'{uri}': {e}"))
     }
 }
 

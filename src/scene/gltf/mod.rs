@@ -10,6 +10,7 @@ pub mod accessor;
 pub mod document;
 pub mod files;
 pub mod glb;
+pub mod image;
 pub mod uri;
 
 use std::path::Path;
@@ -19,7 +20,8 @@ use files::{AssetFiles, UriScope};
 use uri::UriTarget;
 
 /// Extensions sunshade implements.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength"];
 
 /// Extensions whose whole effect is on appearance that sunshade does not draw yet: texture transforms (textures
 /// are not drawn), emission strength (emission is not drawn) and material lobes (KHR_materials_*: materials are
@@ -36,6 +38,8 @@ pub fn is_appearance_only(extension: &str) -> bool {
 pub struct Gltf {
     pub root: Root,
     pub buffers: Vec<Vec<u8>>,
+    /// Where the file's images are read from (the same rules as its buffers).
+    pub files: AssetFiles,
 }
 
 /// Reads and parses a `.gltf` or `.glb` file and every buffer it declares. Errors are one line without the file
@@ -53,7 +57,7 @@ pub fn read(path: &Path, scope: &UriScope) -> Result<Gltf, String> {
     check_required_extensions(&root)?;
     let files = AssetFiles::new(path, scope)?;
     let buffers = read_buffers(&root, bin, &files)?;
-    Ok(Gltf { root, buffers })
+    Ok(Gltf { root, buffers, files })
 }
 
 fn check_version(root: &Root) -> Result<(), String> {
@@ -102,9 +106,9 @@ fn read_buffers(root: &Root, bin: Option<&[u8]>, files: &AssetFiles) -> Result<V
                     bytes.truncate(n);
                     bytes
                 }
-                UriTarget::File(rel) => {
-                    files.read(&rel, u, declared).map_err(|e| format!("buffer {i} (byteLength {declared}): {e}"))?
-                }
+                UriTarget::File(rel) => files
+                    .read(&rel, u, Some(declared))
+                    .map_err(|e| format!("buffer {i} (byteLength {declared}): {e}"))?,
             },
         };
         out.push(data);

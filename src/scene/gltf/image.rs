@@ -1,0 +1,142 @@
+//! glTF images → linear f32 texels: PNG and JPEG, from a buffer view, a data URI or a file inside the asset
+//! folder (the same rules as buffers). Decoding is bounded: at most [`MAX_TEXTURE_SIDE`] texels a side, checked
+//! from the header before the pixels are decoded.
+
+use super::document::{lookup, ImageDef, Root};
+use super::files::AssetFiles;
+use super::uri::{self, UriTarget};
+use crate::scene::texture::{srgb_decode, srgb_to_linear, Level};
+
+/// The longest side of an image sunshade decodes [texels] (lavapipe's `maxImageDimension2D`).
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+/// The encoded bytes of image `index`, and its MIME type where the file gives one.
+pub fn image_bytes(
+    root: &Root,
+    buffers: &[Vec<u8>],
+    files: &AssetFiles,
+    index: u64,
+    owner: &str,
+) -> Result<(Vec<u8>, Option<String>), String> {
+    let image: &ImageDef = lookup(&root.images, index, owner, "image")?;
+    let what = format!("image {index}");
+    match (&image.uri, image.buffer_view) {
+        (Some(u), _) => match uri::resolve(u).map_err(|e| format!("{what}: {e}"))? {
+            UriTarget::Data(bytes) => Ok((bytes, image.mime_type.clone())),
+            UriTarget::File(rel) => {
+                let bytes = files.read(&rel, u, None).map_err(|e| format!("{what}: {e}"))?;
+                Ok((bytes, image.mime_type.clone()))
+            }
+        },
+        (None, Some(view)) => {
+            let v = lookup(&root.buffer_views, view, &what, "bufferView")?;
+            let buffer = usize::try_from(v.buffer).ok().and_then(|b| buffers.get(b));
+            let buffer =
+                buffer.ok_or_else(|| format!("{what}: bufferView {view}: buffer {} does not exist", v.buffer))?;
+            let range = usize::try_from(v.byte_offset)
+                .ok()
+                .zip(usize::try_from(v.byte_length).ok())
+                .and_then(|(start, len)| Some(start..start.checked_add(len)?))
+                .filter(|r| r.end <= buffer.len())
+                .ok_or_else(|| format!("{what}: bufferView {view} is out of range of its buffer"))?;
+            Ok((buffer[range].to_vec(), image.mime_type.clone()))
+        }
+        (None, None) => Err(format!("{what} has neither a uri nor a bufferView")),
+    }
+}
+
+/// How a texture's colour channels are encoded: sRGB (base colour, emission) or linear (metallic-roughness,
+/// normals). Alpha is always linear.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    Srgb,
+    Linear,
+}
+
+/// Decodes PNG (8 or 16 bits, any channel count) or JPEG to linear RGBA f32 (missing channels: grey to RGB,
+/// alpha 1). `what` names the image in errors.
+pub fn decode(bytes: &[u8], space: ColorSpace, what: &str) -> Result<Level, String> {
+    use image::ImageDecoder;
+    let format = image::guess_format(bytes).map_err(|_| format!("{what}: not a PNG or JPEG image"))?;
+    if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
+        return Err(format!("{what}: {format:?} images are not read (PNG and JPEG are)"));
+    }
+    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(2 << 30);
+    reader.limits(limits);
+    let decoder = reader.into_decoder().map_err(|e| format!("{what}: {e}"))?;
+    let (width, height) = decoder.dimensions();
+    if width == 0 || height == 0 {
+        return Err(format!("{what}: the image is empty ({width}x{height})"));
+    }
+    let decoded = image::DynamicImage::from_decoder(decoder).map_err(|e| format!("{what}: {e}"))?;
+    let sixteen = matches!(
+        decoded.color(),
+        image::ColorType::L16 | image::ColorType::La16 | image::ColorType::Rgb16 | image::ColorType::Rgba16
+    );
+    let texels: Vec<[f32; 4]> = if sixteen {
+        let rgba = decoded.to_rgba16();
+        rgba.pixels()
+            .map(|p| {
+                let c = |v: u16| {
+                    let x = v as f64 / 65535.0;
+                    match space {
+                        ColorSpace::Linear => x as f32,
+                        ColorSpace::Srgb => srgb_decode(x) as f32,
+                    }
+                };
+                [c(p[0]), c(p[1]), c(p[2]), (p[3] as f64 / 65535.0) as f32]
+            })
+            .collect()
+    } else {
+        let table: Vec<f32> = (0..=255u8)
+            .map(|v| match space {
+                ColorSpace::Linear => (v as f64 / 255.0) as f32,
+                ColorSpace::Srgb => srgb_to_linear(v),
+            })
+            .collect();
+        let rgba = decoded.to_rgba8();
+        rgba.pixels()
+            .map(|p| [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize], (p[3] as f64 / 255.0) as f32])
+            .collect()
+    };
+    Ok(Level { width, height, texels })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.write_header().unwrap().write_image_data(rgba).unwrap();
+        out
+    }
+
+    #[test]
+    fn decodes_png_in_both_colour_spaces() {
+        let bytes = png(2, 1, &[255, 128, 0, 255, 10, 20, 30, 128]);
+        let lin = decode(&bytes, ColorSpace::Linear, "t").unwrap();
+        assert_eq!((lin.width, lin.height), (2, 1));
+        assert_eq!(lin.texels[0], [1.0, (128.0f64 / 255.0) as f32, 0.0, 1.0]);
+        let srgb = decode(&bytes, ColorSpace::Srgb, "t").unwrap();
+        assert_eq!(
+            srgb.texels[1],
+            [srgb_to_linear(10), srgb_to_linear(20), srgb_to_linear(30), (128.0f64 / 255.0) as f32]
+        );
+    }
+
+    #[test]
+    fn refuses_what_it_cannot_decode() {
+        assert!(decode(b"not an image", ColorSpace::Linear, "image 3").unwrap_err().starts_with("image 3"));
+        let mut bytes = png(4, 4, &[0; 64]);
+        bytes.truncate(bytes.len() - 20);
+        assert!(decode(&bytes, ColorSpace::Linear, "image 3").is_err());
+    }
+}

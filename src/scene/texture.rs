@@ -1,0 +1,259 @@
+//! Textures as both renderers read them: texels decoded once to linear f32 RGBA, a mip chain built once here on
+//! the CPU, and the sampler's wrap and filter modes. How a texture is looked up (texel centres, wrapping, the
+//! level chosen from UV derivatives, the blends) is `shading::texture_filter`, mirrored by
+//! `shaders/texture_filter.glsl`; docs/textures.md gives the formulas.
+
+/// How texel coordinates outside [0, N) are brought back, per axis (glTF sampler `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    /// 10497: `i mod N`.
+    Repeat,
+    /// 33648: reflected every other period.
+    MirroredRepeat,
+    /// 33071: `clamp(i, 0, N − 1)`.
+    ClampToEdge,
+}
+
+/// A filter within one level (glTF `magFilter`, and the first half of `minFilter`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    /// The texel containing the point.
+    Nearest,
+    /// Bilinear between the four texel centres around the point.
+    Linear,
+}
+
+/// Which levels minification reads (the second half of glTF's `minFilter`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MipFilter {
+    /// Level 0 only (`NEAREST`, `LINEAR`).
+    None,
+    /// The nearest level (`*_MIPMAP_NEAREST`).
+    Nearest,
+    /// A blend of the two levels around the footprint (`*_MIPMAP_LINEAR`).
+    Linear,
+}
+
+/// A glTF sampler.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    pub wrap_s: Wrap,
+    pub wrap_t: Wrap,
+    pub mag: Filter,
+    pub min: Filter,
+    pub mip: MipFilter,
+}
+
+impl Default for Sampler {
+    /// glTF leaves absent filters to the implementation: sunshade takes LINEAR magnification and
+    /// LINEAR_MIPMAP_LINEAR (trilinear) minification, and REPEAT as the spec says.
+    fn default() -> Self {
+        Self {
+            wrap_s: Wrap::Repeat,
+            wrap_t: Wrap::Repeat,
+            mag: Filter::Linear,
+            min: Filter::Linear,
+            mip: MipFilter::Linear,
+        }
+    }
+}
+
+impl Sampler {
+    /// From glTF's codes (`None`: absent). Unknown codes are errors naming the code.
+    pub fn from_gl(mag: Option<u64>, min: Option<u64>, wrap_s: u64, wrap_t: u64) -> Result<Self, String> {
+        let wrap = |code: u64| match code {
+            10497 => Ok(Wrap::Repeat),
+            33648 => Ok(Wrap::MirroredRepeat),
+            33071 => Ok(Wrap::ClampToEdge),
+            other => Err(format!("wrap mode {other} is not a glTF wrap mode")),
+        };
+        let d = Sampler::default();
+        let mag = match mag {
+            None => d.mag,
+            Some(9728) => Filter::Nearest,
+            Some(9729) => Filter::Linear,
+            Some(other) => return Err(format!("magFilter {other} is not a glTF filter")),
+        };
+        let (min, mip) = match min {
+            None => (d.min, d.mip),
+            Some(9728) => (Filter::Nearest, MipFilter::None),
+            Some(9729) => (Filter::Linear, MipFilter::None),
+            Some(9984) => (Filter::Nearest, MipFilter::Nearest),
+            Some(9985) => (Filter::Linear, MipFilter::Nearest),
+            Some(9986) => (Filter::Nearest, MipFilter::Linear),
+            Some(9987) => (Filter::Linear, MipFilter::Linear),
+            Some(other) => return Err(format!("minFilter {other} is not a glTF filter")),
+        };
+        Ok(Self { wrap_s: wrap(wrap_s)?, wrap_t: wrap(wrap_t)?, mag, min, mip })
+    }
+}
+
+/// One level of a mip chain: `width × height` linear RGBA texels, row by row from the image's top row (glTF's
+/// UV (0, 0) is the top-left corner of the image).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Level {
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[f32; 4]>,
+}
+
+/// A texture: its mip chain (level 0 the image itself) and its sampler.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// For messages: the glTF texture and image.
+    pub name: String,
+    pub levels: Vec<Level>,
+    pub sampler: Sampler,
+}
+
+impl Texture {
+    /// A texture with its mip chain built from `level0` ([`mip_chain`]).
+    pub fn new(name: String, level0: Level, sampler: Sampler) -> Self {
+        Self { name, levels: mip_chain(level0), sampler }
+    }
+}
+
+/// A material's use of a texture: which one, which texture-coordinate set, and the affine map applied to the
+/// coordinates first (KHR_texture_transform; identity otherwise): `uv' = [m0 m1 m2; m3 m4 m5] (u, v, 1)`, computed
+/// in f64 from the extension's offset, rotation and scale and rounded once to f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into `Scene::textures`.
+    pub texture: usize,
+    /// TEXCOORD_n set (0 or 1).
+    pub tex_coord: u32,
+    pub transform: [f32; 6],
+}
+
+/// The identity transform of [`TextureRef::transform`].
+pub const IDENTITY_UV_TRANSFORM: [f32; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+/// KHR_texture_transform's matrix `T(offset) · R(rotation) · S(scale)`, with the extension's rotation convention
+/// (`R = [cos r, sin r; −sin r, cos r]`, counter-clockwise in UV space whose v axis points down).
+pub fn uv_transform(offset: [f64; 2], rotation: f64, scale: [f64; 2]) -> [f32; 6] {
+    let (s, c) = rotation.sin_cos();
+    [c * scale[0], s * scale[1], offset[0], -s * scale[0], c * scale[1], offset[1]].map(|x| x as f32)
+}
+
+/// Level sizes halve, rounding down, to 1 × 1 (Vulkan's rule: `max(1, ⌊N/2^k⌋)`).
+pub fn level_count(width: u32, height: u32) -> usize {
+    32 - width.max(height).max(1).leading_zeros() as usize
+}
+
+/// The mip chain: each level a box filter of the one above. A texel of the smaller level covers the interval
+/// `[i·N/M, (i+1)·N/M)` of the larger level's texels (N → M = max(1, ⌊N/2⌋) texels); each source texel weighs by
+/// the length of its overlap with that interval, divided by N/M. For even N that is the 2 × 2 average; for odd N
+/// it spreads over three texels, so no texel is dropped and every level keeps the image's mean. Computed
+/// separably in f64 (rows, then columns) from linear texels, rounded once to f32.
+pub fn mip_chain(level0: Level) -> Vec<Level> {
+    let count = level_count(level0.width, level0.height);
+    let mut levels = vec![level0];
+    while levels.len() < count {
+        let prev = levels.last().expect("level 0 is there");
+        let (w, h) = ((prev.width / 2).max(1), (prev.height / 2).max(1));
+        let across: Vec<[f64; 4]> = (0..prev.height)
+            .flat_map(|y| {
+                let row = &prev.texels[(y * prev.width) as usize..((y + 1) * prev.width) as usize];
+                (0..w).map(move |i| box_filter(prev.width, w, i, |s| row[s].map(f64::from)))
+            })
+            .collect();
+        let texels = (0..h)
+            .flat_map(|j| {
+                let across = &across;
+                (0..w).map(move |i| {
+                    box_filter(prev.height, h, j, |s| across[s * w as usize + i as usize]).map(|v| v as f32)
+                })
+            })
+            .collect();
+        levels.push(Level { width: w, height: h, texels });
+    }
+    levels
+}
+
+/// Texel `i` of `m` texels box-filtered from `n` (see [`mip_chain`]).
+fn box_filter(n: u32, m: u32, i: u32, texel: impl Fn(usize) -> [f64; 4]) -> [f64; 4] {
+    let scale = n as f64 / m as f64;
+    let (lo, hi) = (i as f64 * scale, (i + 1) as f64 * scale);
+    let mut sum = [0.0; 4];
+    for s in (lo.floor() as u32)..(hi.ceil() as u32).min(n) {
+        let overlap = (hi.min(s as f64 + 1.0) - lo.max(s as f64)).max(0.0);
+        let t = texel(s as usize);
+        for c in 0..4 {
+            sum[c] += overlap * t[c];
+        }
+    }
+    sum.map(|v| v / scale)
+}
+
+/// sRGB-encoded 8-bit value → linear (IEC 61966-2-1), in f64, rounded once to f32.
+pub fn srgb_to_linear(code: u8) -> f32 {
+    srgb_decode(code as f64 / 255.0) as f32
+}
+
+/// The sRGB transfer function's inverse on an encoded value in [0, 1].
+pub fn srgb_decode(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mip_chain_keeps_the_mean_and_halves_down_to_one() {
+        // A 5 × 3 ramp: sizes 5×3 → 2×1 → 1×1; every level's mean equals level 0's.
+        let texels: Vec<[f32; 4]> = (0..15).map(|i| [i as f32, 1.0, 0.5, 1.0]).collect();
+        let levels = mip_chain(Level { width: 5, height: 3, texels });
+        let sizes: Vec<(u32, u32)> = levels.iter().map(|l| (l.width, l.height)).collect();
+        assert_eq!(sizes, [(5, 3), (2, 1), (1, 1)]);
+        for l in &levels {
+            let mean = l.texels.iter().map(|t| t[0] as f64).sum::<f64>() / l.texels.len() as f64;
+            assert!((mean - 7.0).abs() < 1e-5, "{l:?}");
+            assert!(l.texels.iter().all(|t| t[1] == 1.0 && t[3] == 1.0));
+        }
+        // An even size is the 2 × 2 average.
+        let l = mip_chain(Level { width: 2, height: 2, texels: vec![[0.0; 4], [1.0; 4], [2.0; 4], [5.0; 4]] });
+        assert_eq!(l[1].texels, vec![[2.0; 4]]);
+        assert_eq!(level_count(1, 1), 1);
+        assert_eq!(level_count(1024, 3), 11);
+    }
+
+    #[test]
+    fn srgb_decoding_is_the_standard_curve() {
+        assert_eq!(srgb_to_linear(0), 0.0);
+        assert_eq!(srgb_to_linear(255), 1.0);
+        assert!((srgb_to_linear(10) as f64 - 10.0 / 255.0 / 12.92).abs() < 1e-9);
+        assert!((srgb_to_linear(128) - 0.2158605).abs() < 1e-6);
+    }
+
+    #[test]
+    fn samplers_from_gl_codes() {
+        let s = Sampler::from_gl(Some(9728), Some(9986), 33648, 33071).unwrap();
+        assert_eq!(
+            s,
+            Sampler {
+                wrap_s: Wrap::MirroredRepeat,
+                wrap_t: Wrap::ClampToEdge,
+                mag: Filter::Nearest,
+                min: Filter::Nearest,
+                mip: MipFilter::Linear
+            }
+        );
+        assert!(Sampler::from_gl(Some(1), None, 10497, 10497).unwrap_err().contains("magFilter 1"));
+        assert!(Sampler::from_gl(None, None, 5, 10497).is_err());
+    }
+
+    #[test]
+    fn texture_transform_rotates_counter_clockwise() {
+        // The extension's example: rotation by π/2 maps u = (1, 0) to (0, −1).
+        let m = uv_transform([0.0, 0.0], std::f64::consts::FRAC_PI_2, [1.0, 1.0]);
+        let (u, v) = (m[0] * 1.0 + m[2], m[3] * 1.0 + m[5]);
+        assert!(u.abs() < 1e-7 && (v + 1.0).abs() < 1e-7, "{u} {v}");
+        let m = uv_transform([0.5, 0.25], 0.0, [2.0, 3.0]);
+        assert_eq!(m, [2.0, 0.0, 0.5, 0.0, 3.0, 0.25]);
+    }
+}
