@@ -30,17 +30,68 @@ layout(constant_id = 1) const uint VARIANT_SUN = 0u;   // LIGHT_ABSENT, SUN_DISK
 layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EXACT or DISKS_SMALL_SOURCE
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
 layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
+layout(constant_id = 5) const uint VARIANT_SURFACE = 0u; // SURFACE_* bits: what the material needs per pixel
+
+// What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
+#define SURFACE_EVAL 1u
+#define SURFACE_NORMAL_MAP 2u
+#define SURFACE_EMISSION 4u
+#define SURFACE_ALPHA_MASK 8u
+#define SURFACE_COLORS 16u
+
+// Samplers (texture headers' bits: wrap_s | wrap_t << 2 | mag << 4 | min << 5 | mip << 6); values match
+// gpu::layout.
+#define WRAP_REPEAT 0u
+#define WRAP_MIRRORED_REPEAT 1u
+#define WRAP_CLAMP_TO_EDGE 2u
+#define FILTER_NEAREST 0u
+#define FILTER_LINEAR 1u
+#define MIP_NONE 0u
+#define MIP_NEAREST 1u
+#define MIP_LINEAR 2u
+// A material slot without a texture.
+#define NO_TEXTURE 0xffffffffu
+
+// Texture coordinates and footprints are computed in f64 where the device has it (the same barycentrics as the
+// reference's), else in f32.
+#ifdef SUNSHADE_F64_BARYCENTRICS
+#define REAL double
+#define REAL2 dvec2
+#define REAL3 dvec3
+#define REAL4 dvec4
+#else
+#define REAL float
+#define REAL2 vec2
+#define REAL3 vec3
+#define REAL4 vec4
+#endif
 
 // Disk lights with a shadow map of their own (`--shadows map`); the others stay unoccluded. Matches
 // gpu::layout::MAX_DISK_MAPS.
 #define MAX_DISK_MAPS 4u
+
+// A material's use of a texture: the texture-coordinate transform (KHR_texture_transform) rows, the texture and
+// its coordinate set.
+struct TextureRefGpu {
+    vec4 row0;     // xyz: m0 m1 m2 (u' = m0 u + m1 v + m2)
+    vec4 row1;     // xyz: m3 m4 m5
+    uvec4 texture; // x: texture index or NO_TEXTURE; y: TEXCOORD set
+};
 
 struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
     vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
     vec4 params; // x, y: Ward alpha_x, alpha_y
     uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided
+    vec4 base;   // base colour factor (rgb linear, alpha)
+    vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
+    vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
+    TextureRefGpu tex[4]; // TEX_BASE, TEX_METALLIC_ROUGHNESS, TEX_NORMAL, TEX_EMISSIVE
 };
+#define TEX_BASE 0
+#define TEX_METALLIC_ROUGHNESS 1
+#define TEX_NORMAL 2
+#define TEX_EMISSIVE 3
 
 struct SunGpu {
     vec4 direction;  // xyz: unit vector towards the sun (world); w: angular diameter [rad]
@@ -77,10 +128,28 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
     uint indices[];
 };
 
-// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space).
-#define FLOATS_PER_VERTEX 10u
+// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space),
+// TEXCOORD_0 uv, TEXCOORD_1 uv, COLOR_0 rgba; the offsets below (gpu::layout::Vertex).
+#define FLOATS_PER_VERTEX 18u
+#define VERTEX_POSITION 0u
+#define VERTEX_NORMAL 3u
+#define VERTEX_TANGENT 6u
+#define VERTEX_UV0 10u
+#define VERTEX_UV1 12u
+#define VERTEX_COLOR 14u
 layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
     float vertex_data[];
+};
+
+// Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with
+// texelFetch: a plain load of the stored floats, no filtering or conversion by the device). A uniform texel
+// buffer rather than a storage buffer, which lavapipe limits to 128 MiB.
+layout(set = 0, binding = 7) uniform samplerBuffer texels;
+
+// Texture t's header at texture_table[t]: (first level entry, level count, sampler bits, 0); a level entry:
+// (first texel in texels[], width, height, 0).
+layout(std430, set = 0, binding = 8) readonly buffer TextureTable {
+    uvec4 texture_table[];
 };
 
 // The sun's shadow map (depth, read texel by texel with texelFetch: no filtering by the device).

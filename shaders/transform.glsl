@@ -36,7 +36,7 @@ vec2 pixel_ndc(vec2 frag) {
 // rounds. Without it, the f32 version below loses up to ~1e-5 in the weights of thin triangles (measured on
 // lavapipe; docs/accuracy.md).
 #ifdef SUNSHADE_F64_BARYCENTRICS
-vec3 triangle_barycentrics(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
+dvec3 triangle_barycentrics_exact(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
     dvec2 n = dvec2(ndc);
     precise dvec2 d0 = dvec2(c0.xy) - n * double(c0.w);
     precise dvec2 d1 = dvec2(c1.xy) - n * double(c1.w);
@@ -46,12 +46,12 @@ vec3 triangle_barycentrics(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
     precise double b2 = d0.x * d1.y - d0.y * d1.x;
     precise double sum = b0 + b1 + b2;
     if (sum == 0.0) {
-        return vec3(1.0 / 3.0);
+        return dvec3(1.0 / 3.0);
     }
-    return vec3(dvec3(b0, b1, b2) / sum);
+    return dvec3(b0, b1, b2) / sum;
 }
 #else
-vec3 triangle_barycentrics(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
+vec3 triangle_barycentrics_exact(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
     precise vec2 d0 = c0.xy - ndc * c0.w;
     precise vec2 d1 = c1.xy - ndc * c1.w;
     precise vec2 d2 = c2.xy - ndc * c2.w;
@@ -66,5 +66,11 @@ vec3 triangle_barycentrics(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
     return l;
 }
 #endif
+
+// The barycentrics rounded to f32, for the f32 interpolation of position, normal and tangent. Texture
+// coordinates use triangle_barycentrics_exact (f64 where the device has it), as the reference does.
+vec3 triangle_barycentrics(vec4 c0, vec4 c1, vec4 c2, vec2 ndc) {
+    return vec3(triangle_barycentrics_exact(c0, c1, c2, ndc));
+}
 
 #endif

@@ -42,7 +42,25 @@ fn modules_depend_one_way() {
 
 /// Names of the functions defined in a GLSL file (a return type, a name, an opening parenthesis at line start).
 fn glsl_functions(text: &str) -> Vec<String> {
-    const TYPES: [&str; 10] = ["float", "vec2", "vec3", "vec4", "bool", "double", "dvec3", "uint", "int", "mat3"];
+    const TYPES: [&str; 17] = [
+        "float",
+        "vec2",
+        "vec3",
+        "vec4",
+        "bool",
+        "double",
+        "dvec3",
+        "uint",
+        "int",
+        "mat3",
+        "REAL",
+        "REAL2",
+        "REAL3",
+        "MaterialGpu",
+        "LevelChoice",
+        "SurfaceSample",
+        "uvec4",
+    ];
     text.lines()
         .filter_map(|line| {
             let mut words = line.split_whitespace();
@@ -57,7 +75,8 @@ fn glsl_functions(text: &str) -> Vec<String> {
 fn every_glsl_shading_function_has_a_rust_twin() {
     let rust: String = sources("src/shading").into_iter().map(|(_, t)| t).collect();
     let mut checked = 0;
-    for file in ["radiometry.glsl", "brdf.glsl", "shade.glsl", "visibility.glsl"] {
+    for file in ["radiometry.glsl", "brdf.glsl", "shade.glsl", "visibility.glsl", "surface.glsl", "texture_filter.glsl"]
+    {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders").join(file)).unwrap();
         for name in glsl_functions(&text) {
             assert!(
@@ -121,6 +140,8 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         ("brdf.glsl", "src/shading"),
         ("shade.glsl", "src/shading"),
         ("visibility.glsl", "src/shading"),
+        ("surface.glsl", "src/shading"),
+        ("texture_filter.glsl", "src/shading"),
         ("transform.glsl", "src/cpu"),
     ];
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
@@ -143,4 +164,10 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
             assert!(rust.contains(&format!("fn {f}(")), "shaders/{name}: `{f}` has no Rust function in {rust_dir}");
         }
     }
+}
+
+/// The reference carries every vertex attribute the GPU's vertex layout holds, in the same order.
+#[test]
+fn vertex_layout_matches_the_references_attributes() {
+    assert_eq!(sunshade::cpu::clip::ATTRIBUTES * 4, std::mem::size_of::<sunshade::gpu::layout::Vertex>());
 }

@@ -410,6 +410,7 @@ fn indexed_and_unindexed_give_bitwise_the_same_image() {
         indices: None,
         material: Some(mat),
         mode: None,
+        ..Default::default()
     };
     let m = b.add_mesh("sphere", &[prim]);
     let n = b.add_node(Node { mesh: Some(m), ..Default::default() });

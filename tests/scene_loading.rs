@@ -44,8 +44,18 @@ fn reads_materials_and_default_material() {
     assert!(!default.double_sided);
 }
 
+/// A 2 × 2 RGBA PNG.
+fn tiny_png() -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, 2, 2);
+    enc.set_color(png::ColorType::Rgba);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.write_header().unwrap().write_image_data(&[200; 16]).unwrap();
+    out
+}
+
 #[test]
-fn unmodelled_material_features_and_extensions_are_named_in_warnings() {
+fn material_features_not_drawn_are_named_in_warnings() {
     let dir = TempDir::new("unmodelled");
     let b = square_scene();
     let mut doc = b.document(Some("u.bin"));
@@ -54,44 +64,76 @@ fn unmodelled_material_features_and_extensions_are_named_in_warnings() {
     let plain = scene::load(&dir.path("plain.gltf")).unwrap();
     assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
 
-    // The image is never read: sunshade does not decode textures.
-    doc["images"] = json!([{ "uri": "never-read.png" }]);
+    // Textures, emission and its strength are drawn without a warning; BLEND (drawn opaque), the occlusion
+    // texture and a material extension sunshade does not draw are named.
+    std::fs::write(dir.path("t.png"), tiny_png()).unwrap();
+    doc["images"] = json!([{ "uri": "t.png" }]);
     doc["textures"] = json!([{ "source": 0 }]);
     doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
     doc["materials"][0]["normalTexture"] = json!({ "index": 0 });
+    doc["materials"][0]["occlusionTexture"] = json!({ "index": 0 });
     doc["materials"][0]["emissiveFactor"] = json!([1.0, 0.5, 0.0]);
     doc["materials"][0]["alphaMode"] = json!("BLEND");
-    doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
-    doc["materials"][0]["extensions"] = json!({ "KHR_materials_emissive_strength": { "emissiveStrength": 5.0 } });
+    doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength", "KHR_materials_clearcoat"]);
+    doc["materials"][0]["extensions"] = json!({
+        "KHR_materials_emissive_strength": { "emissiveStrength": 5.0 },
+        "KHR_materials_clearcoat": { "clearcoatFactor": 1.0 }
+    });
     std::fs::write(dir.path("u.gltf"), doc.to_string()).unwrap();
     let s = scene::load(&dir.path("u.gltf")).unwrap();
-    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
-    assert!(s.warnings[0].contains("KHR_materials_emissive_strength"), "{:?}", s.warnings);
+    assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
+    assert!(s.warnings[0].contains("KHR_materials_clearcoat"), "{:?}", s.warnings);
+    assert!(s.warnings[2].contains("reads TEXCOORD_0, which the primitive lacks"), "{:?}", s.warnings);
+    assert!(!s.warnings[0].contains("emissive_strength"), "{:?}", s.warnings);
     let w = &s.warnings[1];
-    for named in ["material 'grey'", "baseColorTexture", "normalTexture", "emissiveFactor", "alphaMode BLEND"] {
+    for named in ["material 'grey'", "occlusionTexture", "alphaMode BLEND", "KHR_materials_clearcoat"] {
         assert!(w.contains(named), "{named} missing from {w}");
     }
-    assert!(!w.contains("occlusionTexture") && !w.contains("metallicRoughnessTexture"), "{w}");
-    // The factors are still read.
-    assert_eq!(s.materials[0].brdf, Brdf::Lambert { albedo: [0.5, 0.4, 0.3] });
+    for drawn in ["baseColorTexture", "normalTexture", "emissive"] {
+        assert!(!w.contains(drawn), "{drawn} named as not drawn: {w}");
+    }
+    let m = &s.materials[0];
+    assert_eq!(m.brdf, Brdf::Lambert { albedo: [0.5, 0.4, 0.3] });
+    assert_eq!(m.emission, [5.0, 2.5, 0.0]);
+    assert!(m.base_color_texture.is_some() && m.normal_texture.is_some());
+    assert_eq!(s.textures.len(), 2, "one texture read as sRGB (base colour) and as linear (normals)");
 
-    // A required extension that only changes appearance sunshade does not draw yet is drawn, and the warning says
+    // A required extension that only changes appearance sunshade does not draw is drawn, and the warning says
     // the file requires it; one that changes geometry is refused, naming it.
-    doc["extensionsRequired"] = json!(["KHR_materials_emissive_strength"]);
+    doc["extensionsRequired"] = json!(["KHR_materials_clearcoat"]);
     std::fs::write(dir.path("required.gltf"), doc.to_string()).unwrap();
     let s = scene::load(&dir.path("required.gltf")).unwrap();
     assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.contains("requires KHR_materials_emissive_strength") && w.contains("drawn without it")),
+        s.warnings.iter().any(|w| w.contains("requires KHR_materials_clearcoat") && w.contains("drawn without it")),
         "{:?}",
         s.warnings
     );
-    doc["extensionsRequired"] = json!(["KHR_materials_emissive_strength", "KHR_draco_mesh_compression"]);
+    doc["extensionsRequired"] = json!(["KHR_materials_clearcoat", "KHR_draco_mesh_compression"]);
     std::fs::write(dir.path("draco.gltf"), doc.to_string()).unwrap();
     let e = load_err(&dir.path("draco.gltf"));
     assert!(e.contains("draco.gltf") && e.contains("KHR_draco_mesh_compression"), "{e}");
-    assert!(!e.contains("emissive_strength"), "an appearance-only extension is named as unsupported: {e}");
+    assert!(!e.contains("clearcoat"), "an appearance-only extension is named as unsupported: {e}");
+
+    // An image that cannot be read or decoded is an error naming it; a texture with only a WebP source is
+    // ignored with a warning naming the extension.
+    doc["extensionsRequired"] = json!([]);
+    doc["images"] = json!([{ "uri": "missing.png" }]);
+    std::fs::write(dir.path("missing.gltf"), doc.to_string()).unwrap();
+    let e = load_err(&dir.path("missing.gltf"));
+    assert!(e.contains("missing.png") && e.contains("image 0"), "{e}");
+    std::fs::write(dir.path("bad.png"), b"not a png").unwrap();
+    doc["images"] = json!([{ "uri": "bad.png" }]);
+    std::fs::write(dir.path("bad.gltf"), doc.to_string()).unwrap();
+    assert!(load_err(&dir.path("bad.gltf")).contains("not a PNG or JPEG"));
+    doc["textures"] = json!([{ "extensions": { "EXT_texture_webp": { "source": 0 } } }]);
+    std::fs::write(dir.path("webp.gltf"), doc.to_string()).unwrap();
+    let s = scene::load(&dir.path("webp.gltf")).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("EXT_texture_webp") && w.contains("texture ignored")),
+        "{:?}",
+        s.warnings
+    );
+    assert!(s.materials[0].base_color_texture.is_none());
 }
 
 #[test]

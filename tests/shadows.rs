@@ -25,10 +25,9 @@ const E_PERP: f32 = 1000.0;
 
 fn material(double_sided: bool) -> Material {
     Material {
-        name: "white".into(),
         double_sided,
-        brdf: Brdf::Lambert { albedo: [1.0; 3] },
         pbr: MetallicRoughness { base_color: [1.0; 3], metallic: 0.0, roughness: 1.0 },
+        ..Material::with_brdf("white", Brdf::Lambert { albedo: [1.0; 3] })
     }
 }
 
@@ -57,6 +56,7 @@ fn scene(parts: &[MeshData]) -> Scene {
                 .collect::<Vec<Vec4>>(),
             indices: m.indices.clone(),
             material: 0,
+            ..Default::default()
         })
         .collect();
     Scene { meshes, materials: vec![material(false)], ..Default::default() }

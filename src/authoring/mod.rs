@@ -38,6 +38,10 @@ pub struct Primitive {
     pub positions: Vec<[f32; 3]>,
     /// `None`: the file carries no NORMAL (the loader must make flat normals).
     pub normals: Option<Vec<[f32; 3]>>,
+    /// TEXCOORD_0 (f32), if any.
+    pub tex_coords: Option<Vec<[f32; 2]>>,
+    /// COLOR_0 (f32 RGBA), if any.
+    pub colors: Option<Vec<[f32; 4]>>,
     /// `None`: non-indexed.
     pub indices: Option<Indices>,
     pub material: Option<usize>,
@@ -69,6 +73,17 @@ pub struct Node {
     pub extras: Option<Value>,
 }
 
+/// An 8-bit RGBA PNG of `width × height` pixels, row by row from the top.
+pub fn png_rgba8(width: u32, height: u32, rgba: &[[u8; 4]]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width, height);
+    enc.set_color(png::ColorType::Rgba);
+    enc.set_depth(png::BitDepth::Eight);
+    let data: Vec<u8> = rgba.iter().flatten().copied().collect();
+    enc.write_header().and_then(|mut w| w.write_image_data(&data)).expect("PNG in memory");
+    out
+}
+
 /// A glTF document being built, with one binary buffer.
 #[derive(Clone, Debug)]
 pub struct GltfBuilder {
@@ -77,6 +92,9 @@ pub struct GltfBuilder {
     accessors: Vec<Value>,
     meshes: Vec<Value>,
     materials: Vec<Value>,
+    images: Vec<Value>,
+    textures: Vec<Value>,
+    samplers: Vec<Value>,
     nodes: Vec<Value>,
     cameras: Vec<Value>,
     lights: Vec<Value>,
@@ -97,6 +115,9 @@ impl GltfBuilder {
             accessors: Vec::new(),
             meshes: Vec::new(),
             materials: Vec::new(),
+            images: Vec::new(),
+            textures: Vec::new(),
+            samplers: Vec::new(),
             nodes: Vec::new(),
             cameras: Vec::new(),
             lights: Vec::new(),
@@ -137,6 +158,15 @@ impl GltfBuilder {
         self.accessors.len() - 1
     }
 
+    /// An accessor of f32 elements of `n` components (`"VEC2"`, `"VEC4"`...).
+    fn push_f32_accessor(&mut self, data: &[f32], n: usize, kind: &str) -> usize {
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.push_view(&bytes, Some(34962));
+        self.accessors
+            .push(json!({ "bufferView": view, "componentType": 5126, "count": data.len() / n, "type": kind }));
+        self.accessors.len() - 1
+    }
+
     fn push_index_accessor(&mut self, indices: &Indices) -> usize {
         let (bytes, component, count): (Vec<u8>, u32, usize) = match indices {
             Indices::U8(v) => (v.clone(), 5121, v.len()),
@@ -157,6 +187,14 @@ impl GltfBuilder {
             attributes.insert("POSITION".into(), json!(self.push_vec3_accessor(&p.positions, true)));
             if let Some(n) = &p.normals {
                 attributes.insert("NORMAL".into(), json!(self.push_vec3_accessor(n, false)));
+            }
+            if let Some(uv) = &p.tex_coords {
+                let flat: Vec<f32> = uv.iter().flatten().copied().collect();
+                attributes.insert("TEXCOORD_0".into(), json!(self.push_f32_accessor(&flat, 2, "VEC2")));
+            }
+            if let Some(c) = &p.colors {
+                let flat: Vec<f32> = c.iter().flatten().copied().collect();
+                attributes.insert("COLOR_0".into(), json!(self.push_f32_accessor(&flat, 4, "VEC4")));
             }
             let mut prim = json!({ "attributes": attributes });
             if let Some(i) = &p.indices {
@@ -188,6 +226,34 @@ impl GltfBuilder {
         }
         self.materials.push(m);
         self.materials.len() - 1
+    }
+
+    /// Adds a material given as its glTF JSON object; returns its index.
+    pub fn add_material_json(&mut self, material: Value) -> usize {
+        self.materials.push(material);
+        self.materials.len() - 1
+    }
+
+    /// Adds a PNG image stored in the binary buffer; returns its index.
+    pub fn add_png_image(&mut self, png: &[u8]) -> usize {
+        let view = self.push_view(png, None);
+        self.images.push(json!({ "bufferView": view, "mimeType": "image/png" }));
+        self.images.len() - 1
+    }
+
+    /// Adds a texture of an image with a sampler (glTF codes: `magFilter`, `minFilter`, `wrapS`, `wrapT`; `None`
+    /// leaves a code out); returns its index.
+    pub fn add_texture(&mut self, image: usize, mag: Option<u32>, min: Option<u32>, wrap: [u32; 2]) -> usize {
+        let mut sampler = json!({ "wrapS": wrap[0], "wrapT": wrap[1] });
+        if let Some(m) = mag {
+            sampler["magFilter"] = json!(m);
+        }
+        if let Some(m) = min {
+            sampler["minFilter"] = json!(m);
+        }
+        self.samplers.push(sampler);
+        self.textures.push(json!({ "source": image, "sampler": self.samplers.len() - 1 }));
+        self.textures.len() - 1
     }
 
     /// Adds a perspective camera (`yfov` [rad], `zfar = None` infinite); returns its index.
@@ -288,6 +354,11 @@ impl GltfBuilder {
         }
         if !self.cameras.is_empty() {
             doc["cameras"] = json!(self.cameras);
+        }
+        if !self.images.is_empty() {
+            doc["images"] = json!(self.images);
+            doc["textures"] = json!(self.textures);
+            doc["samplers"] = json!(self.samplers);
         }
         if !self.lights.is_empty() {
             doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);

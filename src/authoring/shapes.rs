@@ -21,6 +21,7 @@ impl MeshData {
             indices: Some(Indices::narrowest(&self.indices)),
             material,
             mode: None,
+            ..Default::default()
         }
     }
 

@@ -19,8 +19,16 @@ pub fn pixel_ndc(x: u32, y: u32, width: u32, height: u32) -> Vec2 {
     (2.0 * frag) / Vec2::new(width as f32, height as f32) - Vec2::ONE
 }
 
-/// Perspective-correct barycentrics (f64) of the point with NDC `ndc` in the triangle `c` (clip space).
+/// Perspective-correct barycentrics (f64) of the point with NDC `ndc` in the triangle `c` (clip space): the
+/// weights the reference interpolates every attribute with. (The device rounds them to f32 for position, normal
+/// and tangent, `triangle_barycentrics` in the shader, and keeps them in f64 for texture coordinates.)
 pub fn triangle_barycentrics(c: [Vec4; 3], ndc: Vec2) -> DVec3 {
+    triangle_barycentrics_exact(c, ndc)
+}
+
+/// The barycentrics in f64, as `triangle_barycentrics_exact` in the shader computes them where the device has
+/// shaderFloat64 (the same operations in the same order, so the same bits).
+pub fn triangle_barycentrics_exact(c: [Vec4; 3], ndc: Vec2) -> DVec3 {
     let (nx, ny) = (ndc.x as f64, ndc.y as f64);
     let d = c.map(|v| (v.x as f64 - nx * v.w as f64, v.y as f64 - ny * v.w as f64));
     let cross = |a: (f64, f64), b: (f64, f64)| a.0 * b.1 - a.1 * b.0;

@@ -19,8 +19,9 @@ use glam::{Vec3, Vec4};
 
 use super::viewport::Viewport;
 
-/// Number of f32 attributes carried per vertex: world position (3), normal (3), tangent (3) and handedness (1).
-pub const ATTRIBUTES: usize = 10;
+/// Number of f32 attributes carried per vertex: world position (3), normal (3), tangent (3) and handedness (1),
+/// TEXCOORD_0 (2), TEXCOORD_1 (2), COLOR_0 (4) (the layout of `gpu::layout::Vertex`).
+pub const ATTRIBUTES: usize = 18;
 
 /// A vertex after the vertex shader.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -179,7 +180,13 @@ mod tests {
 
     fn vertex(clip: Vec4, viewport: &Viewport) -> ClipVertex {
         let window = if clip_mask(clip) == 0 { viewport.window_from_vertex(clip) } else { Vec3::NAN };
-        ClipVertex { clip, window, attributes: [clip.x, clip.y, clip.z, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0] }
+        ClipVertex {
+            clip,
+            window,
+            attributes: [
+                clip.x, clip.y, clip.z, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0,
+            ],
+        }
     }
 
     fn collect(tri: [ClipVertex; 3], vp: &Viewport) -> Vec<[ClipVertex; 3]> {

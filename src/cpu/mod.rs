@@ -36,6 +36,10 @@ use crate::film::Image;
 use crate::scene::tangent::orthonormal_tangent;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::shading::surface::{
+    alpha_covers, base_color, emitted_radiance, perturbed_normal, surface_brdf, surface_flags, tangent_space_normal,
+    SurfaceSample, SURFACE_ALPHA_MASK, SURFACE_COLORS, SURFACE_EMISSION, SURFACE_EVAL, SURFACE_NORMAL_MAP,
+};
 use crate::shading::visibility::shadow_ray_origin;
 use crate::shading::{radiance_out, radiance_out_visible, safe_normalize, Occlusion, Shadowing, Shadows, SurfacePoint};
 use crate::visibility::{Bvh, ShadowChoice};
@@ -112,6 +116,8 @@ struct Prepared {
     /// The scene triangle's vertex attributes (world position, normal).
     attributes: [[f64; ATTRIBUTES]; 3],
     material: usize,
+    /// What the material needs evaluated per pixel (`SURFACE_*` bits of [`surface_flags`]).
+    surface: u32,
     /// Double-sided material seen from the back: the normal is reversed.
     flip_normal: bool,
 }
@@ -223,11 +229,14 @@ fn render_inner(
             let mut visible = vec![u32::MAX; pixels.len()];
             for &ti in bin {
                 let t = &triangles[ti as usize];
+                let masked = t.surface & SURFACE_ALPHA_MASK != 0;
                 t.raster.for_each_covered(y0, y0 + rows, |x, y| {
                     let l = t.depth.barycentrics(x, y);
                     let z = t.depth.depth(&l);
                     let k = ((y - y0) * width + x) as usize;
-                    if z < depth[k] {
+                    // An alpha-masked fragment below its cutoff is discarded before the depth write, as on the
+                    // device.
+                    if z < depth[k] && (!masked || covers(scene, settings, t, x, y)) {
                         depth[k] = z;
                         visible[k] = ti;
                     }
@@ -243,13 +252,13 @@ fn render_inner(
                 let radiance = match (occluders, fragile) {
                     (Some(bvh), true) => {
                         let rec = Recording { bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
-                        let r = shade(scene, settings, t, w.to_array(), viewer, Some(&rec));
+                        let r = shade(scene, settings, t, (x, y), w.to_array(), viewer, Some(&rec));
                         if rec.fragile.load(std::sync::atomic::Ordering::Relaxed) {
                             flagged[k] = true;
                         }
                         r
                     }
-                    (o, _) => shade(scene, settings, t, w.to_array(), viewer, o.map(|b| b as &dyn Occlusion)),
+                    (o, _) => shade(scene, settings, t, (x, y), w.to_array(), viewer, o.map(|b| b as &dyn Occlusion)),
                 };
                 pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
             }
@@ -292,13 +301,18 @@ fn prepare(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions)
     let mut out = Vec::new();
     for mesh in &scene.meshes {
         let material = &scene.materials[mesh.material];
+        let surface = surface_flags(material, !mesh.colors.is_empty());
         // The vertex shader, once per vertex.
         let vertices: Vec<ClipVertex> = (0..mesh.positions.len())
             .map(|i| {
                 let (p, n, t) = (mesh.positions[i], mesh.normals[i], mesh.tangents[i]);
+                let uv = |set: usize| mesh.tex_coords[set].get(i).copied().unwrap_or([0.0; 2]);
+                let ([u0, v0], [u1, v1]) = (uv(0), uv(1));
+                let [r, g, b, a] = mesh.colors.get(i).copied().unwrap_or([1.0; 4]);
                 let clip = clip_position(&m, p);
                 let window = if clip_mask(clip) == 0 { viewport.window_from_vertex(clip) } else { Vec3::NAN };
-                ClipVertex { clip, window, attributes: [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, t.z, t.w] }
+                let attributes = [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, t.z, t.w, u0, v0, u1, v1, r, g, b, a];
+                ClipVertex { clip, window, attributes }
             })
             .collect();
         for tri in mesh.indices.chunks_exact(3) {
@@ -325,6 +339,7 @@ fn prepare(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions)
                     raster,
                     depth,
                     material: mesh.material,
+                    surface,
                 });
             });
         }
@@ -332,11 +347,34 @@ fn prepare(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions)
     out
 }
 
+/// The pixel's surface inputs ([`SurfaceSample`]): each set's texture coordinates at the pixel centre and at
+/// its right and lower neighbours, and the vertex colour, interpolated in f64 with the fragment shader's
+/// barycentrics (rounded to f32 for the colour), as `shaders/scene.frag` does.
+fn surface_sample(settings: &RenderSettings, t: &Prepared, x: u32, y: u32) -> SurfaceSample {
+    let (width, height) = (settings.width, settings.height);
+    let at = |w: DVec3, k: usize| w.x * t.attributes[0][k] + w.y * t.attributes[1][k] + w.z * t.attributes[2][k];
+    let centre = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, height));
+    let right = triangle_barycentrics(t.clip, pixel_ndc(x + 1, y, width, height));
+    let below = triangle_barycentrics(t.clip, pixel_ndc(x, y + 1, width, height));
+    let uvs = |w: DVec3| [[at(w, 10), at(w, 11)], [at(w, 12), at(w, 13)]];
+    let color = (t.surface & SURFACE_COLORS != 0).then(|| [14, 15, 16, 17].map(|k| at(centre, k) as f32));
+    SurfaceSample { uv: uvs(centre), uv_x: uvs(right), uv_y: uvs(below), color }
+}
+
+/// Whether an alpha-masked triangle covers pixel (x, y): its base colour's alpha against the cutoff.
+fn covers(scene: &Scene, settings: &RenderSettings, t: &Prepared, x: u32, y: u32) -> bool {
+    let material = &scene.materials[t.material];
+    let s = surface_sample(settings, t, x, y);
+    alpha_covers(material, base_color(material, &scene.textures, &s)[3])
+}
+
 /// Radiance at the point of triangle `t` with barycentrics `w`.
+#[allow(clippy::too_many_arguments)]
 fn shade(
     scene: &Scene,
     settings: &RenderSettings,
     t: &Prepared,
+    (x, y): (u32, u32),
     w: [f64; 3],
     viewer: glam::Vec4,
     occluders: Option<&dyn Occlusion>,
@@ -359,10 +397,33 @@ fn shade(
     } else {
         viewer.truncate().as_dvec3()
     };
-    let point = SurfacePoint { position, normal, tangent, bitangent, to_viewer };
     let material = &scene.materials[t.material];
+    let mut point = SurfacePoint { position, normal, tangent, bitangent, to_viewer };
+    // The material at this pixel (textures, vertex colours, normal map, emission), as scene.frag evaluates it.
+    let mut brdf = std::borrow::Cow::Borrowed(&material.brdf);
+    let mut emission = [0.0f64; 3];
+    if t.surface != 0 {
+        let s = surface_sample(settings, t, x, y);
+        let textures = &scene.textures;
+        if t.surface & SURFACE_EVAL != 0 {
+            brdf = std::borrow::Cow::Owned(surface_brdf(material, textures, &s, base_color(material, textures, &s)));
+        }
+        if let (Some((r, scale)), true) = (&material.normal_texture, t.surface & SURFACE_NORMAL_MAP != 0) {
+            // Back faces of double-sided materials turn the whole frame (the normal and bitangent already are).
+            let tn = tangent_space_normal(textures, r, *scale, &s);
+            let t_side = if t.flip_normal { -tangent } else { tangent };
+            point.normal = perturbed_normal(tn, t_side, bitangent, normal);
+            point.tangent = orthonormal_tangent(DVec3::new(a[6], a[7], a[8]), point.normal);
+            point.bitangent = handedness * point.normal.cross(point.tangent);
+        }
+        if t.surface & SURFACE_EMISSION != 0 {
+            emission = emitted_radiance(material, textures, &s).map(f64::from);
+        }
+    }
+    let emits = t.surface & SURFACE_EMISSION != 0;
+    let add_emission = |r: [f64; 3]| if emits { [0, 1, 2].map(|c| r[c] + emission[c]) } else { r };
     let Some(occluders) = occluders else {
-        return radiance_out(material, &point, &settings.lights, &settings.shading);
+        return add_emission(radiance_out(&brdf, &point, &settings.lights, &settings.shading));
     };
     // The shadow rays' origin from the triangle's corners and vertex normals (on the side being shaded).
     let corner = |k: usize| DVec3::new(t.attributes[k][0], t.attributes[k][1], t.attributes[k][2]);
@@ -376,5 +437,5 @@ fn shade(
         occluders,
         samples_per_axis: settings.shading.shadow_samples_per_axis,
     };
-    radiance_out_visible(material, &point, &settings.lights, &settings.shading, Some(&shadow))
+    add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &settings.shading, Some(&shadow)))
 }

@@ -25,6 +25,10 @@ pub struct DeviceInfo {
     /// Size of the largest device-local heap [bytes].
     pub device_local_heap_bytes: u64,
     pub max_push_constants_size: u32,
+    /// `maxStorageBufferRange` [bytes]: the most one storage-buffer binding shows a shader (vertices, texels).
+    pub max_storage_buffer_range: u32,
+    /// `maxTexelBufferElements`: the most texels one texel buffer holds (the textures' texels).
+    pub max_texel_buffer_elements: u32,
     /// `shaderFloat64`: the fragment shader then computes its barycentrics in f64.
     pub shader_float64: bool,
     pub framebuffer_color_sample_counts: vk::SampleCountFlags,
@@ -157,6 +161,8 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
             max_memory_allocation_size: maint3.max_memory_allocation_size,
             device_local_heap_bytes,
             max_push_constants_size: limits.max_push_constants_size,
+            max_storage_buffer_range: limits.max_storage_buffer_range,
+            max_texel_buffer_elements: limits.max_texel_buffer_elements,
             shader_float64,
             framebuffer_color_sample_counts: limits.framebuffer_color_sample_counts,
             graphics_queue_family,

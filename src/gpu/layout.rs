@@ -2,7 +2,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::scene::{Brdf, Lights, Material};
+use crate::scene::texture::{Filter, MipFilter, Wrap};
+use crate::scene::{AlphaMode, Brdf, Lights, Material, Scene, TextureRef};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadingOptions, ShadowMapFilter, SunModel};
 use crate::visibility::shadow_map::{DiskMapFrame, SunMapFrame};
@@ -22,6 +23,16 @@ pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
 /// Disk lights with a shadow map of their own (`MAX_DISK_MAPS` in the shaders).
 pub const MAX_DISK_MAPS: usize = 4;
+pub const WRAP_REPEAT: u32 = 0;
+pub const WRAP_MIRRORED_REPEAT: u32 = 1;
+pub const WRAP_CLAMP_TO_EDGE: u32 = 2;
+pub const FILTER_NEAREST: u32 = 0;
+pub const FILTER_LINEAR: u32 = 1;
+pub const MIP_NONE: u32 = 0;
+pub const MIP_NEAREST: u32 = 1;
+pub const MIP_LINEAR: u32 = 2;
+/// A material slot without a texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
 /// `shaders/bindings.glsl`, constant ids 0 to 4). The shader keeps only the code these select; `shadows` also
@@ -38,11 +49,13 @@ pub struct ShaderVariant {
     pub sky: u32,
     /// `SHADOWS_NONE`, `SHADOWS_RAY` or `SHADOWS_MAP`.
     pub shadows: u32,
+    /// `shading::surface::SURFACE_*` bits of the draw's material (0: untextured, opaque, not emissive).
+    pub surface: u32,
 }
 
 impl ShaderVariant {
     /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights.
-    pub fn new(brdf: u32, lights: &Lights, shading: &ShadingOptions, shadows: u32) -> Self {
+    pub fn new(brdf: u32, surface: u32, lights: &Lights, shading: &ShadingOptions, shadows: u32) -> Self {
         let sun = match (&lights.sun, shading.sun) {
             (None, _) => LIGHT_ABSENT,
             (Some(_), SunModel::Disk) => SUN_DISK,
@@ -54,23 +67,37 @@ impl ShaderVariant {
             (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
         };
         let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
-        Self { brdf, sun, disks, sky, shadows }
+        Self { brdf, sun, disks, sky, shadows, surface }
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 5] {
-        [self.brdf, self.sun, self.disks, self.sky, self.shadows]
+    pub fn constants(&self) -> [u32; 6] {
+        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface]
     }
 }
 
-/// One vertex: world position [m], unit normal, unit tangent and handedness, interleaved
-/// (`FLOATS_PER_VERTEX` = 10 floats in the shaders).
+/// One vertex: world position [m], unit normal, unit tangent and handedness, TEXCOORD_0, TEXCOORD_1 and COLOR_0
+/// (white where the mesh has none), interleaved (`FLOATS_PER_VERTEX` = 18 floats and the `VERTEX_*` offsets in
+/// the shaders; `cpu::clip::ATTRIBUTES` in the reference).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub tangent: [f32; 4],
+    pub uv0: [f32; 2],
+    pub uv1: [f32; 2],
+    pub color: [f32; 4],
+}
+
+/// A material's use of a texture (`TextureRefGpu`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TextureRefGpu {
+    pub row0: [f32; 4],
+    pub row1: [f32; 4],
+    /// Texture index (`NO_TEXTURE` for none), TEXCOORD set.
+    pub texture: [u32; 4],
 }
 
 #[repr(C)]
@@ -80,6 +107,14 @@ pub struct MaterialGpu {
     pub ks: [f32; 4],
     pub params: [f32; 4],
     pub kind: [u32; 4],
+    /// Base colour factor (rgb, alpha).
+    pub base: [f32; 4],
+    /// Metallic and roughness factors, normal-map scale, alpha cutoff.
+    pub pbr: [f32; 4],
+    /// Emitted radiance [W/(m²·sr)] before the emissive texture.
+    pub emission: [f32; 4],
+    /// Base colour, metallic-roughness, normal, emissive.
+    pub tex: [TextureRefGpu; 4],
 }
 
 #[repr(C)]
@@ -138,12 +173,75 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
         Brdf::BlinnPhong { exponent, .. } => (BRDF_BLINN_PHONG, exponent, [0.0, 0.0]),
         Brdf::Ward { alpha_x, alpha_y, .. } => (BRDF_WARD, 0.0, [alpha_x, alpha_y]),
     };
+    let slot = |r: Option<&TextureRef>| match r {
+        Some(r) => {
+            let t = r.transform;
+            TextureRefGpu {
+                row0: [t[0], t[1], t[2], 0.0],
+                row1: [t[3], t[4], t[5], 0.0],
+                texture: [r.texture as u32, r.tex_coord, 0, 0],
+            }
+        }
+        None => TextureRefGpu { row0: [0.0; 4], row1: [0.0; 4], texture: [NO_TEXTURE, 0, 0, 0] },
+    };
+    let cutoff = match m.alpha {
+        AlphaMode::Mask(c) => c,
+        AlphaMode::Opaque | AlphaMode::Blend => 0.0,
+    };
+    let b = m.pbr.base_color;
     MaterialGpu {
         kd: [kd[0], kd[1], kd[2], 0.0],
         ks: [ks[0], ks[1], ks[2], exponent],
         params: [alpha[0], alpha[1], 0.0, 0.0],
         kind: [kind, m.double_sided as u32, 0, 0],
+        base: [b[0], b[1], b[2], m.base_alpha],
+        pbr: [m.pbr.metallic, m.pbr.roughness, m.normal_texture.map_or(1.0, |(_, s)| s), cutoff],
+        emission: [m.emission[0], m.emission[1], m.emission[2], 0.0],
+        tex: [
+            slot(m.base_color_texture.as_ref()),
+            slot(m.metallic_roughness_texture.as_ref()),
+            slot(m.normal_texture.as_ref().map(|(t, _)| t)),
+            slot(m.emissive_texture.as_ref()),
+        ],
     }
+}
+
+/// The texel buffer (every texture's levels, linear RGBA f32) and the texture table (`TextureTable` in the
+/// shaders: a header per texture, then a record per level). Both at least one element long, so that a scene
+/// without textures binds valid buffers.
+pub fn texture_buffers(scene: &Scene) -> (Vec<[f32; 4]>, Vec<[u32; 4]>) {
+    let mut texels: Vec<[f32; 4]> = Vec::new();
+    let mut table: Vec<[u32; 4]> = vec![[0; 4]; scene.textures.len()];
+    for (t, texture) in scene.textures.iter().enumerate() {
+        let s = texture.sampler;
+        let wrap = |w: Wrap| match w {
+            Wrap::Repeat => WRAP_REPEAT,
+            Wrap::MirroredRepeat => WRAP_MIRRORED_REPEAT,
+            Wrap::ClampToEdge => WRAP_CLAMP_TO_EDGE,
+        };
+        let filter = |f: Filter| match f {
+            Filter::Nearest => FILTER_NEAREST,
+            Filter::Linear => FILTER_LINEAR,
+        };
+        let mip = match s.mip {
+            MipFilter::None => MIP_NONE,
+            MipFilter::Nearest => MIP_NEAREST,
+            MipFilter::Linear => MIP_LINEAR,
+        };
+        let bits = wrap(s.wrap_s) | wrap(s.wrap_t) << 2 | filter(s.mag) << 4 | filter(s.min) << 5 | mip << 6;
+        table[t] = [table.len() as u32, texture.levels.len() as u32, bits, 0];
+        for level in &texture.levels {
+            table.push([texels.len() as u32, level.width, level.height, 0]);
+            texels.extend_from_slice(&level.texels);
+        }
+    }
+    if texels.is_empty() {
+        texels.push([0.0; 4]);
+    }
+    if table.is_empty() {
+        table.push([0; 4]);
+    }
+    (texels, table)
 }
 
 /// The light buffer's bytes.
@@ -232,13 +330,41 @@ mod tests {
             ("SHADOWS_NONE", SHADOWS_NONE),
             ("SHADOWS_RAY", SHADOWS_RAY),
             ("SHADOWS_MAP", SHADOWS_MAP),
+            ("WRAP_REPEAT", WRAP_REPEAT),
+            ("WRAP_MIRRORED_REPEAT", WRAP_MIRRORED_REPEAT),
+            ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),
+            ("FILTER_NEAREST", FILTER_NEAREST),
+            ("FILTER_LINEAR", FILTER_LINEAR),
+            ("MIP_NONE", MIP_NONE),
+            ("MIP_NEAREST", MIP_NEAREST),
+            ("MIP_LINEAR", MIP_LINEAR),
+            ("SURFACE_EVAL", crate::shading::surface::SURFACE_EVAL),
+            ("SURFACE_NORMAL_MAP", crate::shading::surface::SURFACE_NORMAL_MAP),
+            ("SURFACE_EMISSION", crate::shading::surface::SURFACE_EMISSION),
+            ("SURFACE_ALPHA_MASK", crate::shading::surface::SURFACE_ALPHA_MASK),
+            ("SURFACE_COLORS", crate::shading::surface::SURFACE_COLORS),
         ];
         for (name, value) in constants {
             assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
         }
         assert!(glsl.contains(&format!("#define MAX_DISK_MAPS {MAX_DISK_MAPS}u\n")));
+        assert!(glsl.contains("#define NO_TEXTURE 0xffffffffu\n"));
+        // The vertex layout: FLOATS_PER_VERTEX and each attribute's offset in floats.
+        assert!(glsl.contains(&format!("#define FLOATS_PER_VERTEX {}u\n", std::mem::size_of::<Vertex>() / 4)));
+        for (name, offset) in [
+            ("VERTEX_POSITION", std::mem::offset_of!(Vertex, position)),
+            ("VERTEX_NORMAL", std::mem::offset_of!(Vertex, normal)),
+            ("VERTEX_TANGENT", std::mem::offset_of!(Vertex, tangent)),
+            ("VERTEX_UV0", std::mem::offset_of!(Vertex, uv0)),
+            ("VERTEX_UV1", std::mem::offset_of!(Vertex, uv1)),
+            ("VERTEX_COLOR", std::mem::offset_of!(Vertex, color)),
+        ] {
+            assert!(glsl.contains(&format!("#define {name} {}u\n", offset / 4)), "bindings.glsl: {name}");
+        }
         for (id, name) in
-            ["VARIANT_BRDF", "VARIANT_SUN", "VARIANT_DISKS", "VARIANT_SKY", "VARIANT_SHADOWS"].iter().enumerate()
+            ["VARIANT_BRDF", "VARIANT_SUN", "VARIANT_DISKS", "VARIANT_SKY", "VARIANT_SHADOWS", "VARIANT_SURFACE"]
+                .iter()
+                .enumerate()
         {
             assert!(
                 glsl.contains(&format!("layout(constant_id = {id}) const uint {name} ")),
@@ -249,7 +375,9 @@ mod tests {
 
     #[test]
     fn sizes_match_std430() {
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 64);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 304);
+        assert_eq!(std::mem::offset_of!(MaterialGpu, tex), 112);
+        assert_eq!(std::mem::size_of::<TextureRefGpu>(), 48);
         assert_eq!(std::mem::size_of::<LightsHeader>(), 480);
         assert_eq!(std::mem::offset_of!(LightsHeader, disk_map_from_world), 160);
         assert_eq!(std::mem::offset_of!(LightsHeader, disk_map), 416);
@@ -258,6 +386,6 @@ mod tests {
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
         assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
-        assert_eq!(std::mem::size_of::<Vertex>(), 40);
+        assert_eq!(std::mem::size_of::<Vertex>(), 72);
     }
 }

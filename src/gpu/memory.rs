@@ -72,6 +72,38 @@ impl Buffer {
     }
 }
 
+/// A host-visible buffer of RGBA32F texels read through a buffer view (a uniform texel buffer: `texelFetch`
+/// returns a texel's four floats as stored, with no filtering or conversion), for data larger than
+/// `maxStorageBufferRange` allows in a storage buffer.
+pub(crate) struct TexelBuffer {
+    pub view: vk::BufferView,
+    pub buffer: Buffer,
+}
+
+impl TexelBuffer {
+    pub fn with_texels(dev: &Arc<Device>, texels: &[[f32; 4]], name: &str) -> Result<Self, GpuError> {
+        let buffer =
+            Buffer::with_data(dev, bytemuck::cast_slice(texels), vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, name)?;
+        let info = vk::BufferViewCreateInfo::default()
+            .buffer(buffer.buffer)
+            .format(vk::Format::R32G32B32A32_SFLOAT)
+            .offset(0)
+            .range(vk::WHOLE_SIZE);
+        // SAFETY: valid device and buffer created with UNIFORM_TEXEL_BUFFER usage.
+        let view = unsafe { dev.device.create_buffer_view(&info, None) }.vk("vkCreateBufferView")?;
+        Ok(Self { view, buffer })
+    }
+}
+
+impl Drop for TexelBuffer {
+    fn drop(&mut self) {
+        // SAFETY: the GPU is done with the view (renders wait on a fence); the buffer is dropped after it.
+        unsafe {
+            self.buffer.dev.device.destroy_buffer_view(self.view, None);
+        }
+    }
+}
+
 impl Drop for Buffer {
     fn drop(&mut self) {
         // SAFETY: the caller waited for the GPU to finish with this buffer (renders wait on a fence).

@@ -71,7 +71,8 @@ impl ScenePipeline {
         unsafe {
             // 0 materials, 1 lights, 2 indices, 3 vertices: all read by the fragment shader; 4 the scene's top-level
             // acceleration structure, on devices with ray queries.
-            let mut bindings: Vec<_> = [0, 1, 2, 3]
+            // 8 the texture table (texture_filter.glsl).
+            let mut bindings: Vec<_> = [0, 1, 2, 3, 8]
                 .map(|b| {
                     vk::DescriptorSetLayoutBinding::default()
                         .binding(b)
@@ -80,6 +81,15 @@ impl ScenePipeline {
                         .stage_flags(vk::ShaderStageFlags::FRAGMENT)
                 })
                 .to_vec();
+            // 7: the texels (a uniform texel buffer: maxStorageBufferRange is 128 MiB on lavapipe, a texel buffer
+            // holds maxTexelBufferElements texels).
+            bindings.push(
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(7)
+                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+            );
             // 5: the sun's shadow map, 6: the first disks' (always bound: 1 × 1 maps until a shadow pass ran).
             for (binding, count) in [(5, 1), (6, MAX_DISK_MAPS as u32)] {
                 bindings.push(
@@ -113,8 +123,14 @@ impl ScenePipeline {
                     None,
                 )
                 .vk("vkCreatePipelineLayout")?;
-            let mut pool_sizes =
-                vec![vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 4 }];
+            let mut pool_sizes = vec![
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 5 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_TEXEL_BUFFER, descriptor_count: 1 },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    descriptor_count: 1 + MAX_DISK_MAPS as u32,
+                },
+            ];
             if ray_query_spirv.is_some() {
                 pool_sizes.push(vk::DescriptorPoolSize {
                     ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
@@ -233,7 +249,7 @@ unsafe fn create_pipeline(
     unsafe {
         // `None`: the shadow map's depth-only pipeline (no fragment stage, no colour attachment).
         let depth_only = variant.is_none();
-        let constants = variant.map_or([0; 5], |v| v.constants());
+        let constants = variant.map_or([0; 6], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();

@@ -12,19 +12,21 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, push_constants, PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_MAP,
-    SHADOWS_NONE, SHADOWS_RAY,
+    lights_bytes, material_gpu, push_constants, texture_buffers, MaterialGpu, PushConstants, ShaderVariant, Vertex,
+    MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
-use super::memory::{image_barrier, Buffer, Image2d};
+use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
 use super::shadow_map::DepthMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::shading::surface::surface_flags;
 use crate::shading::Shadows;
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
+use bytemuck::Zeroable;
 
 /// Wall-clock time of the set-up phases [s].
 #[derive(Clone, Copy, Debug, Default)]
@@ -55,6 +57,9 @@ pub struct GpuScene {
     vertices: Option<Buffer>,
     indices: Option<Buffer>,
     materials: Buffer,
+    /// Every texture's levels as linear RGBA f32, and the texture table (headers and level records).
+    texels: TexelBuffer,
+    texture_table: Buffer,
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
@@ -76,6 +81,8 @@ struct Draw {
     material: u32,
     /// The material's `BRDF_*` kind: which pipeline variant draws it.
     brdf: u32,
+    /// What the material needs per pixel (`shading::surface::SURFACE_*`), also a variant constant.
+    surface: u32,
     double_sided: bool,
 }
 
@@ -265,19 +272,56 @@ impl Renderer {
                 vertex_offset,
                 material: mesh.material as u32,
                 brdf: materials[mesh.material].kind[0],
+                surface: surface_flags(&scene.materials[mesh.material], !mesh.colors.is_empty()),
                 double_sided: scene.materials[mesh.material].double_sided,
             });
             if rq {
                 global_indices.extend(mesh.indices.iter().map(|&i| i + vertex_offset as u32));
             }
+            let uv = |set: usize, i: usize| mesh.tex_coords[set].get(i).copied().unwrap_or([0.0; 2]);
             vertices.extend((0..mesh.positions.len()).map(|i| Vertex {
                 position: mesh.positions[i].to_array(),
                 normal: mesh.normals[i].to_array(),
                 tangent: mesh.tangents[i].to_array(),
+                uv0: uv(0, i),
+                uv1: uv(1, i),
+                color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
             }));
             indices.extend_from_slice(&mesh.indices);
         }
-        let materials_bytes: &[u8] = if materials.is_empty() { &[0; 64] } else { bytemuck::cast_slice(&materials) };
+        let no_material = [MaterialGpu::zeroed()];
+        let materials_bytes: &[u8] = bytemuck::cast_slice(if materials.is_empty() { &no_material } else { &materials });
+        let (texels, texture_table) = texture_buffers(scene);
+        let limit = self.dev.info.max_storage_buffer_range as u64;
+        let vertex_bytes = std::mem::size_of_val(&vertices[..]) as u64;
+        if vertex_bytes > limit {
+            return Err(GpuError::TooLarge(format!(
+                "the scene's {} vertices take {:.1} MiB; {} binds at most {:.1} MiB in one storage buffer",
+                vertices.len(),
+                vertex_bytes as f64 / (1 << 20) as f64,
+                self.dev.info.name,
+                limit as f64 / (1 << 20) as f64
+            )));
+        }
+        let texel_limit = self.dev.info.max_texel_buffer_elements as usize;
+        let texel_bytes = std::mem::size_of_val(&texels[..]) as u64;
+        if texels.len() > texel_limit || texel_bytes > self.dev.info.max_memory_allocation_size {
+            return Err(GpuError::TooLarge(format!(
+                "the scene's textures and their mip levels are {} texels ({:.1} MiB as f32 RGBA); {} reads at most \
+                 {texel_limit} from one texel buffer in one allocation of {:.1} MiB",
+                texels.len(),
+                texel_bytes as f64 / (1 << 20) as f64,
+                self.dev.info.name,
+                self.dev.info.max_memory_allocation_size as f64 / (1 << 20) as f64
+            )));
+        }
+        let texels = TexelBuffer::with_texels(&self.dev, &texels, "texels")?;
+        let texture_table = Buffer::with_data(
+            &self.dev,
+            bytemuck::cast_slice(&texture_table),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            "texture table",
+        )?;
         // With ray queries the vertex buffer is also the acceleration structure's build input.
         let accel_usage = if rq {
             vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
@@ -325,6 +369,8 @@ impl Renderer {
                 vk::BufferUsageFlags::STORAGE_BUFFER,
                 "materials",
             )?,
+            texels,
+            texture_table,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
             // ray queries warns that `auto` has no shadows for this scene.
@@ -427,7 +473,7 @@ impl Renderer {
         let t_pipelines = Instant::now();
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
         for draw in &scene.draws {
-            let variant = ShaderVariant::new(draw.brdf, &settings.lights, &settings.shading, shadows);
+            let variant = ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &settings.shading, shadows);
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
@@ -502,21 +548,35 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                let buffers = [scene.materials.buffer, lights.buffer, ib.buffer, vb.buffer];
-                let infos =
-                    buffers.map(|buffer| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]);
+                // 8 the texture table.
+                let buffers = [
+                    (0, scene.materials.buffer),
+                    (1, lights.buffer),
+                    (2, ib.buffer),
+                    (3, vb.buffer),
+                    (8, scene.texture_table.buffer),
+                ];
+                let infos = buffers
+                    .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]));
                 let writes: Vec<_> = infos
                     .iter()
-                    .enumerate()
                     .map(|(b, info)| {
                         vk::WriteDescriptorSet::default()
                             .dst_set(self.pipeline.descriptor_set)
-                            .dst_binding(b as u32)
+                            .dst_binding(*b)
                             .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
                             .buffer_info(info)
                     })
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
+                // 7: the texels, a uniform texel buffer.
+                let views = [scene.texels.view];
+                let write = vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(7)
+                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                    .texel_buffer_view(&views);
+                d.update_descriptor_sets(&[write], &[]);
             }
             // Binding 5: the sun's shadow map, 6: the first disks' (valid images in every frame; read only by
             // SHADOWS_MAP pipelines).

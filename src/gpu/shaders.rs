@@ -15,6 +15,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
     ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),
+    ("texture_filter.glsl", include_str!("../../shaders/texture_filter.glsl")),
+    ("surface.glsl", include_str!("../../shaders/surface.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),
 ];

@@ -57,11 +57,10 @@ impl<'a> MaterialReader<'a> {
         let mut ignored = Vec::new();
         let mut texture = |info: &Option<TextureInfo>, slot: &str, space: ColorSpace, this: &mut Self| {
             let Some(info) = info else { return Ok(None) };
-            this.texture_ref(info, space, &format!("{name} {slot}")).map(|t| {
+            this.texture_ref(info, space, &format!("{name} {slot}")).inspect(|t| {
                 if t.is_none() {
                     ignored.push(slot.to_string());
                 }
-                t
             })
         };
         let base_color_texture = texture(&pbr.base_color_texture, "baseColorTexture", ColorSpace::Srgb, self)?;

@@ -115,17 +115,7 @@ impl Brdf {
     ///
     /// Lambert takes `base` as the albedo.
     pub fn from_metallic_roughness(kind: BrdfKind, p: MetallicRoughness) -> Brdf {
-        let m = p.metallic.clamp(0.0, 1.0);
-        let ks = p.base_color.map(|b| 0.04 * (1.0 - m) + b * m);
-        let kd = [0, 1, 2].map(|c| p.base_color[c] * (1.0 - m) * (1.0 - ks[c]));
-        let alpha = (p.roughness.clamp(0.0, 1.0) * p.roughness.clamp(0.0, 1.0)).max(MIN_MAPPED_ALPHA);
-        let exponent = (2.0 / (alpha * alpha) - 2.0).clamp(0.0, MAX_EXPONENT);
-        match kind {
-            BrdfKind::Lambert => Brdf::Lambert { albedo: p.base_color },
-            BrdfKind::Phong => Brdf::Phong { kd, ks, exponent },
-            BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent },
-            BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: alpha, alpha_y: alpha },
-        }
+        crate::shading::surface::brdf_from_metallic_roughness(kind, p.base_color, p.metallic, p.roughness)
     }
 }
 

@@ -1,13 +1,16 @@
 //! Shading: radiometry, BRDFs, and the outgoing radiance at a surface point.
 //!
 //! This Rust code is the specification. It is written for f64 and used as is by the CPU reference renderer;
-//! the GLSL in `shaders/` (`radiometry.glsl`, `brdf.glsl`, `shade.glsl`) mirrors it name for name in f32.
+//! the GLSL in `shaders/` (`radiometry.glsl`, `brdf.glsl`, `shade.glsl`, `visibility.glsl`, `surface.glsl`,
+//! `texture_filter.glsl`) mirrors it name for name in f32.
 
 pub mod albedo;
 pub mod brdf;
 pub mod quadrature;
 pub mod radiometry;
 mod shade;
+pub mod surface;
+pub mod texture_filter;
 pub mod visibility;
 
 pub use shade::{

@@ -28,7 +28,7 @@ use super::visibility::{
     disk_visible_fraction, sky_visible_fraction, sun_visible_fraction, ShadowMapFilter, Shadowing, Shadows,
     DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
 };
-use crate::scene::{Brdf, DiskLight, Lights, Material};
+use crate::scene::{Brdf, DiskLight, Lights};
 
 /// How the sun is evaluated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -487,15 +487,15 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
 }
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer, every light unoccluded.
-pub fn radiance_out(material: &Material, point: &SurfacePoint, lights: &Lights, options: &ShadingOptions) -> [f64; 3] {
-    radiance_out_visible(material, point, lights, options, None)
+pub fn radiance_out(brdf: &Brdf, point: &SurfacePoint, lights: &Lights, options: &ShadingOptions) -> [f64; 3] {
+    radiance_out_visible(brdf, point, lights, options, None)
 }
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer from the visible part of
 /// each light (`shadow`; `None`: unoccluded): the diffuse part by the lights' visible fractions, each specular
 /// sample by its own shadow ray (`visibility`).
 pub fn radiance_out_visible(
-    material: &Material,
+    brdf: &Brdf,
     point: &SurfacePoint,
     lights: &Lights,
     options: &ShadingOptions,
@@ -505,7 +505,6 @@ pub fn radiance_out_visible(
     if point.normal == DVec3::ZERO {
         return [0.0; 3];
     }
-    let brdf = &material.brdf;
     let e = irradiance_visible(point, lights, options, shadow);
     let (kd, ks) = (brdf.kd(), brdf.ks());
     let mut radiance = [0, 1, 2].map(|c| lambert_brdf(kd[c] as f64) * e[c]);
@@ -577,16 +576,7 @@ pub fn radiance_out_visible(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{MetallicRoughness, Sun};
-
-    fn material(brdf: Brdf) -> Material {
-        Material {
-            name: "m".into(),
-            double_sided: false,
-            brdf,
-            pbr: MetallicRoughness { base_color: [1.0; 3], metallic: 0.0, roughness: 1.0 },
-        }
-    }
+    use crate::scene::Sun;
 
     fn point(normal: DVec3, to_viewer: DVec3) -> SurfacePoint {
         let tangent = crate::scene::tangent::default_tangent(normal);
@@ -595,7 +585,7 @@ mod tests {
 
     #[test]
     fn lambert_under_the_sun() {
-        let m = material(Brdf::Lambert { albedo: [0.5, 0.25, 1.0] });
+        let m = Brdf::Lambert { albedo: [0.5, 0.25, 1.0] };
         let l = DVec3::new(0.0, 1.0, 1.0).normalize();
         let lights = Lights {
             sun: Some(Sun { direction: l.as_vec3(), irradiance: [1000.0, 500.0, 0.0], angular_diameter: 0.00925 }),

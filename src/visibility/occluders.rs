@@ -139,6 +139,8 @@ mod tests {
             positions: m.positions.iter().map(|p| glam::Vec3::from_array(*p)).collect(),
             normals: m.normals.iter().map(|n| glam::Vec3::from_array(*n)).collect(),
             tangents: vec![glam::Vec4::X; m.positions.len()],
+            tex_coords: Default::default(),
+            colors: Vec::new(),
             indices: m.indices.clone(),
             material: 0,
         };

@@ -176,26 +176,29 @@ mod tests {
     fn reads_inside_and_refuses_outside() {
         let d = temp("confine");
         let files = AssetFiles::new(&d.join("scene/s.gltf"), &UriScope::SceneFolder).unwrap();
-        assert_eq!(files.read("a.bin", "a.bin", 2).unwrap(), [1, 2]);
-        assert_eq!(files.read("sub/../a.bin", "sub/../a.bin", 4).unwrap(), [1, 2, 3, 4]);
-        assert_eq!(files.read("sub/b.bin", "sub/b.bin", 8).unwrap(), [5; 8]);
-        assert!(files.read("../secret.bin", "../secret.bin", 4).unwrap_err().contains("outside the asset folder"));
+        assert_eq!(files.read("a.bin", "a.bin", Some(2)).unwrap(), [1, 2]);
+        assert_eq!(files.read("sub/../a.bin", "sub/../a.bin", Some(4)).unwrap(), [1, 2, 3, 4]);
+        assert_eq!(files.read("sub/b.bin", "sub/b.bin", Some(8)).unwrap(), [5; 8]);
+        assert!(files
+            .read("../secret.bin", "../secret.bin", Some(4))
+            .unwrap_err()
+            .contains("outside the asset folder"));
         let abs = d.join("secret.bin");
         let abs = abs.to_str().unwrap();
-        assert!(files.read(abs, abs, 4).unwrap_err().contains("absolute path"));
-        assert!(files.read("a.bin", "a.bin", 5).unwrap_err().contains("fewer than the 5 declared"));
-        assert!(files.read("sub", "sub", 0).unwrap_err().contains("a directory"));
-        assert!(files.read("missing.bin", "missing.bin", 0).unwrap_err().contains("missing.bin"));
+        assert!(files.read(abs, abs, Some(4)).unwrap_err().contains("absolute path"));
+        assert!(files.read("a.bin", "a.bin", Some(5)).unwrap_err().contains("fewer than the 5 declared"));
+        assert!(files.read("sub", "sub", Some(0)).unwrap_err().contains("a directory"));
+        assert!(files.read("missing.bin", "missing.bin", Some(0)).unwrap_err().contains("missing.bin"));
 
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(d.join("secret.bin"), d.join("scene/link.bin")).unwrap();
-            assert!(files.read("link.bin", "link.bin", 4).unwrap_err().contains("outside the asset folder"));
+            assert!(files.read("link.bin", "link.bin", Some(4)).unwrap_err().contains("outside the asset folder"));
         }
         let wide = AssetFiles::new(&d.join("scene/s.gltf"), &UriScope::Folder(d.clone())).unwrap();
-        assert_eq!(wide.read("../secret.bin", "../secret.bin", 4).unwrap(), [9; 4]);
+        assert_eq!(wide.read("../secret.bin", "../secret.bin", Some(4)).unwrap(), [9; 4]);
         let anywhere = AssetFiles::new(&d.join("scene/s.gltf"), &UriScope::Anywhere).unwrap();
-        assert_eq!(anywhere.read(abs, abs, 4).unwrap(), [9; 4]);
+        assert_eq!(anywhere.read(abs, abs, Some(4)).unwrap(), [9; 4]);
         fs::remove_dir_all(&d).unwrap();
     }
 

@@ -1,0 +1,103 @@
+// The material at one pixel: texture coordinates, textures, base colour, the metallic-roughness mapping, the
+// normal map and emission. Mirrors src/shading/surface.rs name for name (f32 products in the same order, marked
+// `precise`), so that the GPU and the reference agree on the BRDF's parameters bitwise where the device
+// interpolates in f64.
+#ifndef SUNSHADE_SURFACE_GLSL
+#define SUNSHADE_SURFACE_GLSL
+
+#include "bindings.glsl"
+#include "texture_filter.glsl"
+
+// The pixel's surface inputs (Rust: SurfaceSample): each set's texture coordinates at the pixel centre and at its
+// right and lower neighbours, and the vertex colour (white where the mesh has none).
+struct SurfaceSample {
+    REAL2 uv[2];
+    REAL2 uv_x[2];
+    REAL2 uv_y[2];
+    vec4 color;
+};
+
+// KHR_texture_transform's affine map, (m0 u + m1 v) + m2, (m3 u + m4 v) + m5.
+REAL2 transform_uv(TextureRefGpu r, REAL2 uv) {
+    precise REAL u = REAL(r.row0.x) * uv.x + REAL(r.row0.y) * uv.y + REAL(r.row0.z);
+    precise REAL v = REAL(r.row1.x) * uv.x + REAL(r.row1.y) * uv.y + REAL(r.row1.z);
+    return REAL2(u, v);
+}
+
+// A material's texture at the pixel.
+vec4 material_texture(TextureRefGpu r, SurfaceSample s) {
+    uint set = r.texture.y;
+    return texture_lookup(r.texture.x, transform_uv(r, s.uv[set]), transform_uv(r, s.uv_x[set]),
+                          transform_uv(r, s.uv_y[set]));
+}
+
+// Linear base colour and alpha: (factor x texture) x vertex colour.
+vec4 base_color(MaterialGpu m, SurfaceSample s) {
+    precise vec4 c = m.base;
+    if (m.tex[TEX_BASE].texture.x != NO_TEXTURE) {
+        c = c * material_texture(m.tex[TEX_BASE], s);
+    }
+    if ((VARIANT_SURFACE & SURFACE_COLORS) != 0u) {
+        c = c * s.color;
+    }
+    return c;
+}
+
+// The metallic-roughness mapping onto the draw's BRDF (VARIANT_BRDF): kd, ks, exponent, Ward alpha of m.
+MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metallic, float roughness) {
+    precise float mm = clamp(metallic, 0.0, 1.0);
+    precise vec3 ks = 0.04 * (1.0 - mm) + base * mm;
+    precise vec3 kd = base * (1.0 - mm) * (1.0 - ks);
+    precise float r = clamp(roughness, 0.0, 1.0);
+    precise float alpha = max(r * r, 1e-3);
+    precise float exponent = clamp(2.0 / (alpha * alpha) - 2.0, 0.0, 1e7);
+    if (VARIANT_BRDF == BRDF_LAMBERT) {
+        m.kd = vec4(base, 0.0);
+    } else {
+        m.kd = vec4(kd, 0.0);
+        m.ks = vec4(ks, VARIANT_BRDF == BRDF_WARD ? 0.0 : exponent);
+        m.params = vec4(VARIANT_BRDF == BRDF_WARD ? vec2(alpha) : vec2(0.0), 0.0, 0.0);
+    }
+    return m;
+}
+
+// The BRDF at the pixel: the mapping of the base colour and the metallic-roughness texture (B metallic, G
+// roughness) times the factors.
+MaterialGpu surface_brdf(MaterialGpu m, SurfaceSample s, vec4 base) {
+    precise float metallic = m.pbr.x;
+    precise float roughness = m.pbr.y;
+    if (VARIANT_BRDF != BRDF_LAMBERT && m.tex[TEX_METALLIC_ROUGHNESS].texture.x != NO_TEXTURE) {
+        vec4 t = material_texture(m.tex[TEX_METALLIC_ROUGHNESS], s);
+        metallic = metallic * t.b;
+        roughness = roughness * t.g;
+    }
+    return brdf_from_metallic_roughness(m, base.rgb, metallic, roughness);
+}
+
+// Whether the pixel is covered under alpha MASK: alpha >= cutoff.
+bool alpha_covers(MaterialGpu m, float alpha) {
+    return alpha >= m.pbr.w;
+}
+
+// Emitted radiance [W/(m^2 sr)]: the material's emission times its emissive texture.
+vec3 emitted_radiance(MaterialGpu m, SurfaceSample s) {
+    precise vec3 e = m.emission.rgb;
+    if (m.tex[TEX_EMISSIVE].texture.x != NO_TEXTURE) {
+        e = e * material_texture(m.tex[TEX_EMISSIVE], s).rgb;
+    }
+    return e;
+}
+
+// The normal map's tangent-space normal, unnormalised: (2 t - 1) (scale, scale, 1).
+vec3 tangent_space_normal(MaterialGpu m, SurfaceSample s) {
+    vec4 t = material_texture(m.tex[TEX_NORMAL], s);
+    precise vec3 n = (t.rgb * 2.0 - 1.0) * vec3(m.pbr.z, m.pbr.z, 1.0);
+    return n;
+}
+
+// The shading normal from a tangent-space normal in the frame (t, b, n).
+vec3 perturbed_normal(vec3 tn, vec3 t, vec3 b, vec3 n) {
+    return safe_normalize(t * tn.x + b * tn.y + n * tn.z);
+}
+
+#endif
