@@ -158,8 +158,8 @@ impl GltfBuilder {
         self.accessors.len() - 1
     }
 
-    /// An accessor of f32 elements of `n` components (`"VEC2"`, `"VEC4"`...).
-    fn push_f32_accessor(&mut self, data: &[f32], n: usize, kind: &str) -> usize {
+    /// Adds an accessor of f32 elements of `n` components each (`"VEC2"`, `"VEC4"`...); returns its index.
+    pub fn add_accessor_f32(&mut self, data: &[f32], n: usize, kind: &str) -> usize {
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.push_view(&bytes, Some(34962));
         self.accessors
@@ -190,11 +190,11 @@ impl GltfBuilder {
             }
             if let Some(uv) = &p.tex_coords {
                 let flat: Vec<f32> = uv.iter().flatten().copied().collect();
-                attributes.insert("TEXCOORD_0".into(), json!(self.push_f32_accessor(&flat, 2, "VEC2")));
+                attributes.insert("TEXCOORD_0".into(), json!(self.add_accessor_f32(&flat, 2, "VEC2")));
             }
             if let Some(c) = &p.colors {
                 let flat: Vec<f32> = c.iter().flatten().copied().collect();
-                attributes.insert("COLOR_0".into(), json!(self.push_f32_accessor(&flat, 4, "VEC4")));
+                attributes.insert("COLOR_0".into(), json!(self.add_accessor_f32(&flat, 4, "VEC4")));
             }
             let mut prim = json!({ "attributes": attributes });
             if let Some(i) = &p.indices {
