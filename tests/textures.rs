@@ -172,7 +172,10 @@ fn texture_transform_and_wrap_modes() {
             let (su, sv) = (scale[0] as f32 as f64 * u, scale[1] as f32 as f64 * v);
             let tu = cs * su + sn * sv + offset[0] as f32 as f64;
             let tv = -sn * su + cs * sv + offset[1] as f32 as f64;
-            let (i, j) = (wrap_index((tu * w as f64).floor() as i64, w as i64), wrap_index((tv * h as f64).floor() as i64, h as i64));
+            let (i, j) = (
+                wrap_index((tu * w as f64).floor() as i64, w as i64),
+                wrap_index((tv * h as f64).floor() as i64, h as i64),
+            );
             [0, 1, 2].map(|c| FACTOR[c] * texel(&t, w, i, j, c) / PI * E_PERP as f64)
         });
     }
@@ -183,13 +186,16 @@ fn minification_averages_the_texels_under_the_pixel() {
     // A 64 × 64 checker seen at 8 × 8 pixels: 8 texels a pixel, level 3 of the chain, whose texels are each the
     // mean of an 8 × 8 block of the checker: half black, half white, in linear units.
     let w = 64u32;
-    let t: Vec<[u8; 4]> =
-        (0..w * w).map(|k| if (k % w + k / w).is_multiple_of(2) { [255, 255, 255, 255] } else { [0, 0, 0, 255] }).collect();
+    let t: Vec<[u8; 4]> = (0..w * w)
+        .map(|k| if (k % w + k / w).is_multiple_of(2) { [255, 255, 255, 255] } else { [0, 0, 0, 255] })
+        .collect();
     let dir = TempDir::new("minify");
     let mut b = GltfBuilder::new();
     let image = b.add_png_image(&png_rgba8(w, w, &t));
     let tex = b.add_texture(image, Some(9729), Some(9987), [10497, 10497]);
-    let mat = b.add_material_json(json!({ "pbrMetallicRoughness": { "baseColorTexture": { "index": tex }, "metallicFactor": 0.0 } }));
+    let mat = b.add_material_json(
+        json!({ "pbrMetallicRoughness": { "baseColorTexture": { "index": tex }, "metallicFactor": 0.0 } }),
+    );
     let scene = load(&dir.write("m.glb", &one_mesh(b, &[square(0.0, mat, None)])));
     assert_matches(&both(&scene, &settings(8, DVec3::Z)), 1e-5, |_, _| [0.5 / PI * E_PERP as f64; 3]);
 }
@@ -240,31 +246,42 @@ fn alpha_mask_covers_exactly_where_alpha_reaches_the_cutoff() {
 
 #[test]
 fn a_normal_map_tilts_the_shading_normal() {
-    // A constant normal map tilted by 30° towards +u (+x here), under a sun 45° towards +x: the lit value follows
-    // cos of the angle between the decoded, normalised map normal and the sun.
+    // A constant normal map tilted towards +x (the map's right, +u) and +y (the map's up, towards decreasing v:
+    // world +y on this square), under a sun from +x +y +z: the lit value follows the cosine between the decoded,
+    // normalised map normal in the frame (t = +x, b = +y, n = +z) and the sun. With tangents from MikkTSpace (the
+    // file has none) and with the file's TANGENT: the same frame, glTF's handedness.
     let n = 8u32;
-    let tilt = 30f64.to_radians();
     let code = |v: f64| ((v * 0.5 + 0.5) * 255.0).round() as u8;
-    let t = vec![[code(tilt.sin()), code(0.0), code(tilt.cos()), 255]; 4];
-    let dir = TempDir::new("normal-map");
-    let mut b = GltfBuilder::new();
-    let image = b.add_png_image(&png_rgba8(2, 2, &t));
-    let tex = b.add_texture(image, Some(9728), Some(9728), [10497, 10497]);
-    let mat = b.add_material_json(json!({
-        "normalTexture": { "index": tex },
-        "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0 }
-    }));
-    let scene = load(&dir.write("nm.glb", &one_mesh(b, &[square(0.0, mat, None)])));
-    let sun = DVec3::new(1.0, 0.0, 1.0);
+    let tn = DVec3::new(0.4, 0.3, 1.0).normalize();
+    let t = vec![[code(tn.x), code(tn.y), code(tn.z), 255]; 4];
+    let sun = DVec3::new(1.0, 1.0, 1.0);
     let s = settings(n, sun);
     let decoded = [0, 1, 2].map(|c| t[0][c] as f64 / 255.0 * 2.0 - 1.0);
-    // Tangent +x (u), bitangent −y (v grows downwards), normal +z.
-    let normal = DVec3::new(decoded[0], -decoded[1], decoded[2]).normalize();
+    let normal = DVec3::new(decoded[0], decoded[1], decoded[2]).normalize();
     let l = s.lights.sun.unwrap().direction.as_dvec3();
     let want = 0.5 / PI * E_PERP as f64 * normal.dot(l);
-    let flat = 0.5 / PI * E_PERP as f64 * l.z;
-    assert!(rel(want, flat) > 0.1, "the tilt must change the value");
-    assert_matches(&both(&scene, &s), 1e-5, |_, _| [want; 3]);
+    let flipped_y = 0.5 / PI * E_PERP as f64 * DVec3::new(decoded[0], -decoded[1], decoded[2]).normalize().dot(l);
+    assert!(rel(want, 0.5 / PI * E_PERP as f64 * l.z) > 0.05 && rel(want, flipped_y) > 0.05, "the tilt must show");
+    for file_tangents in [false, true] {
+        let dir = TempDir::new("normal-map");
+        let mut b = GltfBuilder::new();
+        let image = b.add_png_image(&png_rgba8(2, 2, &t));
+        let tex = b.add_texture(image, Some(9728), Some(9728), [10497, 10497]);
+        let mat = b.add_material_json(json!({
+            "normalTexture": { "index": tex },
+            "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0 }
+        }));
+        let mut mb = one_mesh(b, &[square(0.0, mat, None)]);
+        let tangents = mb.add_accessor_f32(&[1.0, 0.0, 0.0, 1.0].repeat(4), 4, "VEC4");
+        let mut doc = mb.document(Some("nm.bin"));
+        if file_tangents {
+            doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(tangents);
+        }
+        std::fs::write(dir.path("nm.bin"), mb.bin()).unwrap();
+        std::fs::write(dir.path("nm.gltf"), doc.to_string()).unwrap();
+        let scene = load(&dir.path("nm.gltf"));
+        assert_matches(&both(&scene, &s), 1e-5, |_, _| [want; 3]);
+    }
 }
 
 #[test]
@@ -308,8 +325,11 @@ fn morphed_and_skinned_meshes_equal_their_pre_posed_twins() {
     morphed.normals = None;
     let twin_scene = load(&dir.write("twin.glb", &one_mesh(b.clone(), &[twin])));
     let mut mb = one_mesh(b, &[morphed]);
-    let displacement: Vec<f32> =
-        [[0.5, -0.25, 0.0], [0.5, -0.25, 0.5], [0.5, -0.25, 0.5], [0.5, -0.25, 0.0]].iter().flatten().copied().collect();
+    let displacement: Vec<f32> = [[0.5, -0.25, 0.0], [0.5, -0.25, 0.5], [0.5, -0.25, 0.5], [0.5, -0.25, 0.0]]
+        .iter()
+        .flatten()
+        .copied()
+        .collect();
     let acc = mb.add_accessor_f32(&displacement, 3, "VEC3");
     let mut doc = mb.document(Some("morph.bin"));
     doc["meshes"][0]["primitives"][0]["targets"] = json!([{ "POSITION": acc }]);
@@ -340,11 +360,7 @@ fn morphed_and_skinned_meshes_equal_their_pre_posed_twins() {
     let twin_scene = load(&dir.write("skin-twin.glb", &one_mesh(b.clone(), &[twin])));
     let m = b.add_mesh("square", &[skinned]);
     let joint1 = b.add_node(Node {
-        transform: Transform::Trs {
-            translation: [0.5, 0.0, 0.0],
-            rotation: q.as_quat().to_array(),
-            scale: [1.0; 3],
-        },
+        transform: Transform::Trs { translation: [0.5, 0.0, 0.0], rotation: q.as_quat().to_array(), scale: [1.0; 3] },
         ..Default::default()
     });
     let joint0 = b.add_node(Node { children: vec![joint1], ..Default::default() });

@@ -399,6 +399,7 @@ impl<'a> Loader<'a> {
             colors.map(|c| c.chunks_exact(4).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32]).collect());
         // Tangent sources: TANGENT (transformed as a direction, handedness flipped by a mirroring node), else
         // TEXCOORD_0.
+        let had_tangents = local_tangents.is_some();
         let file_tangents = local_tangents.map(|t| {
             let w_sign = det.signum();
             t.chunks_exact(4)
@@ -473,8 +474,9 @@ impl<'a> Loader<'a> {
                             let p = [a, b, c].map(|p| p.as_dvec3());
                             let (t, w) = match triangle_tangent(p, [0, 1, 2].map(|k| uv[tri[k] as usize])) {
                                 Some((t, bt)) => {
+                                    // glTF's handedness: the bitangent against ∂p/∂v (super::tangent).
                                     let t = orthonormal_tangent(t, nd);
-                                    (t, if nd.cross(t).dot(bt) < 0.0 { -1.0 } else { 1.0 })
+                                    (t, if nd.cross(t).dot(bt) > 0.0 { -1.0 } else { 1.0 })
                                 }
                                 None => (default_tangent(nd), 1.0),
                             };
@@ -484,6 +486,13 @@ impl<'a> Loader<'a> {
                     };
                     out.tangents.extend(tangents);
                 }
+            }
+        }
+        // A normal map without the file's tangents: MikkTSpace on its texture-coordinate set, as glTF asks.
+        let normal_map_set = self.scene.materials[out.material].normal_texture.map(|(t, _)| t.tex_coord as usize);
+        if let (Some(set), false) = (normal_map_set, had_tangents) {
+            if !super::tangent::mikktspace_tangents(&mut out, set) {
+                self.scene.warnings.push(format!("{name}: MikkTSpace could not make tangents; UV-derived ones used"));
             }
         }
         if !out.indices.is_empty() {
