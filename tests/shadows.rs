@@ -535,7 +535,7 @@ fn gpu_ray_query_differences_lie_at_fragile_rays() {
     lights.sky = Some([100.0; 3]);
     let s = settings(160, 160, camera, lights, Shadows::Ray, 6);
     let g = gpu.render(&sc, &s);
-    let (c, fragile) = cpu::render_with_fragile_rays(&sc, &s, &gpu.reference_options());
+    let (c, fragile) = cpu::render_with_fragile_pixels(&sc, &s, &gpu.reference_options());
     let (over, flagged) = over_tolerance_and_fragile(&g, &c, &fragile);
     let marked = fragile.iter().filter(|&&f| f).count();
     eprintln!(
@@ -559,7 +559,7 @@ fn gpu_ray_queries_agree_with_the_reference_at_every_scale_and_at_grazing_sun() 
         for l in [DVec3::new(-1.0, 1.0, 0.2), DVec3::new(0.5f64.to_radians().cos(), 0.5f64.to_radians().sin(), 0.1)] {
             let s = settings(96, 96, camera, sun_lights(l, 0.53), Shadows::Ray, 4);
             let g = gpu.render(&sc, &s);
-            let (c, fragile) = cpu::render_with_fragile_rays(&sc, &s, &gpu.reference_options());
+            let (c, fragile) = cpu::render_with_fragile_pixels(&sc, &s, &gpu.reference_options());
             let (over, flagged) = over_tolerance_and_fragile(&g, &c, &fragile);
             assert!(c.pixels().iter().any(|p| p[3] > 0.0 && p[0] == 0.0), "scale {scale}, sun {l}: no shadow seen");
             assert_eq!(over, flagged, "scale {scale}, sun {l}: {over} pixels over tolerance, {flagged} fragile");

@@ -396,3 +396,27 @@ fn morphed_and_skinned_meshes_equal_their_pre_posed_twins() {
     }
     let _ = Vec3::ZERO;
 }
+
+#[test]
+fn pixels_at_texture_discontinuities_are_flagged_fragile() {
+    // 8 texels across 4 pixels: pixel centres land on texel boundaries (u·8 = 2x + 1). With NEAREST the result
+    // jumps there, so every pixel is fragile; with LINEAR it is continuous, so none is; an alpha mask whose
+    // alpha equals its cutoff is fragile too.
+    let dir = TempDir::new("fragile");
+    let t = ramp(8, 8);
+    for (filter, alpha_mode, want) in [(9728, "OPAQUE", true), (9729, "OPAQUE", false), (9729, "MASK", true)] {
+        let mut b = GltfBuilder::new();
+        let image = b.add_png_image(&png_rgba8(8, 8, &t));
+        let tex = b.add_texture(image, Some(filter), Some(filter), [10497, 10497]);
+        let mat = b.add_material_json(json!({
+            "alphaMode": alpha_mode,
+            "alphaCutoff": 1.0,
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": tex }, "metallicFactor": 0.0 }
+        }));
+        let scene = load(&dir.write(&format!("f{filter}{alpha_mode}.glb"), &one_mesh(b, &[square(0.0, mat, None)])));
+        let s = settings(4, DVec3::Z);
+        let (image, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &cpu::ReferenceOptions::default());
+        assert_eq!(image.covered_count(), 16);
+        assert!(fragile.iter().all(|&f| f == want), "filter {filter} {alpha_mode}: {fragile:?}");
+    }
+}

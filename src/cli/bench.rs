@@ -66,6 +66,11 @@ pub struct BenchArgs {
     /// --update region is "shadows".
     #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs", "brdf_chart"])]
     pub shadows: bool,
+    /// Measure what textures cost: each textured scene (default: the textured samples in models/gltf-samples;
+    /// 512 × 512 unless --width/--height are given) with and without its textures, GPU frame and CPU reference
+    /// times, and the GPU's agreement with the reference. Its --update region is "textures".
+    #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows"])]
+    pub textures: bool,
     /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
     #[arg(long)]
     pub json: bool,
@@ -85,6 +90,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         "brdf-chart"
     } else if a.shadows {
         "shadows"
+    } else if a.textures {
+        "textures"
     } else {
         ""
     };
@@ -96,6 +103,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.shadows {
         return super::bench_shadows::run(a);
+    }
+    if a.textures {
+        return super::bench_textures::run(a);
     }
     let (width, height) = (a.width.unwrap_or(1024), a.height.unwrap_or(1024));
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };

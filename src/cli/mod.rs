@@ -8,6 +8,7 @@ mod args;
 mod batch;
 mod bench;
 mod bench_shadows;
+mod bench_textures;
 mod diff;
 mod generated;
 mod info;

@@ -158,15 +158,21 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     if report.pass {
         return Ok(());
     }
-    if job.settings.shading.shadows == Shadows::Ray && !report.over_tolerance_pixels.is_empty() && !a.json {
-        // Which of the differences lie at shadow rays the GPU's f32 geometry may answer the other way.
+    let may_be_fragile = {
+        let scene = session.scene_ref(job.scene);
+        job.settings.shading.shadows == Shadows::Ray
+            || !scene.textures.is_empty()
+            || scene.materials.iter().any(|m| matches!(m.alpha, crate::scene::AlphaMode::Mask(_)))
+    };
+    if may_be_fragile && !report.over_tolerance_pixels.is_empty() && !a.json {
+        // Which of the differences lie where the GPU's f32 geometry or texture coordinates may decide the other way.
         let options = reference_options(session, a, job);
-        let (_, fragile) = cpu::render_with_fragile_rays(session.scene_ref(job.scene), &job.settings, &options);
-        let width = job.image.width();
-        let at = report.over_tolerance_pixels.iter().filter(|&&(x, y)| fragile[(y * width + x) as usize]).count();
+        let (_, fragile) = cpu::render_with_fragile_pixels(session.scene_ref(job.scene), &job.settings, &options);
+        let at = report.over_tolerance_at(&fragile, job.image.width());
         println!(
-            "of the {} pixels over tolerance, {at} have a fragile shadow ray (within 2^-18 of the scene's size from \
-             an occluder's edge, where f32 geometry may answer the other way)",
+            "of the {} pixels over tolerance, {at} are fragile: a shadow ray within 2^-18 of the scene's size from \
+             an occluder's edge, or a texture lookup or alpha cutoff within 2^-16 of a discontinuity, where f32 \
+             geometry or texture coordinates may decide the other way",
             report.over_tolerance_pixels.len()
         );
     }

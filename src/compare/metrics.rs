@@ -289,6 +289,14 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
 }
 
 impl DiffReport {
+    /// How many of the pixels over tolerance are flagged in `mask` (row-major, `width` pixels a row): the class
+    /// of differences at places where the reference's result is *fragile*, a shadow ray grazing an occluder's
+    /// edge or a texture lookup at a discontinuity (`cpu::render_with_fragile_pixels`), counted apart as coverage
+    /// mismatches at triangle edges are.
+    pub fn over_tolerance_at(&self, mask: &[bool], width: u32) -> usize {
+        self.over_tolerance_pixels.iter().filter(|&&(x, y)| mask.get((y * width + x) as usize) == Some(&true)).count()
+    }
+
     /// A short human-readable report.
     pub fn text(&self, name_a: &str, name_b: &str) -> String {
         let mut s = String::new();

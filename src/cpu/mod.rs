@@ -37,8 +37,9 @@ use crate::scene::tangent::orthonormal_tangent;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{
-    alpha_covers, base_color, emitted_radiance, perturbed_normal, surface_brdf, surface_flags, tangent_space_normal,
-    SurfaceSample, SURFACE_ALPHA_MASK, SURFACE_COLORS, SURFACE_EMISSION, SURFACE_EVAL, SURFACE_NORMAL_MAP,
+    alpha_covers, base_color, discontinuity_margin as surface_discontinuity, emitted_radiance, perturbed_normal,
+    surface_brdf, surface_flags, tangent_space_normal, SurfaceSample, SURFACE_ALPHA_MASK, SURFACE_COLORS,
+    SURFACE_EMISSION, SURFACE_EVAL, SURFACE_NORMAL_MAP,
 };
 use crate::shading::visibility::shadow_ray_origin;
 use crate::shading::{radiance_out, radiance_out_visible, safe_normalize, Occlusion, Shadowing, Shadows, SurfacePoint};
@@ -153,12 +154,19 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
 /// coordinates' magnitude, several times the f32 rounding of the GPU's positions and directions (2⁻²³).
 pub const FRAGILE_RAY_RELATIVE: f64 = 1.0 / 262144.0;
 
-/// [`render`], and for each pixel whether any of its shadow rays is *fragile*: it passes within
+/// How near a texture lookup or an alpha cutoff may be to a jump of its result before the pixel counts as
+/// fragile: `2⁻¹⁶` of the decision's scale (docs/textures.md, "Discontinuities"), above the rounding of f32 texture
+/// coordinates from f32 barycentrics (up to ~1e-5 of a thin triangle's weights).
+pub const FRAGILE_TEXTURE_RELATIVE: f64 = 1.0 / 65536.0;
+
+/// [`render`], and for each pixel whether it is *fragile*: one of its shadow rays passes within
 /// [`FRAGILE_RAY_RELATIVE`] of the scene's size from an occluder's boundary, so that the GPU's f32 geometry could
-/// answer it the other way ([`Bvh::occluded_with_margin`]). Image-diff tests count GPU/reference differences at
-/// those pixels apart, as coverage mismatches at triangle edges are. Slower than [`render`] (every ray traverses
-/// with padded boxes and tests edge distances).
-pub fn render_with_fragile_rays(
+/// answer it the other way ([`Bvh::occluded_with_margin`]), or one of its texture lookups (or its alpha mask) lies
+/// within [`FRAGILE_TEXTURE_RELATIVE`] of a discontinuity (a `NEAREST` texel boundary, a nearest mip level's
+/// boundary, the switch between magnification and minification filters, an alpha cutoff). Image-diff tests count
+/// GPU/reference differences at those pixels apart, as coverage mismatches at triangle edges are. Slower than
+/// [`render`] (every ray traverses with padded boxes and tests edge distances).
+pub fn render_with_fragile_pixels(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
@@ -260,6 +268,13 @@ fn render_inner(
                     }
                     (o, _) => shade(scene, settings, t, (x, y), w.to_array(), viewer, o.map(|b| b as &dyn Occlusion)),
                 };
+                if fragile && t.surface != 0 {
+                    let s = surface_sample(settings, t, x, y);
+                    let material = &scene.materials[t.material];
+                    if surface_discontinuity(material, &scene.textures, &s, t.surface) < FRAGILE_TEXTURE_RELATIVE {
+                        flagged[k] = true;
+                    }
+                }
                 pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
             }
         },

@@ -148,6 +148,26 @@ pub fn perturbed_normal(tn: [f32; 3], t: DVec3, b: DVec3, n: DVec3) -> DVec3 {
     super::safe_normalize(t * tn[0] as f64 + b * tn[1] as f64 + n * tn[2] as f64)
 }
 
+/// How near the pixel's material is to a jump of its textures or its alpha mask (the smallest
+/// [`discontinuity_margin`] of the textures it reads, and `|alpha − cutoff|` under MASK); infinity where every
+/// lookup is continuous. Rust only (the reference's flags for image comparison).
+pub fn discontinuity_margin(material: &Material, textures: &[Texture], s: &SurfaceSample, flags: u32) -> f64 {
+    let mut margin = f64::INFINITY;
+    for r in material.textures() {
+        let set = r.tex_coord as usize;
+        let (uv, uv_x, uv_y) = (
+            transform_uv(&r.transform, s.uv[set]),
+            transform_uv(&r.transform, s.uv_x[set]),
+            transform_uv(&r.transform, s.uv_y[set]),
+        );
+        margin = margin.min(super::texture_filter::discontinuity_margin(&textures[r.texture], uv, uv_x, uv_y));
+    }
+    if let (AlphaMode::Mask(cutoff), true) = (material.alpha, flags & SURFACE_ALPHA_MASK != 0) {
+        margin = margin.min((base_color(material, textures, s)[3] as f64 - cutoff as f64).abs());
+    }
+    margin
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

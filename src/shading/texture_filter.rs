@@ -159,6 +159,41 @@ pub fn texture_lookup(texture: &Texture, uv: [f64; 2], uv_x: [f64; 2], uv_y: [f6
     [0, 1, 2, 3].map(|c| r0[c] * rd + r1[c] * d)
 }
 
+/// How near the result of a lookup is to one of its jumps, as a fraction of the decision's own scale: the
+/// distance of a `NEAREST` texel coordinate from a texel boundary over `|x| + 1`, of `2m²` from 1 for a nearest
+/// mip level, of `ρ²` from 1 where magnification and minification filter differently (over `max(ρ², 1)`); infinity
+/// for a lookup whose result is continuous there (bilinear, trilinear). Rust only: the reference uses it to flag
+/// pixels that rounding elsewhere (f32 texture coordinates) could send across a jump (docs/textures.md).
+pub fn discontinuity_margin(texture: &Texture, uv: [f64; 2], uv_x: [f64; 2], uv_y: [f64; 2]) -> f64 {
+    let s = &texture.sampler;
+    let l0 = &texture.levels[0];
+    let (w, h) = (l0.width as f64, l0.height as f64);
+    let (dxu, dxv) = ((uv_x[0] - uv[0]) * w, (uv_x[1] - uv[1]) * h);
+    let (dyu, dyv) = ((uv_y[0] - uv[0]) * w, (uv_y[1] - uv[1]) * h);
+    let rho2 = (dxu * dxu + dxv * dxv).max(dyu * dyu + dyv * dyv);
+    let mut margin = f64::INFINITY;
+    if s.mag != s.min || s.mip != MipFilter::None {
+        margin = margin.min((rho2 - 1.0).abs() / rho2.max(1.0));
+    }
+    let choice = choose_level(texture, uv, uv_x, uv_y);
+    if s.mip == MipFilter::Nearest && rho2 > 1.0 && rho2.is_finite() {
+        let (m, _) = split_exponent(rho2.sqrt());
+        margin = margin.min((2.0 * m * m - 1.0).abs());
+    }
+    if choice.filter == Filter::Nearest {
+        let level = &texture.levels[choice.level];
+        for x in [uv[0] * level.width as f64, uv[1] * level.height as f64] {
+            let x = texel_coordinate(x);
+            margin = margin.min((x - x.round()).abs() / (x.abs() + 1.0));
+        }
+    }
+    if margin.is_nan() {
+        0.0
+    } else {
+        margin
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
