@@ -292,6 +292,10 @@ fn mutated_models_never_panic() {
         .collect();
     models.sort();
     assert!(models.len() >= 8, "models/ has {} scenes", models.len());
+    // Textured and vertex-coloured samples (one file each): images, samplers, texture infos.
+    for sample in ["BoxTextured/BoxTextured.glb", "VertexColorTest/VertexColorTest.glb"] {
+        models.push(models_dir.join("gltf-samples").join(sample));
+    }
     let cases = env_u64("SUNSHADE_FUZZ_CASES", 500);
     let first_seed = env_u64("SUNSHADE_FUZZ_SEED", 1);
     let mut gpu = CheckedRenderer::new();

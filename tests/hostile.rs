@@ -512,3 +512,57 @@ fn cli_refusals_are_one_line_with_the_documented_exit_code() {
         std::fs::remove_file(&out).unwrap();
     }
 }
+
+/// CRC-32 (ISO-HDLC, PNG's) of `bytes`.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 { (crc >> 1) ^ 0xedb8_8320 } else { crc >> 1 };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn images_stay_inside_the_folder_and_within_the_texel_budget() {
+    let material_with_texture = |image_uri: &str| {
+        let uri = image_uri.to_string();
+        move |d: &mut Value| {
+            d["images"] = json!([{ "uri": uri }]);
+            d["textures"] = json!([{ "source": 0 }]);
+            d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": 0 });
+        }
+    };
+    let small = sunshade::authoring::png_rgba8(2, 2, &[[9, 9, 9, 255]; 4]);
+    // An image outside the folder is refused like a buffer; inside, it is read.
+    let mut c = Case::new("image-outside");
+    std::fs::write(c.dir.path("outside.png"), &small).unwrap();
+    material_with_texture("../outside.png")(&mut c.doc);
+    c.refused(&["../outside.png", "outside the asset folder", "image 0"]);
+    std::fs::write(c.scene_dir().join("inside.png"), &small).unwrap();
+    material_with_texture("inside.png")(&mut c.doc);
+    assert_eq!(c.loads().textures.len(), 1);
+    // A decompression bomb: a PNG header claiming 16384 × 16384 texels (the pixel data is not even there) is
+    // refused from its header, before anything is allocated for it.
+    let mut bomb = small.clone();
+    // The IHDR chunk's data starts at byte 16: width, height (big-endian), then its CRC over type + data.
+    bomb[16..20].copy_from_slice(&16384u32.to_be_bytes());
+    bomb[20..24].copy_from_slice(&16384u32.to_be_bytes());
+    let crc = crc32(&bomb[12..29]);
+    bomb[29..33].copy_from_slice(&crc.to_be_bytes());
+    std::fs::write(c.scene_dir().join("bomb.png"), &bomb).unwrap();
+    material_with_texture("bomb.png")(&mut c.doc);
+    let t = std::time::Instant::now();
+    c.refused(&["16384x16384", "budget", "image 0"]);
+    assert!(t.elapsed().as_secs_f64() < 2.0, "the budget must be checked before decoding");
+    // A data URI image and a truncated PNG.
+    use base64::Engine;
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&small);
+    material_with_texture(&format!("data:image/png;base64,{b64}"))(&mut c.doc);
+    assert_eq!(c.loads().textures.len(), 1);
+    std::fs::write(c.scene_dir().join("cut.png"), &small[..small.len() - 12]).unwrap();
+    material_with_texture("cut.png")(&mut c.doc);
+    c.refused(&["image 0"]);
+}

@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use super::gltf::document::{lookup, MaterialDef, Root, TextureInfo};
 use super::gltf::files::AssetFiles;
-use super::gltf::image::{decode, image_bytes, ColorSpace};
+use super::gltf::image::{decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
 use super::material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
 use super::texture::{uv_transform, Sampler, Texture, TextureRef, IDENTITY_UV_TRANSFORM};
 
@@ -26,11 +26,21 @@ pub struct MaterialReader<'a> {
     cache: HashMap<(u64, ColorSpace), usize>,
     pub textures: Vec<Texture>,
     pub warnings: Vec<String>,
+    /// What is left of the scene's texel budget.
+    texels_left: u64,
 }
 
 impl<'a> MaterialReader<'a> {
     pub fn new(root: &'a Root, buffers: &'a [Vec<u8>], files: &'a AssetFiles) -> Self {
-        Self { root, buffers, files, cache: HashMap::new(), textures: Vec::new(), warnings: Vec::new() }
+        Self {
+            root,
+            buffers,
+            files,
+            cache: HashMap::new(),
+            textures: Vec::new(),
+            warnings: Vec::new(),
+            texels_left: MAX_SCENE_TEXELS,
+        }
     }
 
     /// Material `index`.
@@ -197,7 +207,7 @@ impl<'a> MaterialReader<'a> {
             None => Sampler::default(),
         };
         let (bytes, _mime) = image_bytes(root, self.buffers, self.files, source, &what)?;
-        let level0 = decode(&bytes, space, &format!("{what} image {source}"))?;
+        let level0 = decode(&bytes, space, &format!("{what} image {source}"), &mut self.texels_left)?;
         self.textures.push(Texture::new(format!("{what} (image {source})"), level0, sampler));
         let index = self.textures.len() - 1;
         self.cache.insert(key, index);

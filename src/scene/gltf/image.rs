@@ -10,6 +10,11 @@ use crate::scene::texture::{srgb_decode, srgb_to_linear, Level};
 /// The longest side of an image sunshade decodes [texels] (lavapipe's `maxImageDimension2D`).
 pub const MAX_TEXTURE_SIDE: u32 = 16384;
 
+/// The most texels a scene's textures may have, mip levels included: 2^27 (lavapipe's `maxTexelBufferElements`;
+/// 2 GiB as f32 RGBA). Checked from each image's header before its pixels are decoded, so that a small
+/// compressed file cannot make sunshade allocate gigabytes.
+pub const MAX_SCENE_TEXELS: u64 = 1 << 27;
+
 /// The encoded bytes of image `index`, and its MIME type where the file gives one.
 pub fn image_bytes(
     root: &Root,
@@ -54,8 +59,9 @@ pub enum ColorSpace {
 }
 
 /// Decodes PNG (8 or 16 bits, any channel count) or JPEG to linear RGBA f32 (missing channels: grey to RGB,
-/// alpha 1). `what` names the image in errors.
-pub fn decode(bytes: &[u8], space: ColorSpace, what: &str) -> Result<Level, String> {
+/// alpha 1). `what` names the image in errors. `texels_left`: the scene's remaining budget of texels (of
+/// [`MAX_SCENE_TEXELS`]), charged with the image's mip chain (at most 4/3 of its texels) before decoding.
+pub fn decode(bytes: &[u8], space: ColorSpace, what: &str, texels_left: &mut u64) -> Result<Level, String> {
     use image::ImageDecoder;
     let format = image::guess_format(bytes).map_err(|_| format!("{what}: not a PNG or JPEG image"))?;
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
@@ -72,6 +78,15 @@ pub fn decode(bytes: &[u8], space: ColorSpace, what: &str) -> Result<Level, Stri
     if width == 0 || height == 0 {
         return Err(format!("{what}: the image is empty ({width}x{height})"));
     }
+    let chain = (width as u64 * height as u64).div_ceil(3) * 4;
+    if chain > *texels_left {
+        return Err(format!(
+            "{what}: a {width}x{height} image (with its mip levels, {chain} texels) exceeds the {} texels left of the \
+             scene's budget of {MAX_SCENE_TEXELS}",
+            *texels_left
+        ));
+    }
+    *texels_left -= chain;
     let decoded = image::DynamicImage::from_decoder(decoder).map_err(|e| format!("{what}: {e}"))?;
     let sixteen = matches!(
         decoded.color(),
@@ -122,10 +137,14 @@ mod tests {
     #[test]
     fn decodes_png_in_both_colour_spaces() {
         let bytes = png(2, 1, &[255, 128, 0, 255, 10, 20, 30, 128]);
-        let lin = decode(&bytes, ColorSpace::Linear, "t").unwrap();
+        let budget = &mut MAX_SCENE_TEXELS.clone();
+        let lin = decode(&bytes, ColorSpace::Linear, "t", budget).unwrap();
         assert_eq!((lin.width, lin.height), (2, 1));
         assert_eq!(lin.texels[0], [1.0, (128.0f64 / 255.0) as f32, 0.0, 1.0]);
-        let srgb = decode(&bytes, ColorSpace::Srgb, "t").unwrap();
+        let srgb = decode(&bytes, ColorSpace::Srgb, "t", budget).unwrap();
+        assert_eq!(*budget, MAX_SCENE_TEXELS - 2 * 4);
+        let mut small = 3;
+        assert!(decode(&bytes, ColorSpace::Srgb, "image 7", &mut small).unwrap_err().contains("budget"));
         assert_eq!(
             srgb.texels[1],
             [srgb_to_linear(10), srgb_to_linear(20), srgb_to_linear(30), (128.0f64 / 255.0) as f32]
@@ -134,9 +153,10 @@ mod tests {
 
     #[test]
     fn refuses_what_it_cannot_decode() {
-        assert!(decode(b"not an image", ColorSpace::Linear, "image 3").unwrap_err().starts_with("image 3"));
+        let budget = &mut MAX_SCENE_TEXELS.clone();
+        assert!(decode(b"not an image", ColorSpace::Linear, "image 3", budget).unwrap_err().starts_with("image 3"));
         let mut bytes = png(4, 4, &[0; 64]);
         bytes.truncate(bytes.len() - 20);
-        assert!(decode(&bytes, ColorSpace::Linear, "image 3").is_err());
+        assert!(decode(&bytes, ColorSpace::Linear, "image 3", budget).is_err());
     }
 }
