@@ -35,6 +35,7 @@ bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
+	$(SUNSHADE) bench --textures --repeat 5 --update docs/textures.md
 
 # Throughput: 30 renders as processes against one batch, and a whole render process against its frame phases.
 bench-batch: build
@@ -56,7 +57,14 @@ images: build
 		--sun-elevation 35 --sun-azimuth 20 && \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-disk.png --width 640 --height 300 \
 		--disk-light 0,3,2:0,-1,0:0.8:2000 && \
-	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sky.png --width 640 --height 300 --sky-radiance 300
+	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sky.png --width 640 --height 300 --sky-radiance 300 && \
+	for m in BoxTextured/BoxTextured.glb TextureTransformTest/TextureTransformTest.gltf \
+		NormalTangentMirrorTest/NormalTangentMirrorTest.glb CesiumMan/CesiumMan.glb \
+		AlphaBlendModeTest/AlphaBlendModeTest.glb VertexColorTest/VertexColorTest.glb; do \
+		n=$$(basename $${m%.*}); \
+		$(SUNSHADE) render models/gltf-samples/$$m -o docs/images/sample-$$n.png --width 320 --height 240 \
+			--sun-dir -1,1.2,1.5 -q || exit 1; \
+	done
 
 # Regenerates the generated scenes in models/.
 models:
