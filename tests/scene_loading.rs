@@ -134,6 +134,12 @@ fn material_features_not_drawn_are_named_in_warnings() {
         s.warnings
     );
     assert!(s.materials[0].base_color_texture.is_none());
+    // Required, it is refused, named.
+    doc["extensionsUsed"] = json!(["EXT_texture_webp"]);
+    doc["extensionsRequired"] = json!(["EXT_texture_webp"]);
+    std::fs::write(dir.path("webp-required.gltf"), doc.to_string()).unwrap();
+    let e = load_err(&dir.path("webp-required.gltf"));
+    assert!(e.contains("EXT_texture_webp") && e.contains("does not support"), "{e}");
 }
 
 #[test]
