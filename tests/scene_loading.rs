@@ -358,3 +358,47 @@ fn non_finite_positions_are_refused() {
     let e = load_err(&dir.write("nan.gltf", &b));
     assert!(e.contains("nan.gltf") && e.contains("non-finite") && e.contains("vertex 2"), "{e}");
 }
+
+#[test]
+fn animations_pose_the_scene_at_the_time_asked() {
+    // A node translated from x = 0 to x = 2 between t = 0 and 1 s (LINEAR), and a STEP rotation at t = 0.5 s.
+    let dir = TempDir::new("animation");
+    let mut b = square_scene();
+    let times = b.add_accessor_f32(&[0.0, 1.0], 1, "SCALAR");
+    let moves = b.add_accessor_f32(&[0.0, 0.0, 0.0, 2.0, 0.0, 0.0], 3, "VEC3");
+    let step_times = b.add_accessor_f32(&[0.0, 0.5], 1, "SCALAR");
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let turns = b.add_accessor_f32(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, half, half], 4, "VEC4");
+    let mut doc = b.document(Some("a.bin"));
+    doc["animations"] = json!([{
+        "channels": [
+            { "sampler": 0, "target": { "node": 0, "path": "translation" } },
+            { "sampler": 1, "target": { "node": 0, "path": "rotation" } }
+        ],
+        "samplers": [
+            { "input": times, "output": moves },
+            { "input": step_times, "output": turns, "interpolation": "STEP" }
+        ]
+    }]);
+    std::fs::write(dir.path("a.bin"), b.bin()).unwrap();
+    std::fs::write(dir.path("a.gltf"), doc.to_string()).unwrap();
+    let path = dir.path("a.gltf");
+    let rest = scene::load(&path).unwrap();
+    assert!(rest.warnings.iter().any(|w| w.contains("1 animation(s); drawn at rest")), "{:?}", rest.warnings);
+    let at = |t: f64| scene::load_with_options(&path, &LoadOptions { animation: Some((0, t)), ..Default::default() });
+    let posed = at(0.25).unwrap();
+    for (p, q) in posed.meshes[0].positions.iter().zip(&rest.meshes[0].positions) {
+        assert!((*p - *q - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6, "{p} {q}");
+    }
+    // After 0.5 s the STEP rotation (a quarter turn about z) holds; past the last key the last values hold.
+    let turned = at(7.0).unwrap();
+    for (p, q) in turned.meshes[0].positions.iter().zip(&rest.meshes[0].positions) {
+        let want = Vec3::new(-q.y, q.x, q.z) + Vec3::new(2.0, 0.0, 0.0);
+        assert!((*p - want).length() < 1e-5, "{p} against {want}");
+    }
+    assert!(at(0.0).is_ok());
+    let e = scene::load_with_options(&path, &LoadOptions { animation: Some((3, 0.0)), ..Default::default() })
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("animation 3 does not exist"), "{e}");
+}

@@ -146,6 +146,15 @@ pub struct SceneArgs {
     #[arg(help_heading = "Scene", long = "scene", value_name = "N")]
     pub scene_index: Option<usize>,
 
+    /// Pose the scene by glTF animation N (its nodes' translation, rotation, scale and morph weights) at
+    /// --animation-time (default: the file at rest).
+    #[arg(help_heading = "Scene", long, value_name = "N")]
+    pub animation: Option<usize>,
+
+    /// The time of --animation [s] (before its first keyframe the first holds, after the last the last).
+    #[arg(help_heading = "Scene", long, value_name = "SECONDS", requires = "animation", allow_negative_numbers = true)]
+    pub animation_time: Option<f64>,
+
     /// Use glTF camera N (as placed by the scene's nodes) instead of the first one.
     #[arg(help_heading = "Camera", long, value_name = "N")]
     pub camera: Option<usize>,
@@ -267,7 +276,8 @@ impl SceneArgs {
             (Some(dir), false) => UriScope::Folder(dir.clone()),
             (None, false) => UriScope::SceneFolder,
         };
-        LoadOptions { scene: self.scene_index, uris }
+        let animation = self.animation.map(|n| (n, self.animation_time.unwrap_or(0.0)));
+        LoadOptions { scene: self.scene_index, uris, animation }
     }
 
     pub fn camera_options(&self) -> CameraOptions {

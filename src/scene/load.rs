@@ -13,11 +13,13 @@
 //! Every problem is an error naming the file and the glTF object; nothing here panics or recurses on bad input:
 //! the hierarchy is walked with an explicit stack, each node at most once.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DMat4, DQuat, DVec3, Vec3, Vec4};
 use serde_json::Value;
 
+use super::animation::{self, NodePose};
 use super::camera::{Camera, Projection};
 use super::gltf::accessor::AccessorReader;
 use super::gltf::document::{self, lookup, CameraDef, LightDef, NodeDef, PrimitiveDef, Root};
@@ -51,6 +53,9 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// Where buffer and image files may be (default: inside the scene's folder).
     pub uris: UriScope,
+    /// Pose the scene by animation N at time T [s] (`--animation N --time T`); `None`: the file's own transforms
+    /// and weights (the rest pose).
+    pub animation: Option<(usize, f64)>,
 }
 
 /// Loads the default scene of a glTF file.
@@ -72,6 +77,8 @@ struct Loader<'a> {
     /// Every node's world matrix (`None` for nodes that no hierarchy walk from a parentless node reaches), for
     /// skins' joints.
     node_world: Vec<Option<DMat4>>,
+    /// Nodes posed by the sampled animation (`LoadOptions::animation`).
+    poses: HashMap<u64, NodePose>,
     scene: Scene,
     /// Index of glTF's default material in `scene.materials`, once a primitive needs it.
     default_material: Option<usize>,
@@ -99,6 +106,7 @@ impl<'a> Loader<'a> {
             reader: AccessorReader { root, buffers },
             files,
             node_world: Vec::new(),
+            poses: HashMap::new(),
             scene: Scene::default(),
             default_material: None,
             vertex_count: 0,
@@ -131,8 +139,19 @@ impl<'a> Loader<'a> {
         }
         self.scene.textures = materials.textures;
         self.scene.warnings.extend(materials.warnings);
+        if let Some((index, time)) = options.animation {
+            if !time.is_finite() {
+                return Err(format!("--time {time} is not a finite number of seconds"));
+            }
+            self.poses = animation::sample(root, &self.reader, index, time)?;
+        } else if !root.animations.is_empty() {
+            self.scene.warnings.push(format!(
+                "the file has {} animation(s); drawn at rest (--animation N --time T poses it)",
+                root.animations.len()
+            ));
+        }
         if !root.skins.is_empty() {
-            self.node_world = node_world_matrices(root)?;
+            self.node_world = node_world_matrices(root, &self.poses)?;
         }
         self.walk(&roots)?;
         Ok(self.scene)
@@ -200,7 +219,7 @@ impl<'a> Loader<'a> {
                 ));
             }
             *seen = true;
-            let world = parent * local_transform(index, node)?;
+            let world = parent * local_transform(index, node, self.poses.get(&index))?;
             self.visit(index, node, &world)?;
             for &child in node.children.iter().rev() {
                 lookup(&root.nodes, child, &format!("node {index}"), "child node")?;
@@ -220,7 +239,8 @@ impl<'a> Loader<'a> {
                 Some(n) => format!("mesh '{n}'"),
                 None => format!("mesh {m}"),
             };
-            let weights = node.weights.as_deref().or(mesh.weights.as_deref()).unwrap_or(&[]);
+            let posed = self.poses.get(&index).and_then(|p| p.weights.clone());
+            let weights = posed.as_deref().or(node.weights.as_deref()).or(mesh.weights.as_deref()).unwrap_or(&[]);
             let joints = match node.skin {
                 Some(skin) => Some(self.joint_matrices(index, skin)?),
                 None => None,
@@ -653,7 +673,7 @@ fn f32s_slice(m: &[f64]) -> Vec<f64> {
 
 /// Every node's world matrix, walked down from each node that is no node's child with an explicit stack; a node
 /// reached twice keeps its first matrix (the scene walk reports the malformed hierarchy if it draws it).
-fn node_world_matrices(root: &Root) -> Result<Vec<Option<DMat4>>, String> {
+fn node_world_matrices(root: &Root, poses: &HashMap<u64, NodePose>) -> Result<Vec<Option<DMat4>>, String> {
     let n = root.nodes.len();
     let mut is_child = vec![false; n];
     for node in &root.nodes {
@@ -669,7 +689,7 @@ fn node_world_matrices(root: &Root) -> Result<Vec<Option<DMat4>>, String> {
         if world[i].is_some() {
             continue;
         }
-        let m = parent * local_transform(i as u64, &root.nodes[i])?;
+        let m = parent * local_transform(i as u64, &root.nodes[i], poses.get(&(i as u64)))?;
         world[i] = Some(m);
         for &c in &root.nodes[i].children {
             if (c as usize) < n {
@@ -680,16 +700,22 @@ fn node_world_matrices(root: &Root) -> Result<Vec<Option<DMat4>>, String> {
     Ok(world)
 }
 
-fn local_transform(index: u64, node: &NodeDef) -> Result<DMat4, String> {
-    let m = match node.matrix {
-        Some(matrix) => DMat4::from_cols_array(&f32s(matrix)),
-        None => {
+/// A node's local matrix: its matrix, or its TRS with any property the sampled animation drives replaced
+/// (glTF animates only TRS nodes).
+fn local_transform(index: u64, node: &NodeDef, pose: Option<&NodePose>) -> Result<DMat4, String> {
+    let posed = pose.filter(|p| p.translation.is_some() || p.rotation.is_some() || p.scale.is_some());
+    let m = match (node.matrix, posed) {
+        (Some(matrix), None) => DMat4::from_cols_array(&f32s(matrix)),
+        _ => {
             let q = DQuat::from_array(f32s(node.rotation.unwrap_or([0.0, 0.0, 0.0, 1.0])));
+            let q = posed.and_then(|p| p.rotation).unwrap_or(q);
             let q = if q.length_squared() > 0.0 { q.normalize() } else { DQuat::NAN };
+            let scale = DVec3::from_array(f32s(node.scale.unwrap_or([1.0; 3])));
+            let translation = DVec3::from_array(f32s(node.translation.unwrap_or([0.0; 3])));
             DMat4::from_scale_rotation_translation(
-                DVec3::from_array(f32s(node.scale.unwrap_or([1.0; 3]))),
+                posed.and_then(|p| p.scale).unwrap_or(scale),
                 q,
-                DVec3::from_array(f32s(node.translation.unwrap_or([0.0; 3]))),
+                posed.and_then(|p| p.translation).unwrap_or(translation),
             )
         }
     };

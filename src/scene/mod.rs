@@ -7,6 +7,7 @@
 //!
 //! Axes are glTF's: right-handed, +Y up, metres.
 
+pub mod animation;
 pub mod camera;
 pub mod deform;
 mod gltf;
