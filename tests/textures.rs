@@ -420,3 +420,45 @@ fn pixels_at_texture_discontinuities_are_flagged_fragile() {
         assert!(fragile.iter().all(|&f| f == want), "filter {filter} {alpha_mode}: {fragile:?}");
     }
 }
+
+#[test]
+fn quantized_texture_coordinates_equal_their_float_twin() {
+    // KHR_mesh_quantization: TEXCOORD_0 as normalized unsigned shorts (0 and 65535 are exactly 0 and 1) gives the
+    // image of the float coordinates, bit for bit, on both renderers.
+    let (w, h) = (4u32, 3u32);
+    let t = ramp(w, h);
+    let float = textured_square(&t, w, h, 9729, 33071, json!({}));
+    let dir = TempDir::new("quantized-uv");
+    let mut b = GltfBuilder::new();
+    let image = b.add_png_image(&png_rgba8(w, h, &t));
+    let tex = b.add_texture(image, Some(9729), Some(9729), [33071, 33071]);
+    let mat = b.add_material_json(json!({
+        "pbrMetallicRoughness": { "baseColorTexture": { "index": tex }, "baseColorFactor": [1.0, 0.5, 0.25, 1.0], "metallicFactor": 0.0 }
+    }));
+    let mb = one_mesh(b, &[square(0.0, mat, None)]);
+    let mut doc = mb.document(Some("q.bin"));
+    let mut bin = mb.bin().to_vec();
+    let offset = bin.len();
+    for uv in [[0u16, 65535], [65535, 65535], [65535, 0], [0, 0]] {
+        bin.extend(uv.iter().flat_map(|c| c.to_le_bytes()));
+    }
+    doc["buffers"][0]["byteLength"] = json!(bin.len());
+    let view = doc["bufferViews"].as_array().unwrap().len();
+    doc["bufferViews"].as_array_mut().unwrap().push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": 16 }));
+    let acc = doc["accessors"].as_array().unwrap().len();
+    doc["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "bufferView": view, "componentType": 5123, "normalized": true, "count": 4, "type": "VEC2" }));
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = json!(acc);
+    doc["extensionsUsed"] = json!(["KHR_mesh_quantization"]);
+    doc["extensionsRequired"] = json!(["KHR_mesh_quantization"]);
+    std::fs::write(dir.path("q.bin"), &bin).unwrap();
+    std::fs::write(dir.path("q.gltf"), doc.to_string()).unwrap();
+    let quantized = load(&dir.path("q.gltf"));
+    assert_eq!(quantized.meshes[0].tex_coords[0], float.meshes[0].tex_coords[0]);
+    let s = settings(24, DVec3::Z);
+    let (a, b) = (both(&quantized, &s), both(&float, &s));
+    assert_eq!(common::bits(&a[0]), common::bits(&b[0]));
+    assert_eq!(common::bits(&a[1]), common::bits(&b[1]));
+}
