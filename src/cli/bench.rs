@@ -121,18 +121,12 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         rows.extend(bench_scenes(&mut renderer, &scenes, a, (width, height))?);
     }
     let info = info.expect("at least one mode");
-    let mut out = String::new();
-    out += &format!(
-        "Measured by `sunshade bench` on {}: {}; Vulkan device {}; {} build; {}×{} pixels; \
-         median of {} warm runs; tolerance {:e} relative with a floor of 1% of the peak.\n\n",
-        today(),
-        machine(),
-        device_description(&info),
-        build(),
-        width,
-        height,
+    let mut out = measured_by(
+        "sunshade bench",
+        &info,
+        (width, height),
         a.repeat,
-        a.fail_rel,
+        &format!("tolerance {:e} relative with a floor of 1% of the peak", a.fail_rel),
     );
     out += "| scene | interpolation | triangles | covered px | coverage mismatches | px over tolerance | max rel (interior) | max rel (all) | RMSE [W/(m²·sr)] | GPU frame [ms] | CPU reference [ms] | CPU / GPU |\n";
     out += "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
@@ -150,6 +144,25 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         eprintln!("sunshade bench: updated {}", doc.display());
     }
     Ok(())
+}
+
+/// The first line of a generated table: the command, the date, the machine, the device, the build, the image size,
+/// the repetitions and what else the table's reader needs (`tail`).
+pub(super) fn measured_by(
+    command: &str,
+    info: &DeviceInfo,
+    (width, height): (u32, u32),
+    repeat: u32,
+    tail: &str,
+) -> String {
+    format!(
+        "Measured by `{command}` on {}: {}; Vulkan device {}; {} build; {width}×{height} pixels; median of {repeat} warm \
+         runs; {tail}.\n\n",
+        today(),
+        machine(),
+        device_description(info),
+        build(),
+    )
 }
 
 pub(super) fn device_description(info: &DeviceInfo) -> String {

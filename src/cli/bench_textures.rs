@@ -7,8 +7,8 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::bench::{build, device_description, median, ms, BenchArgs};
-use super::generated::{machine, print_output, today, update_region};
+use super::bench::{measured_by, median, ms, BenchArgs};
+use super::generated::{print_output, update_region};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
 use crate::cpu::{self, ReferenceOptions};
@@ -60,16 +60,12 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let info = renderer.device_info().clone();
     let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
-    let mut out = format!(
-        "Measured by `sunshade bench --textures` on {}: {}; Vulkan device {}; {} build; {}×{} pixels; median of {} \
-         warm runs; unshadowed; GPU vs reference at the default tolerance of `render --check`.\n\n",
-        today(),
-        machine(),
-        device_description(&info),
-        build(),
-        width,
-        height,
+    let mut out = measured_by(
+        "sunshade bench --textures",
+        &info,
+        (width, height),
         a.repeat,
+        "unshadowed; GPU vs reference at the default tolerance of `render --check`",
     );
     out += "| scene | textures | texels (all levels) | GPU frame textured [ms] | untextured [ms] | textured / untextured | CPU reference textured [ms] | untextured [ms] | GPU vs reference: max rel | px over tolerance |\n";
     out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";

@@ -69,46 +69,34 @@ impl ScenePipeline {
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
-            // 0 materials, 1 lights, 2 indices, 3 vertices: all read by the fragment shader; 4 the scene's top-level
-            // acceleration structure, on devices with ray queries.
-            // 8 the texture table (texture_filter.glsl).
-            let mut bindings: Vec<_> = [0, 1, 2, 3, 8]
-                .map(|b| {
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(b)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .descriptor_count(1)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-                })
-                .to_vec();
-            // 7: the texels (a uniform texel buffer: maxStorageBufferRange is 128 MiB on lavapipe, a texel buffer
-            // holds maxTexelBufferElements texels).
-            bindings.push(
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(7)
-                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-            );
-            // 5: the sun's shadow map, 6: the first disks' (always bound: 1 × 1 maps until a shadow pass ran).
-            for (binding, count) in [(5, 1), (6, MAX_DISK_MAPS as u32)] {
-                bindings.push(
+            // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table (storage
+            // buffers); 7 the texels (a uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel
+            // buffer holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always
+            // bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices
+            // with ray queries. All read by the fragment shader. The descriptor pool is sized from the same table.
+            let mut table = vec![
+                (0, vk::DescriptorType::STORAGE_BUFFER, 1),
+                (1, vk::DescriptorType::STORAGE_BUFFER, 1),
+                (2, vk::DescriptorType::STORAGE_BUFFER, 1),
+                (3, vk::DescriptorType::STORAGE_BUFFER, 1),
+                (8, vk::DescriptorType::STORAGE_BUFFER, 1),
+                (7, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
+                (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+                (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
+            ];
+            if ray_query_spirv.is_some() {
+                table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
+            }
+            let bindings: Vec<_> = table
+                .iter()
+                .map(|&(binding, ty, count)| {
                     vk::DescriptorSetLayoutBinding::default()
                         .binding(binding)
-                        .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+                        .descriptor_type(ty)
                         .descriptor_count(count)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-                );
-            }
-            if ray_query_spirv.is_some() {
-                bindings.push(
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(4)
-                        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
-                        .descriptor_count(1)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-                );
-            }
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                })
+                .collect();
             out.set_layout = d
                 .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
                 .vk("vkCreateDescriptorSetLayout")?;
@@ -123,19 +111,12 @@ impl ScenePipeline {
                     None,
                 )
                 .vk("vkCreatePipelineLayout")?;
-            let mut pool_sizes = vec![
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: 5 },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::UNIFORM_TEXEL_BUFFER, descriptor_count: 1 },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                    descriptor_count: 1 + MAX_DISK_MAPS as u32,
-                },
-            ];
-            if ray_query_spirv.is_some() {
-                pool_sizes.push(vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
-                    descriptor_count: 1,
-                });
+            let mut pool_sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+            for &(_, ty, count) in &table {
+                match pool_sizes.iter_mut().find(|p| p.ty == ty) {
+                    Some(p) => p.descriptor_count += count,
+                    None => pool_sizes.push(vk::DescriptorPoolSize { ty, descriptor_count: count }),
+                }
             }
             out.descriptor_pool = d
                 .create_descriptor_pool(
