@@ -128,17 +128,24 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
     uint indices[];
 };
 
-// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space),
-// TEXCOORD_0 uv, TEXCOORD_1 uv, COLOR_0 rgba; the offsets below (gpu::layout::Vertex).
-#define FLOATS_PER_VERTEX 18u
+// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space);
+// the offsets below (gpu::layout::Vertex).
+#define FLOATS_PER_VERTEX 10u
 #define VERTEX_POSITION 0u
 #define VERTEX_NORMAL 3u
 #define VERTEX_TANGENT 6u
-#define VERTEX_UV0 10u
-#define VERTEX_UV1 12u
-#define VERTEX_COLOR 14u
 layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
     float vertex_data[];
+};
+
+// FLOATS_PER_SURFACE_VERTEX floats per vertex, read only by textured materials: TEXCOORD_0 uv, TEXCOORD_1 uv,
+// COLOR_0 rgba (gpu::layout::SurfaceVertex).
+#define FLOATS_PER_SURFACE_VERTEX 8u
+#define SURFACE_VERTEX_UV0 0u
+#define SURFACE_VERTEX_UV1 2u
+#define SURFACE_VERTEX_COLOR 4u
+layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
+    float surface_data[];
 };
 
 // Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with

@@ -24,9 +24,14 @@ vec3 vertex_vec3(uint index, uint offset) {
     return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
 }
 
-vec2 vertex_vec2(uint index, uint offset) {
-    uint base = index * FLOATS_PER_VERTEX + offset;
-    return vec2(vertex_data[base], vertex_data[base + 1u]);
+vec2 surface_vec2(uint index, uint offset) {
+    uint base = index * FLOATS_PER_SURFACE_VERTEX + offset;
+    return vec2(surface_data[base], surface_data[base + 1u]);
+}
+
+vec4 surface_vec4(uint index, uint offset) {
+    uint base = index * FLOATS_PER_SURFACE_VERTEX + offset;
+    return vec4(surface_data[base], surface_data[base + 1u], surface_data[base + 2u], surface_data[base + 3u]);
 }
 
 vec4 vertex_vec4(uint index, uint offset) {
@@ -60,10 +65,10 @@ SurfaceSample surface_sample() {
     REAL3 below = triangle_barycentrics_exact(c0, c1, c2, pixel_ndc(gl_FragCoord.xy + vec2(0.0, 1.0)));
     SurfaceSample s;
     for (uint set = 0u; set < 2u; ++set) {
-        uint offset = set == 0u ? VERTEX_UV0 : VERTEX_UV1;
-        REAL2 a = REAL2(vertex_vec2(i0, offset));
-        REAL2 b = REAL2(vertex_vec2(i1, offset));
-        REAL2 c = REAL2(vertex_vec2(i2, offset));
+        uint offset = set == 0u ? SURFACE_VERTEX_UV0 : SURFACE_VERTEX_UV1;
+        REAL2 a = REAL2(surface_vec2(i0, offset));
+        REAL2 b = REAL2(surface_vec2(i1, offset));
+        REAL2 c = REAL2(surface_vec2(i2, offset));
         precise REAL2 at_centre = centre.x * a + centre.y * b + centre.z * c;
         precise REAL2 at_right = right.x * a + right.y * b + right.z * c;
         precise REAL2 at_below = below.x * a + below.y * b + below.z * c;
@@ -73,8 +78,8 @@ SurfaceSample surface_sample() {
     }
     s.color = vec4(1.0);
     if ((VARIANT_SURFACE & SURFACE_COLORS) != 0u) {
-        precise REAL4 color = centre.x * REAL4(vertex_vec4(i0, VERTEX_COLOR)) + centre.y * REAL4(vertex_vec4(i1, VERTEX_COLOR))
-            + centre.z * REAL4(vertex_vec4(i2, VERTEX_COLOR));
+        precise REAL4 color = centre.x * REAL4(surface_vec4(i0, SURFACE_VERTEX_COLOR))
+            + centre.y * REAL4(surface_vec4(i1, SURFACE_VERTEX_COLOR)) + centre.z * REAL4(surface_vec4(i2, SURFACE_VERTEX_COLOR));
         s.color = vec4(color);
     }
     return s;

@@ -169,5 +169,9 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
 /// The reference carries every vertex attribute the GPU's vertex layout holds, in the same order.
 #[test]
 fn vertex_layout_matches_the_references_attributes() {
-    assert_eq!(sunshade::cpu::clip::ATTRIBUTES * 4, std::mem::size_of::<sunshade::gpu::layout::Vertex>());
+    use sunshade::gpu::layout::{SurfaceVertex, Vertex};
+    assert_eq!(
+        sunshade::cpu::clip::ATTRIBUTES * 4,
+        std::mem::size_of::<Vertex>() + std::mem::size_of::<SurfaceVertex>()
+    );
 }

@@ -76,15 +76,24 @@ impl ShaderVariant {
     }
 }
 
-/// One vertex: world position [m], unit normal, unit tangent and handedness, TEXCOORD_0, TEXCOORD_1 and COLOR_0
-/// (white where the mesh has none), interleaved (`FLOATS_PER_VERTEX` = 18 floats and the `VERTEX_*` offsets in
-/// the shaders; `cpu::clip::ATTRIBUTES` in the reference).
+/// One vertex: world position [m], unit normal, unit tangent and handedness, interleaved (`FLOATS_PER_VERTEX` =
+/// 10 floats and the `VERTEX_*` offsets in the shaders). What only textured materials read is in
+/// [`SurfaceVertex`], a buffer of its own, so that untextured draws fetch what they did before textures existed
+/// (and a storage buffer of `maxStorageBufferRange`, 128 MiB on lavapipe, holds 3.3 M vertices).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub tangent: [f32; 4],
+}
+
+/// A vertex's surface attributes: TEXCOORD_0, TEXCOORD_1 and COLOR_0 (white where the mesh has none)
+/// (`FLOATS_PER_SURFACE_VERTEX` = 8 and the `SURFACE_VERTEX_*` offsets in the shaders). With [`Vertex`], the
+/// reference's `cpu::clip::ATTRIBUTES`, in the same order.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SurfaceVertex {
     pub uv0: [f32; 2],
     pub uv1: [f32; 2],
     pub color: [f32; 4],
@@ -351,13 +360,15 @@ mod tests {
         assert!(glsl.contains("#define NO_TEXTURE 0xffffffffu\n"));
         // The vertex layout: FLOATS_PER_VERTEX and each attribute's offset in floats.
         assert!(glsl.contains(&format!("#define FLOATS_PER_VERTEX {}u\n", std::mem::size_of::<Vertex>() / 4)));
+        let surface = std::mem::size_of::<SurfaceVertex>() / 4;
+        assert!(glsl.contains(&format!("#define FLOATS_PER_SURFACE_VERTEX {surface}u\n")));
         for (name, offset) in [
             ("VERTEX_POSITION", std::mem::offset_of!(Vertex, position)),
             ("VERTEX_NORMAL", std::mem::offset_of!(Vertex, normal)),
             ("VERTEX_TANGENT", std::mem::offset_of!(Vertex, tangent)),
-            ("VERTEX_UV0", std::mem::offset_of!(Vertex, uv0)),
-            ("VERTEX_UV1", std::mem::offset_of!(Vertex, uv1)),
-            ("VERTEX_COLOR", std::mem::offset_of!(Vertex, color)),
+            ("SURFACE_VERTEX_UV0", std::mem::offset_of!(SurfaceVertex, uv0)),
+            ("SURFACE_VERTEX_UV1", std::mem::offset_of!(SurfaceVertex, uv1)),
+            ("SURFACE_VERTEX_COLOR", std::mem::offset_of!(SurfaceVertex, color)),
         ] {
             assert!(glsl.contains(&format!("#define {name} {}u\n", offset / 4)), "bindings.glsl: {name}");
         }
@@ -386,6 +397,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
         assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
-        assert_eq!(std::mem::size_of::<Vertex>(), 72);
+        assert_eq!(std::mem::size_of::<Vertex>(), 40);
+        assert_eq!(std::mem::size_of::<SurfaceVertex>(), 32);
     }
 }

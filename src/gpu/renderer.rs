@@ -12,8 +12,8 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, push_constants, texture_buffers, MaterialGpu, PushConstants, ShaderVariant, Vertex,
-    MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
+    lights_bytes, material_gpu, push_constants, texture_buffers, MaterialGpu, PushConstants, ShaderVariant,
+    SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
@@ -60,6 +60,8 @@ pub struct GpuScene {
     /// Every texture's levels as linear RGBA f32, and the texture table (headers and level records).
     texels: TexelBuffer,
     texture_table: Buffer,
+    /// Texture coordinates and colours per vertex (`SurfaceVertex`), read by textured materials.
+    surface_vertices: Buffer,
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
@@ -257,6 +259,7 @@ impl Renderer {
     /// Copies a scene's triangles and materials to the device.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene, GpuError> {
         let mut vertices = Vec::new();
+        let mut surface_vertices = Vec::new();
         let mut indices = Vec::new();
         let mut draws = Vec::new();
         // With ray queries: every triangle's indices into the whole vertex buffer, for the acceleration structure.
@@ -278,11 +281,13 @@ impl Renderer {
             if rq {
                 global_indices.extend(mesh.indices.iter().map(|&i| i + vertex_offset as u32));
             }
-            let uv = |set: usize, i: usize| mesh.tex_coords[set].get(i).copied().unwrap_or([0.0; 2]);
             vertices.extend((0..mesh.positions.len()).map(|i| Vertex {
                 position: mesh.positions[i].to_array(),
                 normal: mesh.normals[i].to_array(),
                 tangent: mesh.tangents[i].to_array(),
+            }));
+            let uv = |set: usize, i: usize| mesh.tex_coords[set].get(i).copied().unwrap_or([0.0; 2]);
+            surface_vertices.extend((0..mesh.positions.len()).map(|i| SurfaceVertex {
                 uv0: uv(0, i),
                 uv1: uv(1, i),
                 color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
@@ -294,7 +299,7 @@ impl Renderer {
         let (texels, texture_table) = texture_buffers(scene);
         let limit = self.dev.info.max_storage_buffer_range as u64;
         let vertex_bytes = std::mem::size_of_val(&vertices[..]) as u64;
-        if vertex_bytes > limit {
+        if vertex_bytes.max(std::mem::size_of_val(&surface_vertices[..]) as u64) > limit {
             return Err(GpuError::TooLarge(format!(
                 "the scene's {} vertices take {:.1} MiB; {} binds at most {:.1} MiB in one storage buffer",
                 vertices.len(),
@@ -316,6 +321,15 @@ impl Renderer {
             )));
         }
         let texels = TexelBuffer::with_texels(&self.dev, &texels, "texels")?;
+        if surface_vertices.is_empty() {
+            surface_vertices.push(SurfaceVertex::zeroed());
+        }
+        let surface_vertices = Buffer::with_data(
+            &self.dev,
+            bytemuck::cast_slice(&surface_vertices),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            "surface vertices",
+        )?;
         let texture_table = Buffer::with_data(
             &self.dev,
             bytemuck::cast_slice(&texture_table),
@@ -371,6 +385,7 @@ impl Renderer {
             )?,
             texels,
             texture_table,
+            surface_vertices,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
             // ray queries warns that `auto` has no shadows for this scene.
@@ -548,13 +563,14 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                // 8 the texture table.
+                // 8 the texture table, 9 the surface vertices.
                 let buffers = [
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
                     (2, ib.buffer),
                     (3, vb.buffer),
                     (8, scene.texture_table.buffer),
+                    (9, scene.surface_vertices.buffer),
                 ];
                 let infos = buffers
                     .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]));
