@@ -1,6 +1,7 @@
 //! The scene in world units: triangle meshes in metres, materials, cameras and lights in radiometric units.
 //!
-//! This is the only module that knows glTF ([`load`], reading files through `gltf`, which treats them as untrusted). Geometry is flattened once while loading: node transforms
+//! This is the only module that knows glTF ([`load`], reading files through `gltf`, which treats them as untrusted;
+//! textures are decoded here once, to linear f32 with their mip chains). Geometry is flattened once while loading: node transforms
 //! are applied (in f64, rounded once to f32), normals are carried by the inverse transpose, triangles of mirrored
 //! nodes are re-wound so that counter-clockwise is the front face everywhere, and flat normals are generated where
 //! the file has none. Both renderers therefore consume exactly the same `f32` triangles.
@@ -14,6 +15,7 @@ mod gltf;
 pub mod light;
 mod load;
 mod load_material;
+mod load_mesh;
 pub mod material;
 pub mod tangent;
 pub mod texture;
