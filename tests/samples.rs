@@ -63,3 +63,25 @@ fn gpu_agrees_with_the_reference_on_every_sample() {
         }
     }
 }
+
+#[test]
+fn max_texture_size_starts_large_textures_at_a_smaller_level() {
+    // AlphaBlendModeTest's 2048² textures drawn from their 256² level: the same texels as that level of the full
+    // chain, and GPU and reference still agree.
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("models/gltf-samples/AlphaBlendModeTest/AlphaBlendModeTest.glb");
+    let full = sunshade::scene::load(&path).unwrap();
+    let options = sunshade::scene::LoadOptions { max_texture_size: Some(256), ..Default::default() };
+    let small = sunshade::scene::load_with_options(&path, &options).unwrap();
+    for (f, s) in full.textures.iter().zip(&small.textures) {
+        let first = &s.levels[0];
+        assert!(first.width.max(first.height) <= 256);
+        let k = f.levels.len() - s.levels.len();
+        assert_eq!(&f.levels[k..], &s.levels[..], "{}", f.name);
+    }
+    let mut gpu = CheckedRenderer::new();
+    let job = testing::job(&path, &["--width", "96", "--height", "80", "--max-texture-size", "256"]).unwrap();
+    let image = gpu.render_job(&job).unwrap();
+    let reference = testing::reference(&job, &gpu.reference_options()).unwrap();
+    testing::check_close(&image, &reference, &DiffOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+}

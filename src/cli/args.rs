@@ -151,6 +151,11 @@ pub struct SceneArgs {
     #[arg(help_heading = "Scene", long, value_name = "N")]
     pub animation: Option<usize>,
 
+    /// Textures larger than N texels on a side are drawn from their first mip level that fits (less memory; the
+    /// same in both renderers).
+    #[arg(help_heading = "Scene", long, value_name = "N", value_parser = parse_pixels)]
+    pub max_texture_size: Option<u32>,
+
     /// The time of --animation [s] (before its first keyframe the first holds, after the last the last).
     #[arg(help_heading = "Scene", long, value_name = "SECONDS", requires = "animation", allow_negative_numbers = true)]
     pub animation_time: Option<f64>,
@@ -277,7 +282,7 @@ impl SceneArgs {
             (None, false) => UriScope::SceneFolder,
         };
         let animation = self.animation.map(|n| (n, self.animation_time.unwrap_or(0.0)));
-        LoadOptions { scene: self.scene_index, uris, animation }
+        LoadOptions { scene: self.scene_index, uris, animation, max_texture_size: self.max_texture_size }
     }
 
     pub fn camera_options(&self) -> CameraOptions {

@@ -313,7 +313,8 @@ impl Renderer {
         if texels.len() > texel_limit || texel_bytes > self.dev.info.max_memory_allocation_size {
             return Err(GpuError::TooLarge(format!(
                 "the scene's textures and their mip levels are {} texels ({:.1} MiB as f32 RGBA); {} reads at most \
-                 {texel_limit} from one texel buffer in one allocation of {:.1} MiB",
+                 {texel_limit} from one texel buffer in one allocation of {:.1} MiB (--max-texture-size N draws \
+                 large textures from a smaller mip level)",
                 texels.len(),
                 texel_bytes as f64 / (1 << 20) as f64,
                 self.dev.info.name,

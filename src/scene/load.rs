@@ -54,6 +54,9 @@ pub struct LoadOptions {
     /// Pose the scene by animation N at time T [s] (`--animation N --time T`); `None`: the file's own transforms
     /// and weights (the rest pose).
     pub animation: Option<(usize, f64)>,
+    /// Textures larger than this many texels on a side start at their first mip level that fits
+    /// (`--max-texture-size`; `None`: as the images are).
+    pub max_texture_size: Option<u32>,
 }
 
 /// Loads the default scene of a glTF file.
@@ -131,6 +134,7 @@ impl<'a> Loader<'a> {
             ));
         }
         let mut materials = MaterialReader::new(root, self.reader.buffers, self.files);
+        materials.max_texture_size = options.max_texture_size;
         for (index, material) in root.materials.iter().enumerate() {
             let m = materials.read(index, material)?;
             self.scene.materials.push(m);

@@ -28,6 +28,8 @@ pub struct MaterialReader<'a> {
     pub warnings: Vec<String>,
     /// What is left of the scene's texel budget.
     texels_left: u64,
+    /// `--max-texture-size`: textures larger on either side start at their first mip level that fits.
+    pub max_texture_size: Option<u32>,
 }
 
 impl<'a> MaterialReader<'a> {
@@ -40,6 +42,7 @@ impl<'a> MaterialReader<'a> {
             textures: Vec::new(),
             warnings: Vec::new(),
             texels_left: MAX_SCENE_TEXELS,
+            max_texture_size: None,
         }
     }
 
@@ -208,7 +211,11 @@ impl<'a> MaterialReader<'a> {
         };
         let (bytes, _mime) = image_bytes(root, self.buffers, self.files, source, &what)?;
         let level0 = decode(&bytes, space, &format!("{what} image {source}"), &mut self.texels_left)?;
-        self.textures.push(Texture::new(format!("{what} (image {source})"), level0, sampler));
+        let mut texture = Texture::new(format!("{what} (image {source})"), level0, sampler);
+        if let Some(max) = self.max_texture_size {
+            texture.limit_size(max);
+        }
+        self.textures.push(texture);
         let index = self.textures.len() - 1;
         self.cache.insert(key, index);
         Ok(Some(TextureRef { texture: index, tex_coord: tex_coord as u32, transform: matrix }))

@@ -111,6 +111,16 @@ impl Texture {
     pub fn new(name: String, level0: Level, sampler: Sampler) -> Self {
         Self { name, levels: mip_chain(level0), sampler }
     }
+
+    /// Drops the levels larger than `max_side` texels on either side, so that the first level kept is the image
+    /// (`--max-texture-size`: the box-filtered level of that size stands for it, everywhere both renderers look
+    /// it up). Returns how many levels were dropped.
+    pub fn limit_size(&mut self, max_side: u32) -> usize {
+        let keep_from =
+            self.levels.iter().position(|l| l.width.max(l.height) <= max_side.max(1)).unwrap_or(self.levels.len() - 1);
+        self.levels.drain(..keep_from);
+        keep_from
+    }
 }
 
 /// A material's use of a texture: which one, which texture-coordinate set, and the affine map applied to the
@@ -220,6 +230,17 @@ mod tests {
         assert_eq!(l[1].texels, vec![[2.0; 4]]);
         assert_eq!(level_count(1, 1), 1);
         assert_eq!(level_count(1024, 3), 11);
+    }
+
+    #[test]
+    fn limiting_the_size_keeps_the_smaller_levels() {
+        let level0 = Level { width: 8, height: 2, texels: vec![[1.0; 4]; 16] };
+        let mut t = Texture::new("t".into(), level0, Sampler::default());
+        assert_eq!(t.levels.len(), 4);
+        assert_eq!(t.limit_size(4), 1);
+        assert_eq!((t.levels[0].width, t.levels[0].height, t.levels.len()), (4, 1, 3));
+        assert_eq!(t.limit_size(0), 2);
+        assert_eq!((t.levels[0].width, t.levels.len()), (1, 1));
     }
 
     #[test]
