@@ -82,7 +82,7 @@ struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
     vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
     vec4 params; // x, y: Ward alpha_x, alpha_y
-    uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided
+    uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided; z: 1 if alpha MASK
     vec4 base;   // base colour factor (rgb linear, alpha)
     vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
     vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
@@ -146,6 +146,12 @@ layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
 #define SURFACE_VERTEX_COLOR 4u
 layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
     float surface_data[];
+};
+
+// Per triangle of the acceleration structure (its primitive order): global vertex indices, and the material
+// (bit 31: the mesh has vertex colours); read by shadow rays that meet alpha-masked triangles.
+layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
+    uvec4 occluder_triangles[];
 };
 
 // Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with

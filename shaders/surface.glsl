@@ -95,9 +95,24 @@ vec3 tangent_space_normal(MaterialGpu m, SurfaceSample s) {
     return n;
 }
 
-// The shading normal from a tangent-space normal in the frame (t, b, n).
+// The shading normal from a tangent-space normal in the frame (t, b, n); 0 where that vanishes (safe_normalize's
+// arithmetic, written out: this file is also included before shade.glsl, by visibility.glsl).
 vec3 perturbed_normal(vec3 tn, vec3 t, vec3 b, vec3 n) {
-    return safe_normalize(t * tn.x + b * tn.y + n * tn.z);
+    vec3 v = t * tn.x + b * tn.y + n * tn.z;
+    float len2 = dot(v, v);
+    return len2 > 0.0 ? v * inversesqrt(len2) : vec3(0.0);
+}
+
+// Whether a shadow ray's hit on an alpha-masked triangle blocks it: the base colour's alpha (factor x texture x
+// vertex colour, s.color white without colours) at the hit reaches the cutoff. The texture is read at the hit's
+// coordinates with no footprint (s.uv_x = s.uv_y = s.uv: level 0, magnification filter).
+bool masked_hit_blocks(MaterialGpu m, SurfaceSample s) {
+    precise float alpha = m.base.a;
+    if (m.tex[TEX_BASE].texture.x != NO_TEXTURE) {
+        alpha = alpha * material_texture(m.tex[TEX_BASE], s).a;
+    }
+    alpha = alpha * s.color.a;
+    return alpha_covers(m, alpha);
 }
 
 #endif

@@ -600,3 +600,110 @@ fn disk_light_maps_leave_a_lone_floor_bitwise_and_cut_the_room_s_shadow_error() 
     eprintln!("room: RMSE against rays, unshadowed {e_none:.3}, disk map {e_map:.3} W/(m²·sr)");
     assert!(e_map < 0.4 * e_none, "the disk's map: RMSE {e_map} against {e_none} unshadowed");
 }
+
+/// A floor (z = 0, 4 m square) and, 1 m above its left part, an alpha-masked square whose 2 × 2 texture
+/// (NEAREST) is opaque in two opposite quarters and cut away in the others; a delta sun from (−1, 0, 1), so the
+/// mask's shadow falls 1 m to the right of it, on the floor the orthographic camera looks down at.
+fn masked_cutout_scene() -> (Scene, RenderSettings) {
+    use serde_json::json;
+    use sunshade::authoring::{png_rgba8, GltfBuilder, Indices, Node, Primitive};
+    let dir = common::TempDir::new("masked-shadow");
+    let mut b = GltfBuilder::new();
+    let image = b.add_png_image(&png_rgba8(
+        2,
+        2,
+        &[[255, 255, 255, 255], [255, 255, 255, 0], [255, 255, 255, 0], [255, 255, 255, 255]],
+    ));
+    let tex = b.add_texture(image, Some(9728), Some(9728), [33071, 33071]);
+    let mask = b.add_material_json(json!({
+        "alphaMode": "MASK", "doubleSided": true,
+        "pbrMetallicRoughness": { "baseColorTexture": { "index": tex }, "metallicFactor": 0.0 }
+    }));
+    let floor = b.add_material("floor", [0.5; 3], false, None);
+    let square = |x0: f32, x1: f32, y0: f32, y1: f32, z: f32, material: usize| Primitive {
+        positions: vec![[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]],
+        normals: Some(vec![[0.0, 0.0, 1.0]; 4]),
+        tex_coords: Some(vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]),
+        colors: None,
+        indices: Some(Indices::U8(vec![0, 1, 2, 0, 2, 3])),
+        material: Some(material),
+        mode: None,
+    };
+    let m =
+        b.add_mesh("parts", &[square(-2.0, 2.0, -2.0, 2.0, 0.0, floor), square(-2.0, -0.5, -0.75, 0.75, 1.0, mask)]);
+    let n = b.add_node(Node { mesh: Some(m), ..Default::default() });
+    b.add_scene(&[n], None);
+    let scene = common::load(&dir.write("m.glb", &b));
+    let camera = Camera::looking(
+        DVec3::new(0.0, 0.0, 5.0),
+        -DVec3::Z,
+        DVec3::Y,
+        Projection::Orthographic { ymag: 2.0, znear: 1.0, zfar: 10.0 },
+    )
+    .unwrap();
+    let lights = Lights {
+        sun: Some(Sun {
+            direction: Vec3::new(-1.0, 0.0, 1.0).normalize(),
+            irradiance: [E_PERP; 3],
+            angular_diameter: 0.0,
+        }),
+        ..Default::default()
+    };
+    let mut s = RenderSettings::new(64, 64, camera, lights);
+    s.shading.sun = sunshade::shading::SunModel::Delta;
+    s.shading.shadows = Shadows::Ray;
+    (scene, s)
+}
+
+#[test]
+fn shadow_rays_pass_through_alpha_masked_cutouts() {
+    // The reference: a floor point in the mask's shadow is lit exactly where the ray towards the sun meets the
+    // mask's cut-away quarters (its texel's alpha 0), dark where it meets an opaque one.
+    let (scene, s) = masked_cutout_scene();
+    let image = cpu::render(&scene, &s, &ReferenceOptions::default());
+    let l = s.lights.sun.unwrap().direction.as_dvec3();
+    let lit = 0.5f32 as f64 / PI * E_PERP as f64 * l.z;
+    let (mut dark, mut through) = (0, 0);
+    for y in 0..64u32 {
+        for x in 0..64u32 {
+            // Pixel centre on the floor; the ray towards the sun meets z = 1 at x − 1.
+            let (wx, wy) = (-2.0 + (x as f64 + 0.5) / 16.0, 2.0 - (y as f64 + 0.5) / 16.0);
+            let (hx, hy) = (wx + l.x / l.z, wy);
+            let (u, v) = ((hx + 2.0) / 1.5, (0.75 - hy) / 1.5);
+            let on_mask_pixel = wx <= -0.5 && wy.abs() <= 0.75; // the camera sees the mask there
+            if on_mask_pixel || !(0.0..1.0).contains(&u) || !(0.0..1.0).contains(&v) {
+                continue;
+            }
+            if (u - 0.5).abs() < 0.02 || (v - 0.5).abs() < 0.02 || u < 0.02 || v < 0.02 || u > 0.98 || v > 0.98 {
+                continue; // at a texel or mask edge
+            }
+            let opaque = (u < 0.5) == (v < 0.5);
+            let got = image.get(x, y)[0] as f64;
+            if opaque {
+                assert_eq!(got, 0.0, "pixel ({x}, {y}) under an opaque quarter");
+                dark += 1;
+            } else {
+                assert!(common::rel(got, lit) < 1e-6, "pixel ({x}, {y}) under a cut-away quarter: {got} against {lit}");
+                through += 1;
+            }
+        }
+    }
+    assert!(dark > 50 && through > 50, "{dark} dark, {through} lit through the mask");
+}
+
+#[test]
+fn gpu_ray_queries_pass_light_through_alpha_masked_cutouts() {
+    let Some(mut gpu) = ray_query_renderer() else { return };
+    let (scene, s) = masked_cutout_scene();
+    let g = gpu.render(&scene, &s);
+    let (c, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &gpu.reference_options());
+    let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+    let at_fragile = report.over_tolerance_at(&fragile, g.width());
+    assert!(
+        report.over_tolerance.total == at_fragile,
+        "{} of {} pixels over tolerance are not fragile:\n{}",
+        report.over_tolerance.total - at_fragile,
+        report.over_tolerance.total,
+        report.text("gpu", "reference")
+    );
+}

@@ -21,6 +21,7 @@ pub mod barycentric;
 pub mod clip;
 mod fragment;
 pub mod interpolate;
+mod occluders;
 pub mod raster;
 pub mod transform;
 pub mod viewport;
@@ -32,6 +33,7 @@ use self::barycentric::{pixel_ndc, triangle_barycentrics};
 use self::clip::{clip_mask, clip_triangle, ClipVertex, ATTRIBUTES};
 use self::fragment::{covers, shade, surface_sample};
 use self::interpolate::Interpolator;
+pub use self::occluders::{occluder_bvh, Occluders};
 use self::raster::RasterTriangle;
 use self::transform::clip_position;
 use self::viewport::{snap, Viewport};
@@ -40,7 +42,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{discontinuity_margin as surface_discontinuity, surface_flags, SURFACE_ALPHA_MASK};
 use crate::shading::{Occlusion, Shadows};
-use crate::visibility::{Bvh, ShadowChoice};
+use crate::visibility::ShadowChoice;
 
 /// How the reference mirrors the device.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -128,21 +130,11 @@ pub fn shadow_choice(scene: &Scene, settings: &RenderSettings, options: &Referen
     crate::visibility::choose_reference(requested, &settings.lights, can_occlude, options.device_ray_queries)
 }
 
-/// Every triangle of the scene in world space, for the shadow rays.
-pub fn occluder_bvh(scene: &Scene) -> Bvh {
-    let triangles = scene
-        .meshes
-        .iter()
-        .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
-        .collect();
-    Bvh::new(triangles)
-}
-
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
     let occluders = match shadow_choice(scene, settings, options).technique {
         Shadows::None => None,
-        _ => Some(occluder_bvh(scene)),
+        _ => Some(Occluders::new(scene)),
     };
     render_inner(scene, settings, options, occluders.as_ref(), false).0
 }
@@ -170,16 +162,17 @@ pub fn render_with_fragile_pixels(
 ) -> (Image, Vec<bool>) {
     let occluders = match shadow_choice(scene, settings, options).technique {
         Shadows::None => None,
-        _ => Some(occluder_bvh(scene)),
+        _ => Some(Occluders::new(scene)),
     };
     let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true);
     let n = image.pixels().len();
     (image, fragile.unwrap_or_else(|| vec![false; n]))
 }
 
-/// A BVH that remembers whether any ray it answered was fragile (one per pixel).
+/// Occluders that remember whether any ray they answered was fragile (one per pixel): it grazed an edge, or met
+/// a masked triangle where its alpha is within [`FRAGILE_TEXTURE_RELATIVE`] of the cutoff.
 struct Recording<'a> {
-    bvh: &'a Bvh,
+    occluders: &'a Occluders<'a>,
     eps: f64,
     fragile: std::sync::atomic::AtomicBool,
 }
@@ -187,7 +180,10 @@ struct Recording<'a> {
 impl Occlusion for Recording<'_> {
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
         let Some(ray) = crate::visibility::WatertightRay::new(origin, direction) else { return false };
-        let (occluded, fragile) = self.bvh.occluded_with_margin(&ray, 0.0, t_max, self.eps);
+        let (occluded, fragile) = self.occluders.bvh.occluded_with_margin_where(&ray, 0.0, t_max, self.eps, |i, t| {
+            let (blocks, margin) = self.occluders.blocks(i, origin, direction, t);
+            (blocks, margin < FRAGILE_TEXTURE_RELATIVE)
+        });
         if fragile {
             self.fragile.store(true, std::sync::atomic::Ordering::Relaxed);
         }
@@ -201,7 +197,7 @@ fn render_inner(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
-    occluders: Option<&Bvh>,
+    occluders: Option<&Occluders>,
     fragile: bool,
 ) -> (Image, Option<Vec<bool>>) {
     let (width, height) = (settings.width, settings.height);
@@ -256,7 +252,7 @@ fn render_inner(
                 let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
                 let radiance = match (occluders, fragile) {
                     (Some(bvh), true) => {
-                        let rec = Recording { bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
+                        let rec = Recording { occluders: bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
                         let r = shade(scene, settings, t, (x, y), w.to_array(), viewer, Some(&rec));
                         if rec.fragile.load(std::sync::atomic::Ordering::Relaxed) {
                             flagged[k] = true;

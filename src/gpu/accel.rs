@@ -52,6 +52,7 @@ impl SceneAccel {
         vertex_count: u32,
         vertex_stride: u64,
         indices: &[u32],
+        opaque: bool,
     ) -> Result<Self, GpuError> {
         let loader = ash::khr::acceleration_structure::Device::new(&dev.instance.instance, &dev.device);
         let index_buffer = Buffer::with_data(
@@ -72,10 +73,17 @@ impl SceneAccel {
                     .max_vertex(vertex_count.saturating_sub(1))
                     .index_type(vk::IndexType::UINT32)
                     .index_data(vk::DeviceOrHostAddressConstKHR { device_address: index_address });
+                // Opaque unless a triangle is alpha-masked: then every candidate hit goes to the shader, which
+                // confirms it where the triangle's alpha reaches its cutoff (visibility.glsl).
+                let flags = if opaque {
+                    vk::GeometryFlagsKHR::OPAQUE
+                } else {
+                    vk::GeometryFlagsKHR::NO_DUPLICATE_ANY_HIT_INVOCATION
+                };
                 vk::AccelerationStructureGeometryKHR::default()
                     .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
                     .geometry(vk::AccelerationStructureGeometryDataKHR { triangles })
-                    .flags(vk::GeometryFlagsKHR::OPAQUE)
+                    .flags(flags)
             })
             .collect();
         let build_ranges = [vk::AccelerationStructureBuildRangeInfoKHR {

@@ -202,7 +202,7 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
         kd: [kd[0], kd[1], kd[2], 0.0],
         ks: [ks[0], ks[1], ks[2], exponent],
         params: [alpha[0], alpha[1], 0.0, 0.0],
-        kind: [kind, m.double_sided as u32, 0, 0],
+        kind: [kind, m.double_sided as u32, matches!(m.alpha, AlphaMode::Mask(_)) as u32, 0],
         base: [b[0], b[1], b[2], m.base_alpha],
         pbr: [m.pbr.metallic, m.pbr.roughness, m.normal_texture.map_or(1.0, |(_, s)| s), cutoff],
         emission: [m.emission[0], m.emission[1], m.emission[2], 0.0],

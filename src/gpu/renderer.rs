@@ -62,11 +62,15 @@ pub struct GpuScene {
     texture_table: Buffer,
     /// Texture coordinates and colours per vertex (`SurfaceVertex`), read by textured materials.
     surface_vertices: Buffer,
+    /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
+    occluder_triangles: Buffer,
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
     /// The scene's bounds (the sun's shadow map is fitted to them).
     bounds: Option<crate::scene::Aabb>,
+    /// Whether any material is alpha-masked (shadow rays test their alpha; shadow maps do not).
+    masked: bool,
 }
 
 impl GpuScene {
@@ -364,6 +368,7 @@ impl Renderer {
                 )
             })
             .transpose()?;
+        let masked = scene.materials.iter().any(|m| matches!(m.alpha, crate::scene::AlphaMode::Mask(_)));
         let accel = match &vertices {
             Some(vb) if rq && !global_indices.is_empty() => Some(SceneAccel::build(
                 &self.dev,
@@ -371,9 +376,31 @@ impl Renderer {
                 (vb.size / std::mem::size_of::<Vertex>() as u64) as u32,
                 std::mem::size_of::<Vertex>() as u64,
                 &global_indices,
+                !masked,
             )?),
             _ => None,
         };
+        // Per occluder triangle (the acceleration structure's primitive order): its global vertex indices and its
+        // material (bit 31: the mesh has vertex colours), for masked hits; one dummy record otherwise.
+        let mut occluder_triangles: Vec<[u32; 4]> = Vec::new();
+        if rq && masked {
+            for (mesh, draw) in scene.meshes.iter().zip(&draws) {
+                let colors = if mesh.colors.is_empty() { 0 } else { 1 << 31 };
+                occluder_triangles.extend(mesh.indices.chunks_exact(3).map(|t| {
+                    let o = draw.vertex_offset as u32;
+                    [t[0] + o, t[1] + o, t[2] + o, mesh.material as u32 | colors]
+                }));
+            }
+        }
+        if occluder_triangles.is_empty() {
+            occluder_triangles.push([0; 4]);
+        }
+        let occluder_triangles = Buffer::with_data(
+            &self.dev,
+            bytemuck::cast_slice(&occluder_triangles),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            "occluder triangles",
+        )?;
         Ok(GpuScene {
             accel,
             vertices,
@@ -387,11 +414,13 @@ impl Renderer {
             texels,
             texture_table,
             surface_vertices,
+            occluder_triangles,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
             // ray queries warns that `auto` has no shadows for this scene.
             can_occlude: crate::visibility::can_occlude(scene),
             bounds: scene.bounds(),
+            masked,
         })
     }
 
@@ -421,6 +450,10 @@ impl Renderer {
             }
             if settings.lights.sky.is_some() {
                 choice.reason += "; the sky has no shadow map: it is unoccluded";
+                choice.warning = true;
+            }
+            if scene.masked {
+                choice.reason += "; alpha-masked triangles cast shadows into the maps as if opaque";
                 choice.warning = true;
             }
         }
@@ -564,7 +597,7 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                // 8 the texture table, 9 the surface vertices.
+                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles.
                 let buffers = [
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
@@ -572,6 +605,7 @@ impl Renderer {
                     (3, vb.buffer),
                     (8, scene.texture_table.buffer),
                     (9, scene.surface_vertices.buffer),
+                    (10, scene.occluder_triangles.buffer),
                 ];
                 let infos = buffers
                     .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]));

@@ -124,6 +124,18 @@ pub fn alpha_covers(material: &Material, alpha: f32) -> bool {
     }
 }
 
+/// Whether a shadow ray's hit on an alpha-masked triangle blocks it, and how near its alpha is to the cutoff:
+/// the base colour's alpha at the hit (`s.uv_x = s.uv_y = s.uv`: no footprint, level 0 with the magnification
+/// filter) against the cutoff ([`alpha_covers`]).
+pub fn masked_hit_blocks(material: &Material, textures: &[Texture], s: &SurfaceSample) -> (bool, f64) {
+    let alpha = base_color(material, textures, s)[3];
+    let margin = match material.alpha {
+        AlphaMode::Mask(cutoff) => (alpha as f64 - cutoff as f64).abs(),
+        AlphaMode::Opaque | AlphaMode::Blend => f64::INFINITY,
+    };
+    (alpha_covers(material, alpha), margin)
+}
+
 /// Emitted radiance [W/(m²·sr)]: the material's emission times its emissive texture (sRGB decoded), in f32.
 pub fn emitted_radiance(material: &Material, textures: &[Texture], s: &SurfaceSample) -> [f32; 3] {
     let e = material.emission;

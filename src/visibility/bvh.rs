@@ -103,6 +103,23 @@ impl Bvh {
         self.traverse(ray, t_min, t_max, true).is_some()
     }
 
+    /// Whether the ray hits, with `t_min < t < t_max`, a triangle that `accept(index, t)` accepts (a hit on an
+    /// alpha-masked triangle where its alpha is below the cutoff is passed through).
+    pub fn any_hit_where(
+        &self,
+        ray: &WatertightRay,
+        t_min: f64,
+        t_max: f64,
+        mut accept: impl FnMut(usize, f64) -> bool,
+    ) -> bool {
+        let mut hit = false;
+        self.walk(ray, t_min, t_max, 0.0, |i, t_max| {
+            hit = ray.intersect(self.triangles[i], t_min, *t_max).is_some_and(|t| accept(i, t));
+            hit
+        });
+        hit
+    }
+
     /// The nearest hit with `t_min < t < t_max`: its `t` and the triangle's index as given to [`Bvh::new`].
     pub fn closest_hit(&self, ray: &WatertightRay, t_min: f64, t_max: f64) -> Option<(f64, usize)> {
         self.traverse(ray, t_min, t_max, false)
@@ -174,13 +191,32 @@ impl Bvh {
     /// hit farther than `eps` [m] inside its boundary, but one is hit, or missed, within `eps` of it, so that a
     /// few ulps of f32 geometry (the GPU's) could flip it. Boxes are padded by `eps` for this traversal.
     pub fn occluded_with_margin(&self, ray: &WatertightRay, t_min: f64, t_max: f64, eps: f64) -> (bool, bool) {
+        self.occluded_with_margin_where(ray, t_min, t_max, eps, |_, _| (true, false))
+    }
+
+    /// [`Bvh::occluded_with_margin`] counting only the hits `accept(index, t)` accepts; its second answer says
+    /// whether that acceptance is itself fragile (an alpha at its cutoff), which makes the ray's answer fragile.
+    pub fn occluded_with_margin_where(
+        &self,
+        ray: &WatertightRay,
+        t_min: f64,
+        t_max: f64,
+        eps: f64,
+        mut accept: impl FnMut(usize, f64) -> (bool, bool),
+    ) -> (bool, bool) {
         let (mut robust_hit, mut fragile_hit, mut near_miss) = (false, false, false);
         self.walk(ray, t_min, t_max, eps, |i, _| {
-            match ray.edge_margin(self.triangles[i], t_min, t_max) {
-                Some(d) if d > eps => robust_hit = true,
-                Some(d) if d >= 0.0 => fragile_hit = true,
-                Some(d) if d >= -eps => near_miss = true,
-                _ => {}
+            let Some(d) = ray.edge_margin(self.triangles[i], t_min, t_max).filter(|&d| d >= -eps) else {
+                return false;
+            };
+            let t = ray.hit_t(self.triangles[i]).unwrap_or(t_min);
+            // A hit the filter rejects is no hit; an acceptance that is itself fragile makes the answer fragile
+            // without changing it.
+            match accept(i, t) {
+                (true, false) if d > eps => robust_hit = true,
+                (true, _) if d >= 0.0 => fragile_hit = true,
+                (true, _) | (false, true) => near_miss = true,
+                (false, false) => {}
             }
             robust_hit
         });

@@ -84,6 +84,12 @@ impl WatertightRay {
         (t > t_min && t < t_max).then_some(t)
     }
 
+    /// The ray parameter of the point where the ray meets the triangle's plane (`None` for a ray in the plane),
+    /// whether or not it lies inside.
+    pub fn hit_t(&self, triangle: [DVec3; 3]) -> Option<f64> {
+        self.shear_triangle(triangle).plane_t()
+    }
+
     /// How far the ray passes from the boundary of the triangle `(a, b, c)`, where it meets the triangle's plane
     /// with `t_min < t < t_max` (`None` otherwise, or for a ray in the plane): in the sheared plane of the test,
     /// each edge function over its edge's length is the distance from the ray to that edge's line [m]; positive

@@ -1,0 +1,104 @@
+//! The reference's occluders: every triangle of the scene in a BVH, and for the triangles of alpha-masked
+//! materials what it takes to test their alpha where a shadow ray meets them, so that light passes where the
+//! mask cuts the surface away, as it does for the camera. Mirrored on the GPU by `occluded` in
+//! shaders/visibility.glsl (with `masked_hit_blocks`).
+//!
+//! The alpha at a hit is the base colour's (factor × texture × vertex colour) at the hit's barycentrics, the
+//! texture read from level 0 with its magnification filter: a shadow ray has no pixel footprint.
+
+use glam::DVec3;
+
+use crate::scene::{AlphaMode, Scene};
+use crate::shading::surface::{masked_hit_blocks, SurfaceSample};
+use crate::shading::Occlusion;
+use crate::visibility::{Bvh, WatertightRay};
+
+/// A masked triangle's material, corners [m], texture coordinates per set, and vertex alphas (if the mesh has
+/// colours).
+struct MaskedTriangle {
+    material: usize,
+    corners: [DVec3; 3],
+    uv: [[[f32; 2]; 3]; 2],
+    alpha: Option<[f32; 3]>,
+}
+
+/// The scene's triangles as occluders.
+pub struct Occluders<'a> {
+    pub bvh: Bvh,
+    /// Per BVH triangle (the scene's order), the masked ones' data.
+    masked: Vec<Option<MaskedTriangle>>,
+    scene: &'a Scene,
+}
+
+/// Every triangle of the scene in world space, for the shadow rays.
+pub fn occluder_bvh(scene: &Scene) -> Bvh {
+    let triangles = scene
+        .meshes
+        .iter()
+        .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
+        .collect();
+    Bvh::new(triangles)
+}
+
+impl<'a> Occluders<'a> {
+    pub fn new(scene: &'a Scene) -> Self {
+        let any_mask = scene.materials.iter().any(|m| matches!(m.alpha, AlphaMode::Mask(_)));
+        let masked = if !any_mask {
+            Vec::new()
+        } else {
+            scene
+                .meshes
+                .iter()
+                .flat_map(|m| {
+                    let masked = matches!(scene.materials[m.material].alpha, AlphaMode::Mask(_));
+                    m.indices.chunks_exact(3).map(move |t| {
+                        masked.then(|| {
+                            let at = |set: usize, k: usize| {
+                                m.tex_coords[set].get(t[k] as usize).copied().unwrap_or([0.0; 2])
+                            };
+                            MaskedTriangle {
+                                material: m.material,
+                                corners: [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3()),
+                                uv: [0, 1].map(|set| [0, 1, 2].map(|k| at(set, k))),
+                                alpha: (!m.colors.is_empty()).then(|| [0, 1, 2].map(|k| m.colors[t[k] as usize][3])),
+                            }
+                        })
+                    })
+                })
+                .collect()
+        };
+        Self { bvh: occluder_bvh(scene), masked, scene }
+    }
+
+    /// Whether triangle `i`, met by the ray at `t`, blocks it, and how near its alpha is to the cutoff (infinity
+    /// for an unmasked triangle).
+    pub fn blocks(&self, i: usize, origin: DVec3, direction: DVec3, t: f64) -> (bool, f64) {
+        let Some(Some(m)) = self.masked.get(i) else { return (true, f64::INFINITY) };
+        let material = &self.scene.materials[m.material];
+        let [a, b, c] = m.corners;
+        let p = origin + t * direction;
+        // Barycentrics of the hit by signed areas (f64), normalised by the triangle's.
+        let n = (b - a).cross(c - a);
+        let n2 = n.length_squared();
+        if n2 == 0.0 || !n2.is_finite() {
+            return (true, f64::INFINITY);
+        }
+        let wa = (b - p).cross(c - p).dot(n) / n2;
+        let wb = (c - p).cross(a - p).dot(n) / n2;
+        let w = [wa, wb, 1.0 - wa - wb];
+        let interpolate = |v: [f32; 3]| w[0] * v[0] as f64 + w[1] * v[1] as f64 + w[2] * v[2] as f64;
+        let uv = [0, 1].map(|set| [0, 1].map(|c| interpolate([0, 1, 2].map(|k| m.uv[set][k][c]))));
+        let color = m.alpha.map(|a| [1.0, 1.0, 1.0, interpolate(a) as f32]);
+        masked_hit_blocks(material, &self.scene.textures, &SurfaceSample { uv, uv_x: uv, uv_y: uv, color })
+    }
+}
+
+impl Occlusion for Occluders<'_> {
+    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
+        let Some(ray) = WatertightRay::new(origin, direction) else { return false };
+        if self.masked.is_empty() {
+            return self.bvh.any_hit(&ray, 0.0, t_max);
+        }
+        self.bvh.any_hit_where(&ray, 0.0, t_max, |i, t| self.blocks(i, origin, direction, t).0)
+    }
+}
