@@ -60,11 +60,14 @@ images: build
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sky.png --width 640 --height 300 --sky-radiance 300 && \
 	for m in BoxTextured/BoxTextured.glb TextureTransformTest/TextureTransformTest.gltf \
 		NormalTangentMirrorTest/NormalTangentMirrorTest.glb CesiumMan/CesiumMan.glb \
-		AlphaBlendModeTest/AlphaBlendModeTest.glb VertexColorTest/VertexColorTest.glb; do \
+		VertexColorTest/VertexColorTest.glb; do \
 		n=$$(basename $${m%.*}); \
 		$(SUNSHADE) render models/gltf-samples/$$m -o docs/images/sample-$$n.png --width 320 --height 240 \
 			--sun-dir -1,1.2,1.5 -q || exit 1; \
-	done
+	done; \
+	$(SUNSHADE) render models/gltf-samples/AlphaBlendModeTest/AlphaBlendModeTest.glb \
+		-o docs/images/sample-AlphaBlendModeTest.png --width 320 --height 240 --sun-dir -1,1.2,1.5 \
+		--eye 0,1.6,7.5 --target 0,0.9,0 -q
 
 # Regenerates the generated scenes in models/.
 models:
