@@ -8,6 +8,8 @@
 use std::path::{Path, PathBuf};
 
 const STAGES: [&str; 2] = ["scene.vert", "scene.frag"];
+/// The alpha-masked draws' fragment stage of the shadow-map pass (one module per interpolation mode).
+const MASK_STAGE: &str = "shadow_mask.frag";
 const INTERPOLATIONS: [&str; 3] =
     ["SUNSHADE_DEVICE_INTERPOLATION", "SUNSHADE_F32_BARYCENTRICS", "SUNSHADE_F64_BARYCENTRICS"];
 const NAIVE_MATH: &str = "SUNSHADE_NAIVE_MATH";
@@ -41,6 +43,9 @@ fn main() {
                 variants.push((stage, vec![interpolation, RAY_QUERY]));
             }
         }
+    }
+    for interpolation in INTERPOLATIONS {
+        variants.push((MASK_STAGE, vec![interpolation]));
     }
     {
         for (stage, defines) in variants {

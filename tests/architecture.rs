@@ -147,7 +147,17 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
     // replacements for lavapipe's inaccurate built-ins (Rust uses f64's); the shadow map (the reference casts rays,
     // docs/accuracy.md measures the map against them); the entry points.
-    let gpu_only = ["bindings.glsl", "math.glsl", "shadow_map.glsl", "scene.vert", "scene.frag"];
+    // fragment.glsl: the entry points' vertex fetches and surface inputs (its surface_sample mirrors
+    // src/cpu/fragment.rs's); shadow_mask.frag: the alpha test of masked draws in the shadow-map pass.
+    let gpu_only = [
+        "bindings.glsl",
+        "math.glsl",
+        "shadow_map.glsl",
+        "scene.vert",
+        "scene.frag",
+        "fragment.glsl",
+        "shadow_mask.frag",
+    ];
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     for entry in std::fs::read_dir(&dir).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();

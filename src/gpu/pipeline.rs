@@ -35,6 +35,10 @@ pub(crate) struct ScenePipeline {
     variants: HashMap<ShaderVariant, vk::Pipeline>,
     /// The depth-only pipeline of the sun's shadow map (vertex stage only), created at first use.
     shadow: vk::Pipeline,
+    /// The masked draws' shadow-map fragment stage (alpha test, no colour), and its pipelines per
+    /// `SURFACE_*` bits, created at first use.
+    shadow_mask_module: vk::ShaderModule,
+    shadow_masked: HashMap<u32, vk::Pipeline>,
     cache: Option<DiskPipelineCache>,
     /// Variants created since the cache was last saved.
     unsaved: bool,
@@ -47,6 +51,7 @@ impl ScenePipeline {
         dev: &Arc<Device>,
         vertex_spirv: &[u32],
         fragment_spirv: &[u32],
+        shadow_mask_spirv: &[u32],
         ray_query_spirv: Option<&[u32]>,
         with_normals: bool,
         cache_dir: Option<&Path>,
@@ -64,6 +69,8 @@ impl ScenePipeline {
             with_normals,
             variants: HashMap::new(),
             shadow: vk::Pipeline::null(),
+            shadow_mask_module: vk::ShaderModule::null(),
+            shadow_masked: HashMap::new(),
             cache: None,
             unsaved: false,
         };
@@ -139,12 +146,15 @@ impl ScenePipeline {
             out.fragment_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None)
                 .vk("vkCreateShaderModule")?;
+            out.shadow_mask_module = d
+                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(shadow_mask_spirv), None)
+                .vk("vkCreateShaderModule")?;
             if let Some(words) = ray_query_spirv {
                 out.ray_query_module = d
                     .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
                     .vk("vkCreateShaderModule")?;
             }
-            let mut hashed = vec![vertex_spirv, fragment_spirv];
+            let mut hashed = vec![vertex_spirv, fragment_spirv, shadow_mask_spirv];
             hashed.extend(ray_query_spirv);
             let name = pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&hashed));
             out.cache = Some(DiskPipelineCache::open(d, cache_dir, &name)?);
@@ -176,15 +186,40 @@ impl ScenePipeline {
                     &self.dev.device,
                     cache,
                     self.layout,
-                    self.vertex_module,
-                    vk::ShaderModule::null(),
+                    (self.vertex_module, vk::ShaderModule::null()),
                     self.with_normals,
                     None,
+                    true,
                 )?
             };
             self.unsaved = true;
         }
         Ok(self.shadow)
+    }
+
+    /// The shadow-map pipeline of alpha-masked draws with these `SURFACE_*` bits (depth only, the fragment stage
+    /// discarding below the cutoff), created on first use.
+    pub fn shadow_mask_pipeline(&mut self, surface: u32) -> Result<vk::Pipeline, GpuError> {
+        if let Some(&p) = self.shadow_masked.get(&surface) {
+            return Ok(p);
+        }
+        let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
+        let variant = ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface };
+        // SAFETY: valid device, layout, modules and cache owned by self.
+        let p = unsafe {
+            create_pipeline(
+                &self.dev.device,
+                cache,
+                self.layout,
+                (self.vertex_module, self.shadow_mask_module),
+                self.with_normals,
+                Some(variant),
+                true,
+            )?
+        };
+        self.shadow_masked.insert(surface, p);
+        self.unsaved = true;
+        Ok(p)
     }
 
     /// Whether pipelines with shadow rays can be made (the device has ray queries).
@@ -207,10 +242,13 @@ impl ScenePipeline {
                 &self.dev.device,
                 cache,
                 self.layout,
-                self.vertex_module,
-                if variant.shadows == SHADOWS_RAY { self.ray_query_module } else { self.fragment_module },
+                (
+                    self.vertex_module,
+                    if variant.shadows == SHADOWS_RAY { self.ray_query_module } else { self.fragment_module },
+                ),
                 self.with_normals,
                 Some(variant),
+                false,
             )?
         };
         self.variants.insert(variant, p);
@@ -223,15 +261,15 @@ unsafe fn create_pipeline(
     d: &ash::Device,
     cache: vk::PipelineCache,
     layout: vk::PipelineLayout,
-    vs: vk::ShaderModule,
-    fs: vk::ShaderModule,
+    (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
     variant: Option<ShaderVariant>,
+    depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.
     unsafe {
-        // `None`: the shadow map's depth-only pipeline (no fragment stage, no colour attachment).
-        let depth_only = variant.is_none();
+        // `depth_only`: a shadow map's pipeline, no colour attachment; its fragment stage (a null `fs`: none)
+        // only discards.
         let constants = variant.map_or([0; 6], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
@@ -246,7 +284,7 @@ unsafe fn create_pipeline(
                 .name(c"main")
                 .specialization_info(&specialization),
         ];
-        let stages = &all_stages[..if depth_only { 1 } else { 2 }];
+        let stages = &all_stages[..if fs == vk::ShaderModule::null() { 1 } else { 2 }];
         let vertex_bindings = [vk::VertexInputBindingDescription {
             binding: 0,
             stride: std::mem::size_of::<Vertex>() as u32,
@@ -313,9 +351,10 @@ impl Drop for ScenePipeline {
         // SAFETY: the device is idle with respect to these objects (renders wait on a fence); null handles are
         // ignored by the destroy calls.
         unsafe {
-            for (_, p) in self.variants.drain() {
+            for p in self.variants.drain().map(|(_, p)| p).chain(self.shadow_masked.drain().map(|(_, p)| p)) {
                 d.destroy_pipeline(p, None);
             }
+            d.destroy_shader_module(self.shadow_mask_module, None);
             d.destroy_pipeline(self.shadow, None);
             d.destroy_shader_module(self.vertex_module, None);
             d.destroy_shader_module(self.fragment_module, None);

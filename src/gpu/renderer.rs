@@ -22,7 +22,7 @@ use super::shadow_map::DepthMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::surface::surface_flags;
+use crate::shading::surface::{surface_flags, SURFACE_ALPHA_MASK};
 use crate::shading::Shadows;
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
@@ -69,8 +69,6 @@ pub struct GpuScene {
     can_occlude: bool,
     /// The scene's bounds (the sun's shadow map is fitted to them).
     bounds: Option<crate::scene::Aabb>,
-    /// Whether any material is alpha-masked (shadow rays test their alpha; shadow maps do not).
-    masked: bool,
 }
 
 impl GpuScene {
@@ -170,10 +168,13 @@ impl Renderer {
         } else {
             None
         };
+        let shadow_mask = shaders::stage_spirv("shadow_mask.frag", &[interpolation_define(interpolation)])
+            .map_err(GpuError::ShaderCompile)?;
         let pipeline = ScenePipeline::new(
             &dev,
             &vs,
             &fs,
+            &shadow_mask,
             ray_query.as_deref(),
             interpolation == Interpolation::Device,
             options.pipeline_cache_dir.as_deref(),
@@ -420,7 +421,6 @@ impl Renderer {
             // ray queries warns that `auto` has no shadows for this scene.
             can_occlude: crate::visibility::can_occlude(scene),
             bounds: scene.bounds(),
-            masked,
         })
     }
 
@@ -450,10 +450,6 @@ impl Renderer {
             }
             if settings.lights.sky.is_some() {
                 choice.reason += "; the sky has no shadow map: it is unoccluded";
-                choice.warning = true;
-            }
-            if scene.masked {
-                choice.reason += "; alpha-masked triangles cast shadows into the maps as if opaque";
                 choice.warning = true;
             }
         }
@@ -526,6 +522,17 @@ impl Renderer {
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
+        // Alpha-masked draws test their alpha in the maps too (shadow_mask.frag).
+        let mut map_pipelines = Vec::new();
+        if let Some(opaque) = shadow_pipeline {
+            for draw in &scene.draws {
+                map_pipelines.push(if draw.surface & SURFACE_ALPHA_MASK != 0 {
+                    self.pipeline.shadow_mask_pipeline(draw.surface)?
+                } else {
+                    opaque
+                });
+            }
+        }
         let pipelines = t_pipelines.elapsed();
         let t_render = Instant::now();
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
@@ -533,14 +540,14 @@ impl Renderer {
         unsafe {
             self.write_descriptors(scene, &lights);
             let cb = self.commands.begin(&self.dev)?;
-            if let Some(pipeline) = shadow_pipeline {
+            if shadow_pipeline.is_some() {
                 if let Some(frame) = &sun_map {
-                    self.record_depth_pass(cb, scene, settings, &self.sun_map, frame.map_from_world, pipeline);
+                    self.record_depth_pass(cb, scene, settings, &self.sun_map, frame.map_from_world, &map_pipelines);
                 }
                 for (map, (frame, _)) in
                     self.disk_maps.iter().zip(&disk_maps).filter_map(|(m, f)| Some((m, f.as_ref()?)))
                 {
-                    self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, pipeline);
+                    self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, &map_pipelines);
                 }
             }
             self.record_scene_pass(cb, scene, settings, &draw_pipelines);
@@ -662,7 +669,8 @@ impl Renderer {
         }
     }
 
-    /// Records a shadow-map pass into `map`: every draw, depth only, through the map's frame.
+    /// Records a shadow-map pass into `map`: every draw, depth only, through the map's frame, each with its
+    /// pipeline (`draw_pipelines`: the plain depth pipeline, or the alpha-testing one of a masked draw).
     unsafe fn record_depth_pass(
         &self,
         cb: vk::CommandBuffer,
@@ -670,7 +678,7 @@ impl Renderer {
         settings: &RenderSettings,
         map: &DepthMap,
         map_from_world: glam::DMat4,
-        shadow_pipeline: vk::Pipeline,
+        draw_pipelines: &[vk::Pipeline],
     ) {
         let d = &self.dev.device;
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer.
@@ -678,13 +686,29 @@ impl Renderer {
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 let layout = self.pipeline.layout;
                 let map_from_world = map_from_world.as_mat4().to_cols_array();
+                let size = map.size as f32;
                 map.record(cb, |cb| {
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, shadow_pipeline);
+                    // The masked draws' fragment stage reads the scene's buffers and textures.
+                    d.cmd_bind_descriptor_sets(
+                        cb,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        layout,
+                        0,
+                        &[self.pipeline.descriptor_set],
+                        &[],
+                    );
                     d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
                     d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
-                    for draw in &scene.draws {
+                    let mut bound = vk::Pipeline::null();
+                    for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
+                        if pipeline != bound {
+                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                            bound = pipeline;
+                        }
+                        // The map's frame and size (a masked draw's barycentrics are the map texel's).
                         let pc = PushConstants {
                             clip_from_world: map_from_world,
+                            framebuffer_size: [size, size],
                             ..push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
                         };
                         d.cmd_push_constants(

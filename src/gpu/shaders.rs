@@ -17,8 +17,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),
     ("texture_filter.glsl", include_str!("../../shaders/texture_filter.glsl")),
     ("surface.glsl", include_str!("../../shaders/surface.glsl")),
+    ("fragment.glsl", include_str!("../../shaders/fragment.glsl")),
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),
+    ("shadow_mask.frag", include_str!("../../shaders/shadow_mask.frag")),
 ];
 
 pub use sunshade_glsl::compile;
@@ -87,8 +89,9 @@ mod tests {
     #[test]
     fn modules_built_ahead_equal_run_time_compilation() {
         // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
-        // 2 stages × 3 interpolations × (plain, naive math), and the fragment stage's 3 with ray queries.
-        assert_eq!(MODULES.len(), 15);
+        // 2 stages × 3 interpolations × (plain, naive math), the fragment stage's 3 with ray queries, and the
+        // masked shadow-map stage's 3.
+        assert_eq!(MODULES.len(), 18);
         for m in MODULES {
             let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);

@@ -1,0 +1,60 @@
+// The fragment's own surface inputs, for the entry points that evaluate a material (scene.frag, and the
+// alpha-masked shadow-map pass, shadow_mask.frag). Mirrors src/cpu/fragment.rs's surface_sample.
+#ifndef SUNSHADE_FRAGMENT_GLSL
+#define SUNSHADE_FRAGMENT_GLSL
+
+#include "bindings.glsl"
+#include "transform.glsl"
+#include "surface.glsl"
+
+vec3 fragment_vertex_position(uint index) {
+    uint base = index * FLOATS_PER_VERTEX + VERTEX_POSITION;
+    return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
+}
+
+vec2 surface_vec2(uint index, uint offset) {
+    uint base = index * FLOATS_PER_SURFACE_VERTEX + offset;
+    return vec2(surface_data[base], surface_data[base + 1u]);
+}
+
+vec4 surface_vec4(uint index, uint offset) {
+    uint base = index * FLOATS_PER_SURFACE_VERTEX + offset;
+    return vec4(surface_data[base], surface_data[base + 1u], surface_data[base + 2u], surface_data[base + 3u]);
+}
+
+// The pixel's surface inputs (src/cpu/fragment.rs surface_sample): each set's texture coordinates at the pixel centre
+// and at its right and lower neighbours, and the vertex colour, interpolated in REAL with the exact barycentrics.
+SurfaceSample surface_sample() {
+    uint first = pc.first_index + 3u * uint(gl_PrimitiveID);
+    uint i0 = uint(int(indices[first]) + pc.vertex_offset);
+    uint i1 = uint(int(indices[first + 1u]) + pc.vertex_offset);
+    uint i2 = uint(int(indices[first + 2u]) + pc.vertex_offset);
+    vec4 c0 = clip_position(fragment_vertex_position(i0));
+    vec4 c1 = clip_position(fragment_vertex_position(i1));
+    vec4 c2 = clip_position(fragment_vertex_position(i2));
+    REAL3 centre = triangle_barycentrics_exact(c0, c1, c2, pixel_ndc(gl_FragCoord.xy));
+    REAL3 right = triangle_barycentrics_exact(c0, c1, c2, pixel_ndc(gl_FragCoord.xy + vec2(1.0, 0.0)));
+    REAL3 below = triangle_barycentrics_exact(c0, c1, c2, pixel_ndc(gl_FragCoord.xy + vec2(0.0, 1.0)));
+    SurfaceSample s;
+    for (uint set = 0u; set < 2u; ++set) {
+        uint offset = set == 0u ? SURFACE_VERTEX_UV0 : SURFACE_VERTEX_UV1;
+        REAL2 a = REAL2(surface_vec2(i0, offset));
+        REAL2 b = REAL2(surface_vec2(i1, offset));
+        REAL2 c = REAL2(surface_vec2(i2, offset));
+        precise REAL2 at_centre = centre.x * a + centre.y * b + centre.z * c;
+        precise REAL2 at_right = right.x * a + right.y * b + right.z * c;
+        precise REAL2 at_below = below.x * a + below.y * b + below.z * c;
+        s.uv[set] = at_centre;
+        s.uv_x[set] = at_right;
+        s.uv_y[set] = at_below;
+    }
+    s.color = vec4(1.0);
+    if ((VARIANT_SURFACE & SURFACE_COLORS) != 0u) {
+        precise REAL4 color = centre.x * REAL4(surface_vec4(i0, SURFACE_VERTEX_COLOR))
+            + centre.y * REAL4(surface_vec4(i1, SURFACE_VERTEX_COLOR)) + centre.z * REAL4(surface_vec4(i2, SURFACE_VERTEX_COLOR));
+        s.color = vec4(color);
+    }
+    return s;
+}
+
+#endif
