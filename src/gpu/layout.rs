@@ -215,6 +215,27 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
     }
 }
 
+/// The occluder-triangle records of binding 10 (`OccluderTriangles`), in the acceleration structure's primitive
+/// order (the meshes' triangles in turn): global vertex indices (each mesh's `vertex_offsets` added) and the
+/// material, bit 31 set where the mesh has vertex colours. Only scenes with alpha-masked materials on devices with
+/// ray queries read them (`needed`); otherwise one dummy record.
+pub fn occluder_records(scene: &Scene, vertex_offsets: &[i32], needed: bool) -> Vec<[u32; 4]> {
+    let mut records = Vec::new();
+    if needed {
+        for (mesh, &offset) in scene.meshes.iter().zip(vertex_offsets) {
+            let colors = if mesh.colors.is_empty() { 0 } else { 1 << 31 };
+            let o = offset as u32;
+            records.extend(
+                mesh.indices.chunks_exact(3).map(|t| [t[0] + o, t[1] + o, t[2] + o, mesh.material as u32 | colors]),
+            );
+        }
+    }
+    if records.is_empty() {
+        records.push([0; 4]);
+    }
+    records
+}
+
 /// The texel buffer (every texture's levels, linear RGBA f32) and the texture table (`TextureTable` in the
 /// shaders: a header per texture, then a record per level). Both at least one element long, so that a scene
 /// without textures binds valid buffers.

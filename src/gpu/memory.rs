@@ -59,6 +59,11 @@ impl Buffer {
         Ok(b)
     }
 
+    /// A host-visible storage buffer holding `bytes` (the fragment shader's inputs).
+    pub fn storage(dev: &Arc<Device>, bytes: &[u8], name: &str) -> Result<Self, GpuError> {
+        Self::with_data(dev, bytes, vk::BufferUsageFlags::STORAGE_BUFFER, name)
+    }
+
     /// The mapped memory (host-visible and coherent: gpu-allocator requires coherence for CPU locations).
     pub fn mapped(&self) -> &[u8] {
         let a = self.allocation.as_ref().expect("allocated");

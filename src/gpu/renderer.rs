@@ -12,8 +12,8 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, push_constants, texture_buffers, MaterialGpu, PushConstants, ShaderVariant,
-    SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
+    lights_bytes, material_gpu, occluder_records, push_constants, texture_buffers, MaterialGpu, PushConstants,
+    ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
@@ -330,18 +330,8 @@ impl Renderer {
         if surface_vertices.is_empty() {
             surface_vertices.push(SurfaceVertex::zeroed());
         }
-        let surface_vertices = Buffer::with_data(
-            &self.dev,
-            bytemuck::cast_slice(&surface_vertices),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            "surface vertices",
-        )?;
-        let texture_table = Buffer::with_data(
-            &self.dev,
-            bytemuck::cast_slice(&texture_table),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            "texture table",
-        )?;
+        let surface_vertices = Buffer::storage(&self.dev, bytemuck::cast_slice(&surface_vertices), "surface vertices")?;
+        let texture_table = Buffer::storage(&self.dev, bytemuck::cast_slice(&texture_table), "texture table")?;
         // With ray queries the vertex buffer is also the acceleration structure's build input.
         let accel_usage = if rq {
             vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
@@ -381,37 +371,20 @@ impl Renderer {
             )?),
             _ => None,
         };
-        // Per occluder triangle (the acceleration structure's primitive order): its global vertex indices and its
-        // material (bit 31: the mesh has vertex colours), for masked hits; one dummy record otherwise.
-        let mut occluder_triangles: Vec<[u32; 4]> = Vec::new();
-        if rq && masked {
-            for (mesh, draw) in scene.meshes.iter().zip(&draws) {
-                let colors = if mesh.colors.is_empty() { 0 } else { 1 << 31 };
-                occluder_triangles.extend(mesh.indices.chunks_exact(3).map(|t| {
-                    let o = draw.vertex_offset as u32;
-                    [t[0] + o, t[1] + o, t[2] + o, mesh.material as u32 | colors]
-                }));
-            }
-        }
-        if occluder_triangles.is_empty() {
-            occluder_triangles.push([0; 4]);
-        }
-        let occluder_triangles = Buffer::with_data(
+        let occluder_triangles = Buffer::storage(
             &self.dev,
-            bytemuck::cast_slice(&occluder_triangles),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
+            bytemuck::cast_slice(&occluder_records(
+                scene,
+                &draws.iter().map(|d| d.vertex_offset).collect::<Vec<_>>(),
+                rq && masked,
+            )),
             "occluder triangles",
         )?;
         Ok(GpuScene {
             accel,
             vertices,
             indices,
-            materials: Buffer::with_data(
-                &self.dev,
-                materials_bytes,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                "materials",
-            )?,
+            materials: Buffer::storage(&self.dev, materials_bytes, "materials")?,
             texels,
             texture_table,
             surface_vertices,
