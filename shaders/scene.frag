@@ -95,11 +95,13 @@ void main() {
     vec3 emission = vec3(0.0);
     if (VARIANT_SURFACE != 0u) {
         SurfaceSample s = surface_sample();
-        if ((VARIANT_SURFACE & SURFACE_ALPHA_MASK) != 0u && !alpha_covers(material, base_color(material, s).a)) {
+        // The base colour once, for the mask and the BRDF (only the variants that use it look it up).
+        vec4 base = (VARIANT_SURFACE & (SURFACE_ALPHA_MASK | SURFACE_EVAL)) != 0u ? base_color(material, s) : vec4(1.0);
+        if ((VARIANT_SURFACE & SURFACE_ALPHA_MASK) != 0u && !alpha_covers(material, base.a)) {
             discard;
         }
         if ((VARIANT_SURFACE & SURFACE_EVAL) != 0u) {
-            material = surface_brdf(material, s, base_color(material, s));
+            material = surface_brdf(material, s, base);
         }
         if ((VARIANT_SURFACE & SURFACE_NORMAL_MAP) != 0u) {
             // Back faces of double-sided materials turn the whole frame (the normal and bitangent already are).
