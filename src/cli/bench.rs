@@ -146,6 +146,20 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The renderer of a bench table on `--device`, checked for the image size, its device, and the reference options
+/// that mirror it.
+pub(super) fn bench_renderer(
+    a: &BenchArgs,
+    (width, height): (u32, u32),
+) -> Result<(Renderer, DeviceInfo, ReferenceOptions), CliError> {
+    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
+    let renderer = Renderer::new(&options)?;
+    renderer.check_size(width, height)?;
+    let info = renderer.device_info().clone();
+    let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
+    Ok((renderer, info, reference))
+}
+
 /// The first line of a generated table: the command, the date, the machine, the device, the build, the image size,
 /// the repetitions and what else the table's reader needs (`tail`).
 pub(super) fn measured_by(

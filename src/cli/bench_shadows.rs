@@ -9,13 +9,12 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 
-use super::bench::{build, device_description, median, ms, BenchArgs};
+use super::bench::{bench_renderer, build, device_description, median, ms, BenchArgs};
 use super::generated::{machine, print_output, today, update_region};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
-use crate::cpu::{self, ReferenceOptions};
+use crate::cpu;
 use crate::film::Image;
-use crate::gpu::{ContextOptions, Renderer};
 use crate::scene::{self, LoadOptions, Mesh, Scene};
 use crate::settings::{self, CameraOptions, LightOptions, RenderSettings, SunOptions};
 use crate::shading::{ShadowMapFilter, Shadows, DEFAULT_SHADOW_SAMPLES_PER_AXIS};
@@ -81,11 +80,7 @@ fn teapot_on_floor() -> Result<Scene, CliError> {
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let (width, height) = (a.width.unwrap_or(256), a.height.unwrap_or(192));
-    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
-    let mut renderer = Renderer::new(&options)?;
-    renderer.check_size(width, height)?;
-    let info = renderer.device_info().clone();
-    let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
+    let (mut renderer, info, reference) = bench_renderer(a, (width, height))?;
     let sun = SunOptions { elevation_degrees: Some(40.0), azimuth_degrees: Some(30.0), ..Default::default() };
     let room = scene::load_with_options(std::path::Path::new("models/room.gltf"), &LoadOptions::default())?;
     let teapot = teapot_on_floor()?;

@@ -7,12 +7,11 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::bench::{measured_by, median, ms, BenchArgs};
+use super::bench::{bench_renderer, measured_by, median, ms, BenchArgs};
 use super::generated::{print_output, update_region};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
-use crate::cpu::{self, ReferenceOptions};
-use crate::gpu::{ContextOptions, Renderer};
+use crate::cpu;
 use crate::scene::{self, LoadOptions, Scene};
 use crate::settings::{self, CameraOptions, SunOptions};
 use crate::shading::Shadows;
@@ -54,11 +53,7 @@ fn default_scenes() -> Result<Vec<PathBuf>, CliError> {
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let (width, height) = (a.width.unwrap_or(512), a.height.unwrap_or(512));
-    let options = ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() };
-    let mut renderer = Renderer::new(&options)?;
-    renderer.check_size(width, height)?;
-    let info = renderer.device_info().clone();
-    let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
+    let (mut renderer, info, reference) = bench_renderer(a, (width, height))?;
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
     let mut out = measured_by(
         "sunshade bench --textures",

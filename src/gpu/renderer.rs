@@ -653,46 +653,19 @@ impl Renderer {
         map_from_world: glam::DMat4,
         draw_pipelines: &[vk::Pipeline],
     ) {
-        let d = &self.dev.device;
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer.
         unsafe {
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                let layout = self.pipeline.layout;
                 let map_from_world = map_from_world.as_mat4().to_cols_array();
                 let size = map.size as f32;
                 map.record(cb, |cb| {
-                    // The masked draws' fragment stage reads the scene's buffers and textures.
-                    d.cmd_bind_descriptor_sets(
-                        cb,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
-                        &[self.pipeline.descriptor_set],
-                        &[],
-                    );
-                    d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
-                    d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
-                    let mut bound = vk::Pipeline::null();
-                    for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
-                        if pipeline != bound {
-                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                            bound = pipeline;
-                        }
-                        // The map's frame and size (a masked draw's barycentrics are the map texel's).
-                        let pc = PushConstants {
-                            clip_from_world: map_from_world,
-                            framebuffer_size: [size, size],
-                            ..push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
-                        };
-                        d.cmd_push_constants(
-                            cb,
-                            layout,
-                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                            0,
-                            bytemuck::bytes_of(&pc),
-                        );
-                        d.cmd_draw_indexed(cb, draw.index_count, 1, draw.first_index, draw.vertex_offset, 0);
-                    }
+                    // The map's frame and size (a masked draw's barycentrics are the map texel's); the cull mode is
+                    // the map's own.
+                    self.record_draws(cb, scene, (vb, ib), draw_pipelines, None, |draw| PushConstants {
+                        clip_from_world: map_from_world,
+                        framebuffer_size: [size, size],
+                        ..push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
+                    });
                 });
             }
         }
@@ -766,38 +739,57 @@ impl Renderer {
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[area]);
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                d.cmd_bind_descriptor_sets(
-                    cb,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    self.pipeline.layout,
-                    0,
-                    &[self.pipeline.descriptor_set],
-                    &[],
-                );
-                d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
-                d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
-                let mut bound = vk::Pipeline::null();
-                for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
-                    if pipeline != bound {
-                        d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                        bound = pipeline;
-                    }
-                    let pc = push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
-                    d.cmd_push_constants(
-                        cb,
-                        self.pipeline.layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&pc),
-                    );
-                    d.cmd_set_cull_mode(
-                        cb,
-                        if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK },
-                    );
-                    d.cmd_draw_indexed(cb, draw.index_count, 1, draw.first_index, draw.vertex_offset, 0);
-                }
+                let cull =
+                    |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
+                self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), |draw| {
+                    push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
+                });
             }
             d.cmd_end_rendering(cb);
+        }
+    }
+
+    /// Records every draw of the scene into the pass being recorded: the descriptor set and the scene's vertex and
+    /// index buffers bound, each draw with its pipeline (`draw_pipelines`, bound when it changes), its push
+    /// constants (`push`) and, where `cull` is given, its cull mode.
+    unsafe fn record_draws(
+        &self,
+        cb: vk::CommandBuffer,
+        scene: &GpuScene,
+        (vb, ib): (&Buffer, &Buffer),
+        draw_pipelines: &[vk::Pipeline],
+        cull: Option<&dyn Fn(&Draw) -> vk::CullModeFlags>,
+        push: impl Fn(&Draw) -> PushConstants,
+    ) {
+        let d = &self.dev.device;
+        let layout = self.pipeline.layout;
+        // SAFETY: `cb` is being recorded by the caller inside a rendering pass; every handle belongs to this
+        // renderer.
+        unsafe {
+            d.cmd_bind_descriptor_sets(
+                cb,
+                vk::PipelineBindPoint::GRAPHICS,
+                layout,
+                0,
+                &[self.pipeline.descriptor_set],
+                &[],
+            );
+            d.cmd_bind_vertex_buffers(cb, 0, &[vb.buffer], &[0]);
+            d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
+            let mut bound = vk::Pipeline::null();
+            for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
+                if pipeline != bound {
+                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    bound = pipeline;
+                }
+                let pc = push(draw);
+                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                d.cmd_push_constants(cb, layout, stages, 0, bytemuck::bytes_of(&pc));
+                if let Some(cull) = cull {
+                    d.cmd_set_cull_mode(cb, cull(draw));
+                }
+                d.cmd_draw_indexed(cb, draw.index_count, 1, draw.first_index, draw.vertex_offset, 0);
+            }
         }
     }
 
