@@ -6,6 +6,7 @@
 //! [`film::Image`] of radiance in W/(m²·sr) → `compare` → the command line. [`testing`] serves users' own image
 //! tests.
 
+pub mod accuracy;
 pub mod authoring;
 /// The command line (`sunshade` binary). Not public API: its items may change at any time; use [`testing`] and
 /// the renderers from a program.

@@ -523,6 +523,27 @@ fn outputs_record_camera_lights_and_settings() {
 }
 
 #[test]
+fn the_converged_reference_says_how_far_it_got() {
+    let dir = TempDir::new("converged-cli");
+    let input = dir.write("scene.glb", &scene());
+    let exr = dir.path("c.exr");
+    let args = ["reference", s(&input), "-o", s(&exr), "--width", "32", "--height", "24", "--converged"];
+    // A claim of 1e-9 after one doubling cannot be met: a warning names the pixels, the image is still written.
+    let o = sunshade(&[&args[..], &["--accuracy", "1e-9", "--max-refinements", "1", "--sky-radiance", "300"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("warning: not converged to 1e-9 after 1 doublings"), "{}", stderr(&o));
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+    let all: serde_json::Value = match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
+    };
+    assert_eq!(all["sunshadeConverged"]["accuracy"], json!(1e-9));
+    assert!(all["sunshadeConverged"]["unconverged_pixels"].as_u64().unwrap() > 0);
+    // The accuracy needs --converged.
+    assert_eq!(sunshade(&["reference", s(&input), "-o", s(&exr), "--accuracy", "1e-3"]).status.code(), Some(2));
+}
+
+#[test]
 fn scripts_get_json_silence_completions_and_a_man_page() {
     let dir = TempDir::new("scripts");
     let input = dir.write("scene.glb", &scene());

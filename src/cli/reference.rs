@@ -4,8 +4,9 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::args::{OutputArgs, SceneArgs};
+use super::args::{parse_positive, OutputArgs, SceneArgs};
 use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
+use crate::accuracy::converged::{self, ConvergenceOptions};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image_with;
 
@@ -44,6 +45,19 @@ pub struct ReferenceCommand {
     /// holds in RGBA32F, so that the reference has the GPU's limits). Each side is at most 16384, as on the GPU.
     #[arg(long, value_name = "N", default_value_t = cpu::DEFAULT_MAX_PIXELS, value_parser = clap::value_parser!(u64).range(1..))]
     pub max_pixels: u64,
+    /// Render the converged reference: exact light models (disk sun, exact disks), and the sample grids (sun,
+    /// lobes, shadow rays) refined from the given counts, each refinement at least doubling every count, until two
+    /// doublings in a row change each pixel by less than a tenth of --accuracy (relative, with the diff's floor
+    /// of 1% of the peak). Pixels that have not converged after --max-refinements are reported, not hidden
+    /// (docs/accuracy.md, "Speed against error").
+    #[arg(long, help_heading = "Quality")]
+    pub converged: bool,
+    /// The accuracy the converged reference claims (relative).
+    #[arg(long, value_name = "REL", default_value_t = converged::DEFAULT_ACCURACY, value_parser = parse_positive, requires = "converged", help_heading = "Quality")]
+    pub accuracy: f64,
+    /// Refinements of the converged reference at most (each doubles the samples of the pixels still moving).
+    #[arg(long, value_name = "N", default_value_t = converged::DEFAULT_MAX_REFINEMENTS, value_parser = clap::value_parser!(u32).range(1..=12), requires = "converged", help_heading = "Quality")]
+    pub max_refinements: u32,
     /// Print the time of each phase.
     #[arg(short, long)]
     pub verbose: bool,
@@ -63,11 +77,37 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let options = a.reference.options();
     let choice = cpu::shadow_choice(&scene, &settings, &options);
     settings.shading.shadows = choice.technique;
-    let image = cpu::render(&scene, &settings, &options);
+    let (image, convergence) = if a.converged {
+        let c = converged::render_converged(
+            &scene,
+            &settings,
+            &options,
+            &ConvergenceOptions { accuracy: a.accuracy, max_refinements: a.max_refinements },
+        );
+        settings.shading = c.shading;
+        if c.converged() {
+            if a.verbose {
+                eprintln!("sunshade: {}", c.summary());
+            }
+        } else {
+            super::warn(&c.summary());
+        }
+        let record = (c.accuracy, c.refinements, c.unconverged.len(), c.last_change);
+        (c.image, Some(record))
+    } else {
+        (cpu::render(&scene, &settings, &options), None)
+    };
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    let meta = super::metadata::of_render(&settings, "cpu reference");
+    let mut meta = super::metadata::of_render(&settings, "cpu reference");
+    if let Some((accuracy, refinements, unconverged, last_change)) = convergence {
+        let record = serde_json::json!({
+            "accuracy": accuracy, "refinements": refinements, "unconverged_pixels": unconverged,
+            "last_change": last_change,
+        });
+        meta.text.push(("sunshadeConverged".into(), record.to_string()));
+    }
     let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
     if a.verbose {
         eprintln!(

@@ -136,7 +136,24 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
         Shadows::None => None,
         _ => Some(Occluders::new(scene)),
     };
-    render_inner(scene, settings, options, occluders.as_ref(), false).0
+    render_inner(scene, settings, options, occluders.as_ref(), false, None).0
+}
+
+/// [`render`] for the pixels flagged in `selected` only (row-major, one flag a pixel); every other pixel is left
+/// empty (alpha 0). Rasterization is done whole, so a selected pixel gets exactly the value [`render`] gives it;
+/// only the shading, where the time goes, is skipped elsewhere. The converged reference refines pixels this way.
+pub fn render_selected(
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+    selected: &[bool],
+) -> Image {
+    assert_eq!(selected.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
+    let occluders = match shadow_choice(scene, settings, options).technique {
+        Shadows::None => None,
+        _ => Some(Occluders::new(scene)),
+    };
+    render_inner(scene, settings, options, occluders.as_ref(), false, Some(selected)).0
 }
 
 /// How near a shadow ray may pass an occluder's edge before its answer counts as fragile: `2⁻¹⁸` of the
@@ -164,7 +181,7 @@ pub fn render_with_fragile_pixels(
         Shadows::None => None,
         _ => Some(Occluders::new(scene)),
     };
-    let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true);
+    let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true, None);
     let n = image.pixels().len();
     (image, fragile.unwrap_or_else(|| vec![false; n]))
 }
@@ -191,14 +208,15 @@ impl Occlusion for Recording<'_> {
     }
 }
 
-/// The render, with these occluders (`None`: every light unoccluded), and with `fragile` the per-pixel mask of
-/// fragile shadow rays.
+/// The render, with these occluders (`None`: every light unoccluded), with `fragile` the per-pixel mask of
+/// fragile shadow rays, and shading only the pixels `selected` flags (`None`: all).
 fn render_inner(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
     occluders: Option<&Occluders>,
     fragile: bool,
+    selected: Option<&[bool]>,
 ) -> (Image, Option<Vec<bool>>) {
     let (width, height) = (settings.width, settings.height);
     let triangles = prepare(scene, settings, options);
@@ -244,7 +262,7 @@ fn render_inner(
                 });
             }
             for (k, &ti) in visible.iter().enumerate() {
-                if ti == u32::MAX {
+                if ti == u32::MAX || selected.is_some_and(|m| !m[band * band_pixels + k]) {
                     continue;
                 }
                 let (x, y) = (k as u32 % width, y0 + k as u32 / width);
