@@ -16,6 +16,7 @@ pub mod compare;
 pub mod cpu;
 pub mod film;
 pub mod gpu;
+pub mod plot;
 pub mod scene;
 pub mod settings;
 pub mod shading;

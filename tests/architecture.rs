@@ -40,6 +40,7 @@ fn modules_depend_one_way() {
     assert_free_of("src/visibility", &["ash::", "gltf::", "crate::gpu", "crate::cpu", "crate::compare", "crate::cli"]);
     // Speed against error knows the reference and the comparison; GPU timings come from the command line.
     assert_free_of("src/accuracy", &["ash::", "gltf::", "crate::gpu", "crate::cli"]);
+    assert_free_of("src/plot", &["ash::", "gltf::", "crate::gpu", "crate::cpu", "crate::scene", "crate::cli"]);
 }
 
 /// Names of the functions defined in a GLSL file (a return type, a name, an opening parenthesis at line start).

@@ -544,6 +544,45 @@ fn the_converged_reference_says_how_far_it_got() {
 }
 
 #[test]
+fn bench_pareto_measures_each_setting_against_the_converged_reference() {
+    let dir = TempDir::new("pareto");
+    let material =
+        sunshade::authoring::chart::brdf_chart().into_iter().find(|m| m.name == "Blinn-Phong e=100").unwrap();
+    let input = dir.write("sphere.glb", &sunshade::authoring::chart::sphere_scene(&material));
+    let plot = dir.path("front.png");
+    let o = sunshade(&[
+        "bench",
+        "--pareto",
+        s(&input),
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--repeat",
+        "1",
+        "--accuracy",
+        "1e-3",
+        "--max-refinements",
+        "4",
+        "--json",
+        "--plot",
+        s(&plot),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = json["tables"][0]["rows"].as_array().unwrap();
+    let row = |prefix: &str| rows.iter().find(|r| r["setting"].as_str().unwrap().starts_with(prefix)).unwrap();
+    // The sun as a disk (8² directions) is closer to the truth than the sun as a direction, for a lobe of e = 100.
+    let (disk, delta) =
+        (row("sun disk 8²")["max rel"].as_f64().unwrap(), row("sun delta")["max rel"].as_f64().unwrap());
+    assert!(disk < delta, "disk {disk:e}, delta {delta:e}");
+    assert!(rows.iter().any(|r| r["front (max)"] == "★"));
+    assert!(rows.iter().all(|r| r["GPU frame [ms]"].as_f64().unwrap() > 0.0));
+    let png = image::open(&plot).unwrap();
+    assert_eq!((png.width(), png.height()), (1280, 400), "two charts: max and p99");
+}
+
+#[test]
 fn scripts_get_json_silence_completions_and_a_man_page() {
     let dir = TempDir::new("scripts");
     let input = dir.write("scene.glb", &scene());

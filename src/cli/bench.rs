@@ -71,6 +71,24 @@ pub struct BenchArgs {
     /// times, and the GPU's agreement with the reference. Its --update region is "textures".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows"])]
     pub textures: bool,
+    /// Speed against error as a trade-off: for each scene (default: every .glb and .gltf in models/; 256 × 256
+    /// unless --width/--height are given), every quality knob over its range alone and in a ladder of
+    /// combinations (sun model and samples, disk model, lobe samples, interpolation, shadow technique, samples and
+    /// map size, where the scene has what they act on), each with its GPU frame time and its error against the
+    /// converged reference (`reference --converged`); the Pareto front is marked. Its --update region is
+    /// "pareto".
+    #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures"])]
+    pub pareto: bool,
+    /// With --pareto: draw error against frame time (log-log, the front drawn, each point labelled by its row)
+    /// into this PNG, one chart per scene.
+    #[arg(long, value_name = "PNG", requires = "pareto")]
+    pub plot: Option<PathBuf>,
+    /// With --pareto: the accuracy the converged reference claims (relative).
+    #[arg(long, value_name = "REL", default_value_t = 1e-4, value_parser = parse_positive)]
+    pub accuracy: f64,
+    /// With --pareto: refinements of the converged reference at most.
+    #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=12))]
+    pub max_refinements: u32,
     /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
     #[arg(long)]
     pub json: bool,
@@ -92,6 +110,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         "shadows"
     } else if a.textures {
         "textures"
+    } else if a.pareto {
+        "pareto"
     } else {
         ""
     };
@@ -106,6 +126,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.textures {
         return super::bench_textures::run(a);
+    }
+    if a.pareto {
+        return super::bench_pareto::run(a);
     }
     let (width, height) = (a.width.unwrap_or(1024), a.height.unwrap_or(1024));
     let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
@@ -335,7 +358,7 @@ fn bench_scenes(
 }
 
 /// Every .glb/.gltf in `models/` (next to the current directory), sorted.
-fn default_scenes() -> Result<Vec<PathBuf>, CliError> {
+pub(super) fn default_scenes() -> Result<Vec<PathBuf>, CliError> {
     let dir = Path::new("models");
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| {

@@ -7,6 +7,7 @@ mod albedo;
 mod args;
 mod batch;
 mod bench;
+mod bench_pareto;
 mod bench_shadows;
 mod bench_textures;
 mod diff;
@@ -17,6 +18,7 @@ mod reference;
 pub(crate) mod render;
 mod session;
 mod suite;
+mod sweep;
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};

@@ -1,0 +1,194 @@
+//! `sunshade bench --pareto`: speed against error as a trade-off. For each scene, every quality knob over its
+//! range (`sweep`), each setting's GPU frame time (median and spread of `--repeat` warm runs) and its error
+//! against the converged reference (`accuracy::converged`; the pixels where the truth itself did not converge are
+//! left out and counted), the Pareto fronts of frame time against the max and the 99th-percentile relative
+//! error, a Markdown table (or JSON) and optionally a log-log plot of each.
+
+use std::path::Path;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::bench::{build, default_scenes, device_description, median, ms, BenchArgs};
+use super::generated::{machine, print_output, today, update_region};
+use super::sweep::{sweep, Relevance};
+use super::CliError;
+use crate::accuracy::converged::{render_converged, ConvergenceOptions};
+use crate::accuracy::error::{image_error, ImageError};
+use crate::accuracy::pareto::pareto_front;
+use crate::cpu::ReferenceOptions;
+use crate::gpu::{ContextOptions, GpuScene, Interpolation, Renderer};
+use crate::plot::{Canvas, LogLogChart, Point};
+use crate::scene::{self, LoadOptions};
+use crate::settings::{self, CameraOptions, SunOptions};
+use crate::shading::Shadows;
+
+/// Max relative errors below this are drawn at it (a log axis has no zero); the table gives them as measured.
+const PLOT_ERROR_FLOOR: f64 = 1e-7;
+
+/// One measured setting.
+struct Row {
+    label: String,
+    frame_ms: f64,
+    spread_ms: f64,
+    error: ImageError,
+}
+
+pub fn run(a: &BenchArgs) -> Result<(), CliError> {
+    let (width, height) = (a.width.unwrap_or(256), a.height.unwrap_or(256));
+    let scenes = if a.scenes.is_empty() { default_scenes()? } else { a.scenes.clone() };
+    // One renderer per interpolation mode the device offers; the first is its default.
+    let first = Renderer::new(&ContextOptions { device: a.device.clone(), ..ContextOptions::from_env() })?;
+    first.check_size(width, height)?;
+    let info = first.device_info().clone();
+    let default_mode = first.interpolation();
+    let mut renderers = vec![first];
+    let mut modes = vec![default_mode];
+    for mode in [Interpolation::BarycentricF64, Interpolation::BarycentricF32, Interpolation::Device] {
+        if mode == default_mode || (mode == Interpolation::BarycentricF64 && !info.shader_float64) {
+            continue;
+        }
+        let options =
+            ContextOptions { device: a.device.clone(), interpolation: Some(mode), ..ContextOptions::from_env() };
+        renderers.push(Renderer::new(&options)?);
+        modes.push(mode);
+    }
+    let reference = ReferenceOptions { sub_pixel_bits: info.sub_pixel_precision_bits, ..Default::default() };
+    let convergence = ConvergenceOptions { accuracy: a.accuracy, max_refinements: a.max_refinements };
+    let ray_queries = info.ray_query;
+    let mut out = format!(
+        "Measured by `sunshade bench --pareto` on {}: {}; Vulkan device {}{}; {} build; {width}×{height} pixels; \
+         GPU frame: median of {} warm runs, spread = slowest − fastest. Error against the converged reference \
+         (claimed accuracy {:.0e}, at most {} doublings): per pixel |L − L_conv| / max(|L|, |L_conv|, 1% of the \
+         peak), largest over RGB; the pixels where the reference itself did not converge are left out (counted per \
+         scene). ★: on the Pareto front of frame time against the max (or the p99) relative error.\n\n",
+        today(),
+        machine(),
+        device_description(&info),
+        if ray_queries { "" } else { " (no ray queries: shadows by map or none)" },
+        build(),
+        a.repeat,
+        a.accuracy,
+        a.max_refinements,
+    );
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {elapsed} {pos} settings measured: {msg}").expect("template"),
+    );
+    let mut charts = Vec::new();
+    for path in &scenes {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let scene = scene::load_with_options(path, &LoadOptions::default())?;
+        let mut s = settings::resolve(&scene, width, height, &CameraOptions::default(), &SunOptions::default())
+            .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        let can_occlude = crate::visibility::can_occlude(&scene);
+        let relevance = Relevance::of(&scene, &s.lights, can_occlude, ray_queries);
+
+        bar.set_message(format!("{name}: the converged reference"));
+        let t = Instant::now();
+        let mut truth_settings = s.clone();
+        truth_settings.shading.shadows = if can_occlude { Shadows::Ray } else { Shadows::None };
+        let truth = render_converged(&scene, &truth_settings, &reference, &convergence);
+        let truth_time = t.elapsed();
+        let mut excluded = vec![false; (width * height) as usize];
+        for u in &truth.unconverged {
+            excluded[(u.y * width + u.x) as usize] = true;
+        }
+
+        let uploaded: Vec<GpuScene> = renderers.iter().map(|r| r.upload(&scene)).collect::<Result<_, _>>()?;
+        let mut rows = Vec::new();
+        for setting in sweep(&relevance, default_mode, &modes) {
+            let label = setting.label(&relevance);
+            bar.set_message(format!("{name}: {label}"));
+            let k = modes.iter().position(|&m| m == setting.interpolation).expect("a renderer per mode");
+            s.shading = setting.shading;
+            // Warm-up: the device compiles the variant's shaders at its first draw.
+            let (image, _) = renderers[k].render(&uploaded[k], &s)?;
+            let mut times = Vec::new();
+            for _ in 0..a.repeat {
+                times.push(renderers[k].render(&uploaded[k], &s)?.1.render);
+            }
+            let spread =
+                times.iter().max().copied().unwrap_or_default() - times.iter().min().copied().unwrap_or_default();
+            let error = image_error(&image, &truth.image, Some(&excluded))
+                .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
+            rows.push(Row { label, frame_ms: ms(median(times)), spread_ms: ms(spread), error });
+            bar.inc(1);
+        }
+        let front = pareto_front(&rows.iter().map(|r| (r.frame_ms, r.error.max_rel)).collect::<Vec<_>>());
+        let front_p99 = pareto_front(&rows.iter().map(|r| (r.frame_ms, r.error.p99)).collect::<Vec<_>>());
+        out += &format!(
+            "**{name}** ({} triangles; truth: {}; {} of {} covered pixels left out as unconverged; the reference \
+             took {:.1} s):\n\n",
+            scene.triangle_count(),
+            truth.summary_counts(),
+            truth.unconverged.len(),
+            truth.covered,
+            truth_time.as_secs_f64(),
+        );
+        out += "| # | setting | GPU frame [ms] | spread [ms] | max rel | p99 rel | RMSE [W/(m²·sr)] | px > 1e-2 | px > 1e-3 | px > 1e-4 | front (max) | front (p99) |\n";
+        out += "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|:---:|:---:|\n";
+        for (i, ((r, &f), &f99)) in rows.iter().zip(&front).zip(&front_p99).enumerate() {
+            out += &format!(
+                "| {} | {} | {:.2} | {:.2} | {:.2e} | {:.2e} | {:.2e} | {} | {} | {} | {} | {} |\n",
+                i + 1,
+                r.label,
+                r.frame_ms,
+                r.spread_ms,
+                r.error.max_rel,
+                r.error.p99,
+                r.error.rmse,
+                r.error.over[0],
+                r.error.over[1],
+                r.error.over[2],
+                if f { "★" } else { "" },
+                if f99 { "★" } else { "" }
+            );
+        }
+        out += "\n";
+        for (metric, fronts, value) in [
+            ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),
+            ("99th percentile of the relative error", &front_p99, |e: &ImageError| e.p99),
+        ] {
+            charts.push(LogLogChart {
+                title: format!("{name}, {width}x{height}: {metric} (labels: # in the table)"),
+                x_title: "GPU frame [ms]".into(),
+                y_title: metric.into(),
+                points: rows
+                    .iter()
+                    .zip(fronts)
+                    .enumerate()
+                    .map(|(i, (r, &f))| Point {
+                        x: r.frame_ms,
+                        y: value(&r.error).max(PLOT_ERROR_FLOOR),
+                        label: (i + 1).to_string(),
+                        front: f,
+                    })
+                    .collect(),
+            });
+        }
+        bar.suspend(|| eprintln!("sunshade bench: {name} done ({} settings)", rows.len()));
+    }
+    bar.finish_and_clear();
+    if let Some(plot) = &a.plot {
+        write_plot(plot, &charts)?;
+    }
+    print_output(&out, a.json);
+    for doc in &a.update {
+        update_region(doc, "pareto", &out)?;
+        eprintln!("sunshade bench: updated {}", doc.display());
+    }
+    Ok(())
+}
+
+/// The charts in one PNG, two a row (each scene's max and p99 side by side).
+fn write_plot(path: &Path, charts: &[LogLogChart]) -> Result<(), CliError> {
+    let (w, h) = (640, 400);
+    let mut canvas = Canvas::new(2 * w as u32, (h * charts.len().div_ceil(2).max(1)) as u32);
+    for (i, chart) in charts.iter().enumerate() {
+        chart.draw(&mut canvas, (((i % 2) * w) as i32, ((i / 2) * h) as i32), (w as i32, h as i32));
+    }
+    canvas.write_png(path).map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+    eprintln!("sunshade bench: wrote {}", path.display());
+    Ok(())
+}
