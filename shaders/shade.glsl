@@ -138,19 +138,43 @@ vec2 sinh_warp(float a, float b, float c, float w, vec2 ends, float u) {
     return vec2(clamp(c + w * sinh_accurate(z), a, b), w * (ends.y - ends.x) * cosh(z));
 }
 
+// How far a graded grid of width w on an interval of length `span` is blended towards the uniform grid: 0 while
+// w <= 8 span, rising linearly to 1 at 16 span (see the Rust).
+float uniform_blend(float w, float span) {
+    return clamp((w / span - 8.0) / 8.0, 0.0, 1.0);
+}
+
+// A graded point (x, dx/du) on [a, b] moved by `lambda` towards the uniform grid's (a + u (b - a), b - a).
+vec2 blended_point(float a, float b, vec2 point, float lambda, float u) {
+    return vec2(point.x + lambda * ((a + u * (b - a)) - point.x), point.y + lambda * ((b - a) - point.y));
+}
+
 // The ends (za, zb) = (asinh((a - c)/w), asinh((b - c)/w)) of sinh_warp's z range.
 vec2 sinh_warp_ends(float a, float b, float c, float w) {
     return vec2(asinh_accurate((a - c) / w), asinh_accurate((b - c) / w));
 }
 
-// integral of lobe (n.w)+ over the part of a disk above the horizon, per unit radiance, for the disk of radius
-// `radius` centred at q from the point, emitting along d: segment coordinates, the grid graded about the lobe's
-// peak (see the Rust).
-float segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
+// The lobe integral with the grid's weights normalised, as far as the grid is uniform, to integrate the cosine
+// exactly: lobe (1 + uniformity (exact/projected - 1)) (a ratio estimator; see the Rust).
+// sums = (lobe, projected, uniformity).
+float normalized_lobe_integral(vec3 sums, float exact) {
+    return sums.y > 0.0 ? sums.x * (1.0 + sums.z * (exact / sums.y - 1.0)) : sums.x;
+}
+
+// The projected solid angle [sr] of the sun's cap above the horizon: pi sin^2(delta/2) E / E_perp.
+float sun_projected_solid_angle_above(float n_dot_l, float angular_diameter) {
+    float s = sin(0.5 * angular_diameter);
+    return PI * s * s * sun_irradiance_disk(vec3(1.0), n_dot_l, angular_diameter).x;
+}
+
+// The grid's sums over a disk, per unit radiance: (integral of lobe (n.w)+ over its visible samples, integral of
+// (n.w)+ over all of them, the grid's uniformity), for the disk of radius `radius` centred at q from the point, emitting along d:
+// segment coordinates, the grid graded about the lobe's peak (see the Rust).
+vec3 segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
     vec3 n = p.normal;
     float h = -dot(d, q);
     if (!(h > 0.0 && radius > 0.0)) {
-        return 0.0;
+        return vec3(0.0);
     }
     vec3 n_perp = n - dot(n, d) * d;
     float mlen = length(n_perp);
@@ -161,7 +185,7 @@ float segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, floa
         w = mlen > 0.0 ? n_perp / mlen : orthonormal_to(d);
         alpha = PI;
     } else if (nq + radius * mlen <= 0.0) {
-        return 0.0;
+        return vec3(0.0);
     } else {
         float kappa = clamp(-nq / (radius * mlen), -1.0, 1.0);
         w = n_perp / mlen;
@@ -189,27 +213,36 @@ float segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, floa
     float width_s = min(footprint / max(radius * sbc, 1e-30), 32.0);
     float k = float(per_axis);
     float sum = 0.0;
+    float projected = 0.0;
     vec2 beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
     vec2 s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
+    float blend_beta = uniform_blend(width_beta, alpha);
+    float blend_s = uniform_blend(width_s, 2.0);
     for (uint i = 0u; i < per_axis; ++i) {
-        vec2 bw = sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, (float(i) + 0.5) / k);
+        float ub = (float(i) + 0.5) / k;
+        vec2 bw = blended_point(0.0, alpha, sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, ub), blend_beta, ub);
         float sb = sin(bw.x);
         float cb = cos(bw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            vec2 sw = sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, (float(j) + 0.5) / k);
+            float us = (float(j) + 0.5) / k;
+            vec2 sw = blended_point(-1.0, 1.0, sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, us), blend_s, us);
             vec3 y = q + radius * cb * w + radius * sb * sw.x * v;
             float dist2 = dot(y, y);
             float dist = sqrt(dist2);
             vec3 omega = y / dist;
             float c = dot(n, omega);
-            // A sample that contributes casts its shadow ray (&& and || short-circuit).
-            if (c > 0.0 && (rays == RAYS_NONE || (rays == RAYS_ALONG ? visible_along(p.shadow_origin, omega)
-                                                                   : visible_to(p.shadow_origin, p.position + y)))) {
-                sum += specular_lobe(m, p, omega) * c * h / (dist2 * dist) * radius * radius * sb * sb * bw.y * sw.y;
+            if (c > 0.0) {
+                float weight = c * h / (dist2 * dist) * radius * radius * sb * sb * bw.y * sw.y;
+                projected += weight;
+                // A sample that contributes casts its shadow ray (|| short-circuits).
+                if (rays == RAYS_NONE || (rays == RAYS_ALONG ? visible_along(p.shadow_origin, omega)
+                                                            : visible_to(p.shadow_origin, p.position + y))) {
+                    sum += specular_lobe(m, p, omega) * weight;
+                }
             }
         }
     }
-    return sum / (k * k);
+    return vec3(sum / (k * k), projected / (k * k), min(blend_beta, blend_s));
 }
 
 // A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
@@ -308,8 +341,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
             float radius = tan(0.5 * delta);
-            float integral = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
+            vec3 sums = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
                 SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
+            float integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
             // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the
             // sun is wholly visible or wholly hidden).
             if (SHADOWS_MAP_ON) {
@@ -329,8 +363,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
                 integral = 0.0;
             }
         } else {
+            // The grid's sum as it is (see disk_lobe_integral in the Rust).
             integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
-                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE);
+                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).x;
         }
         if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
             integral *= disk_map_fraction[i];
