@@ -127,7 +127,7 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata)
         let v = serde_json::from_str(value).unwrap_or_else(|_| serde_json::Value::String(value.clone()));
         all.insert(key.clone(), v);
     }
-    let text = serde_json::Value::Object(all).to_string();
+    let text = ascii_json(&serde_json::Value::Object(all).to_string());
     attributes.other.insert(Text::from("sunshade"), AttributeValue::Text(Text::from(text.as_str())));
     for (key, m) in &metadata.matrices {
         // The two standard camera matrices have fields of their own in the exr crate; others have no place in
@@ -140,6 +140,24 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata)
     }
     let layer = Layer::new((width, height), attributes, Encoding::SMALL_LOSSLESS, channels);
     exr::prelude::Image::from_layer(layer).write().to_buffered(w).map_err(io::Error::other)
+}
+
+/// JSON text with every character outside ASCII written as its `\uXXXX` escape (UTF-16 pairs above U+FFFF): the
+/// same JSON value, in the bytes an EXR text attribute can hold (the exr crate refuses others, by a panic). Outside
+/// strings JSON has only ASCII, so escaping is always valid there.
+pub fn ascii_json(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    for c in json.chars() {
+        if c.is_ascii() {
+            out.push(c);
+        } else {
+            let mut units = [0u16; 2];
+            for u in c.encode_utf16(&mut units) {
+                out += &format!("\\u{:04x}", u);
+            }
+        }
+    }
+    out
 }
 
 /// The tEXt keyword under which a PNG records its exposure.
@@ -157,7 +175,8 @@ fn write_png(w: &mut impl Write, width: u32, height: u32, rgba: &[u8], ev: f64, 
     text(&mut encoder, "Software", format!("sunshade {}", env!("CARGO_PKG_VERSION")))?;
     text(&mut encoder, PNG_EXPOSURE_KEYWORD, format!("{ev}"))?;
     for (key, value) in &metadata.text {
-        text(&mut encoder, key, value.clone())?;
+        // tEXt is Latin-1: the JSON texts go as ASCII.
+        text(&mut encoder, key, ascii_json(value))?;
     }
     let mut writer = encoder.write_header().map_err(io::Error::other)?;
     writer.write_image_data(rgba).map_err(io::Error::other)?;
@@ -274,6 +293,14 @@ fn read_token(r: &mut impl BufRead) -> io::Result<String> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn ascii_json_is_the_same_json_in_ascii() {
+        let v = serde_json::json!({"term": "disk sun 8², Ward α=0.05", "emoji": "\u{1F600}"});
+        let a = ascii_json(&v.to_string());
+        assert!(a.is_ascii(), "{a}");
+        assert_eq!(serde_json::from_str::<serde_json::Value>(&a).unwrap(), v);
+    }
+
     use super::*;
 
     fn sample() -> Image {
