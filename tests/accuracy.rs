@@ -1,5 +1,6 @@
 //! Speed against error: the converged reference (its claim checked by one more doubling, its unconverged pixels
-//! reported), on the CPU only.
+//! reported), the sun's error bounds against measurement, and `--tolerance` meeting itself on the reference and
+//! (with validation on) on the GPU.
 
 mod common;
 
@@ -96,4 +97,218 @@ fn a_scene_without_sampled_integrals_converges_at_once_and_exactly() {
     let c = render_converged(&scene, &s, &reference, &ConvergenceOptions::default());
     assert!(c.converged() && c.refinements == 2 && c.last_change == 0.0, "{}", c.summary());
     assert_eq!(common::bits(&c.image), common::bits(&cpu::render(&scene, &s, &reference)));
+}
+
+/// The sun's bounds (`accuracy::bounds`) against measurement: chart materials from the broadest to the sharpest
+/// lobes under a 0.53° and a 5° sun from three directions, the reference with the delta sun and with k × k grids
+/// against the reference with a fine grid (64², itself checked against 90²). The measured max relative error (diff floor) must stay under the bound,
+/// and the bound must not be vacuous where it claims something.
+#[test]
+fn the_suns_error_bounds_hold_against_measurement() {
+    use sunshade::accuracy::bounds::{
+        horizon_bound, sun_delta_bound, sun_grid_bound, sun_horizon_in_view, SunViewAngles,
+    };
+    use sunshade::accuracy::error::image_error;
+    use sunshade::shading::SunModel;
+    let dir = common::TempDir::new("sun-bounds");
+    let reference = ReferenceOptions::default();
+    let mut report = String::new();
+    let mut claims = 0;
+    let names = [
+        "Lambert",
+        "Phong e=1",
+        "Phong e=100",
+        "Phong e=10000",
+        "Blinn-Phong e=1",
+        "Blinn-Phong e=100",
+        "Blinn-Phong e=10000",
+        "Ward α=0.05",
+        "Ward α=0.2",
+        "Ward αx=0.02 αy=0.3",
+    ];
+    for material in chart::brdf_chart().into_iter().filter(|m| names.contains(&m.name.as_str())) {
+        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
+        for diameter in [0.53, 5.0] {
+            for degrees in chart::SUN_FROM_VIEW_DEGREES {
+                let l = DVec3::from_array(chart::sun_direction(degrees));
+                let lights = LightOptions {
+                    sun: SunOptions { direction: Some(l), diameter_degrees: Some(diameter), ..Default::default() },
+                    shading: ShadingOptions { shadows: Shadows::None, ..Default::default() },
+                    ..Default::default()
+                };
+                let s = settings::resolve_with(&scene, 32, 32, &CameraOptions::default(), &lights).unwrap();
+                let with = |sun: SunModel, k: u32| {
+                    let mut t = s.clone();
+                    t.shading.sun = sun;
+                    t.shading.sun_samples_per_axis = k;
+                    cpu::render(&scene, &t, &reference)
+                };
+                let truth = with(SunModel::Disk, 64);
+                let check = image_error(&with(SunModel::Disk, 90), &truth, None).unwrap().max_rel;
+                let r = 0.5 * diameter.to_radians();
+                let brdf = &scene.materials[0].brdf;
+                let angles = SunViewAngles::of(&s.camera, s.aspect(), l);
+                let horizon = if sun_horizon_in_view(&scene, l, r) { horizon_bound(r) } else { 0.0 };
+                let mut cases =
+                    vec![("delta".to_string(), SunModel::Delta, 1, sun_delta_bound(brdf, r, angles).max(horizon))];
+                for k in [1, 2, 4, 8, 16] {
+                    cases.push((format!("{k}²"), SunModel::Disk, k, sun_grid_bound(brdf, r, k, angles)));
+                }
+                for (name, sun, k, bound) in cases {
+                    let measured = image_error(&with(sun, k), &truth, None).unwrap().max_rel;
+                    report += &format!(
+                        "{} δ={diameter}° at {degrees}°: {name}: measured {measured:.2e}, bound {bound:.2e}, truth moved \
+                         {check:.1e}\n",
+                        material.name
+                    );
+                    if bound < 1.0 {
+                        claims += 1;
+                        // Bounds under 1e-6 are claimed as 1e-6: the f32 image rounds at about 1e-7.
+                        assert!(check < 0.1 * bound.max(1e-6), "{}: the truth moved by {check:e}", material.name);
+                        assert!(measured <= bound.max(1e-6), "over the bound:\n{report}");
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("{report}");
+    assert!(claims > 150, "the bounds claim too little: {claims}\n{report}");
+}
+
+/// The sample count `--tolerance` chose, for comparing costs (the delta sun counts as 0).
+fn sun_cost(shading: &ShadingOptions) -> u32 {
+    match shading.sun {
+        sunshade::shading::SunModel::Delta => 0,
+        sunshade::shading::SunModel::Disk => shading.sun_samples_per_axis,
+    }
+}
+
+/// `--tolerance T` on the reference: every sun-lit scene of models/ (the others are refused, by name) and chart
+/// materials from three sun directions meet T against the converged reference for T = 1e-2, 1e-3, 1e-4 (pixels
+/// where the truth itself did not converge, the penumbrae, left out), and cost no more at looser T.
+#[test]
+fn tolerance_meets_itself_on_the_reference() {
+    use sunshade::accuracy::error::image_error;
+    use sunshade::accuracy::predicted::{choose_for_tolerance, predict, Renderer};
+    let dir = common::TempDir::new("tolerance");
+    let mut cases: Vec<(String, sunshade::scene::Scene, Option<DVec3>)> = Vec::new();
+    let mut models: Vec<_> = std::fs::read_dir("models")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| matches!(p.extension().and_then(|e| e.to_str()), Some("glb" | "gltf")))
+        .collect();
+    models.sort();
+    for path in models {
+        cases.push((path.display().to_string(), common::load(&path), None));
+    }
+    for name in ["Phong e=100", "Blinn-Phong e=10000", "Ward αx=0.02 αy=0.3"] {
+        let material = chart::brdf_chart().into_iter().find(|m| m.name == name).unwrap();
+        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
+        for degrees in chart::SUN_FROM_VIEW_DEGREES {
+            cases.push((
+                format!("{name} at {degrees}°"),
+                scene.clone(),
+                Some(DVec3::from_array(chart::sun_direction(degrees))),
+            ));
+        }
+    }
+    let reference = ReferenceOptions::default();
+    let mut report = String::new();
+    let mut measured_cases = 0;
+    for (name, scene, sun) in &cases {
+        let lights = LightOptions { sun: SunOptions { direction: *sun, ..Default::default() }, ..Default::default() };
+        let mut s = settings::resolve_with(scene, 48, 48, &CameraOptions::default(), &lights).unwrap();
+        s.shading.shadows = cpu::shadow_choice(scene, &s, &reference).technique;
+        let can_occlude = sunshade::visibility::can_occlude(scene);
+        let mut costs = Vec::new();
+        for tolerance in [1e-2, 1e-3, 1e-4] {
+            let chosen = match choose_for_tolerance(scene, &s, Renderer::Reference, can_occlude, tolerance) {
+                Ok(c) => c,
+                Err(e) => {
+                    assert!(s.lights.sky.is_some() || !s.lights.disks.is_empty(), "{name}: refused: {e}");
+                    assert!(e.contains("derived for the sun so far"), "{e}");
+                    report += &format!("{name}: refused ({e})\n");
+                    break;
+                }
+            };
+            let mut t = s.clone();
+            t.shading = chosen;
+            let image = cpu::render(scene, &t, &reference);
+            let truth = render_converged(
+                scene,
+                &s,
+                &reference,
+                &ConvergenceOptions { accuracy: tolerance / 10.0, max_refinements: 5 },
+            );
+            let mut excluded = vec![false; 48 * 48];
+            for u in &truth.unconverged {
+                excluded[(u.y * 48 + u.x) as usize] = true;
+            }
+            let measured = image_error(&image, &truth.image, Some(&excluded)).unwrap().max_rel;
+            let predicted = predict(scene, &t, Renderer::Reference, can_occlude).max_relative;
+            report += &format!(
+                "{name}, T = {tolerance:e}: sun {:?} {}², measured {measured:.2e}, predicted {predicted:.2e}, {} \
+                 pixels left out\n",
+                chosen.sun,
+                chosen.sun_samples_per_axis,
+                truth.unconverged.len()
+            );
+            assert!(measured <= tolerance, "{name}: over T = {tolerance:e}:\n{report}");
+            assert!(predicted <= tolerance, "{name}: predicted over T:\n{report}");
+            costs.push(sun_cost(&chosen));
+            measured_cases += 1;
+        }
+        assert!(costs.windows(2).all(|w| w[0] <= w[1]), "{name}: looser T must cost no more: {costs:?}");
+    }
+    eprintln!("{report}");
+    assert!(measured_cases >= 30, "{report}");
+}
+
+/// `--tolerance` on the GPU (validation on): chart spheres of sharp lobes under the sun meet T = 1e-3 and 1e-4
+/// against the converged reference, the GPU's f32 arithmetic included in the bound.
+#[test]
+fn tolerance_meets_itself_on_the_gpu() {
+    use sunshade::accuracy::error::image_error;
+    use sunshade::accuracy::predicted::{choose_for_tolerance, Renderer};
+    use sunshade::gpu::Interpolation;
+    let dir = common::TempDir::new("tolerance-gpu");
+    let mut gpu = common::CheckedRenderer::new();
+    let reference = gpu.reference_options();
+    let exact_interpolation = gpu.renderer().interpolation() == Interpolation::BarycentricF64;
+    for name in ["Blinn-Phong e=10000", "Ward αx=0.02 αy=0.3"] {
+        let material = chart::brdf_chart().into_iter().find(|m| m.name == name).unwrap();
+        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
+        let l = DVec3::from_array(chart::sun_direction(60.0));
+        let lights =
+            LightOptions { sun: SunOptions { direction: Some(l), ..Default::default() }, ..Default::default() };
+        let mut s = settings::resolve_with(&scene, 64, 64, &CameraOptions::default(), &lights).unwrap();
+        s.shading.shadows = Shadows::None; // a sphere cannot shadow itself
+        for tolerance in [1e-3, 1e-4] {
+            let renderer = Renderer::Gpu { exact_interpolation };
+            let chosen = match choose_for_tolerance(&scene, &s, renderer, false, tolerance) {
+                Ok(c) => c,
+                Err(e) => {
+                    assert!(!exact_interpolation, "{name}: {e}");
+                    return; // a device without f64 interpolation has no bound to test
+                }
+            };
+            let mut t = s.clone();
+            t.shading = chosen;
+            let image = gpu.render(&scene, &t);
+            let truth = render_converged(
+                &scene,
+                &s,
+                &reference,
+                &ConvergenceOptions { accuracy: tolerance / 10.0, max_refinements: 5 },
+            );
+            let mut excluded = vec![false; 64 * 64];
+            for u in &truth.unconverged {
+                excluded[(u.y * 64 + u.x) as usize] = true;
+            }
+            let e = image_error(&image, &truth.image, Some(&excluded)).unwrap();
+            println!("{name}, T = {tolerance:e}: sun {}², GPU measured {:.2e}", chosen.sun_samples_per_axis, e.max_rel);
+            assert!(e.max_rel <= tolerance, "{name}: GPU {:.2e} over T = {tolerance:e}", e.max_rel);
+            assert_eq!(e.coverage_mismatches, 0);
+        }
+    }
 }

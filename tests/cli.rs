@@ -583,6 +583,49 @@ fn bench_pareto_measures_each_setting_against_the_converged_reference() {
 }
 
 #[test]
+fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
+    let dir = TempDir::new("tolerance-cli");
+    let material = sunshade::authoring::chart::brdf_chart().into_iter().find(|m| m.name == "Phong e=100").unwrap();
+    let input = dir.write("sphere.glb", &sunshade::authoring::chart::sphere_scene(&material));
+    let exr = dir.path("t.exr");
+    // `--shadows none`: the bound is then against the unshadowed truth (a device without ray queries has no other).
+    let base = ["render", s(&input), "-o", s(&exr), "--width", "32", "--height", "32", "-v", "--shadows", "none"];
+    let predicted = |o: &Output| -> f64 {
+        let line =
+            stderr(o).lines().find(|l| l.starts_with("sunshade: predicted max relative error: ")).unwrap().to_string();
+        line["sunshade: predicted max relative error: ".len()..].split(' ').next().unwrap().parse().unwrap()
+    };
+    let o = sunshade(&base);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("sunshade: sun: disk, 8² samples"), "{}", stderr(&o));
+    let default_bound = predicted(&o);
+    // The header records the bound, the same number.
+    let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+    let all: serde_json::Value = match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
+    };
+    let recorded = all["sunshadePredictedError"]["max_relative_error"].as_f64().unwrap();
+    assert!((recorded - default_bound).abs() <= 0.01 * recorded, "{recorded} against {default_bound}");
+    // Looser tolerance, fewer samples; each bound within its tolerance.
+    let mut samples = Vec::new();
+    for t in ["1e-2", "1e-4"] {
+        let o = sunshade(&[&base[..], &["--tolerance", t]].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(predicted(&o) <= t.parse::<f64>().unwrap(), "{}", stderr(&o));
+        let line = stderr(&o).lines().find(|l| l.starts_with("sunshade: sun: ")).unwrap().to_string();
+        samples.push(line);
+    }
+    assert_ne!(samples[0], samples[1], "{samples:?}");
+    // No bound for the sky yet: refused, by name, before any output.
+    let sky = dir.path("sky.exr");
+    let o = sunshade(&["render", s(&input), "-o", s(&sky), "--sky-radiance", "100", "--tolerance", "1e-3"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("this scene has a sky"), "{}", stderr(&o));
+    assert!(!sky.exists());
+}
+
+#[test]
 fn scripts_get_json_silence_completions_and_a_man_page() {
     let dir = TempDir::new("scripts");
     let input = dir.write("scene.glb", &scene());

@@ -9,6 +9,8 @@
 //!
 //! This module knows the reference renderer and the comparison, never Vulkan: GPU timings come from the caller.
 
+pub mod bounds;
 pub mod converged;
 pub mod error;
 pub mod pareto;
+pub mod predicted;

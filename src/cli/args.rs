@@ -240,6 +240,14 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
 
+    /// Choose the cheapest sun model (delta, or the disk with the fewest samples) whose derived error bound, with
+    /// the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
+    /// the models and the predicted bound (docs/accuracy.md, "Error bounds"). Bounds exist for the sun so far:
+    /// scenes with disk lights or a sky, f32 interpolation, and shadows other than rays (or `--shadows none`, which
+    /// measures against the unshadowed truth) are refused.
+    #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
+    pub tolerance: Option<f64>,
+
     /// Shadows: `auto` (shadow rays where the device has ray queries, else none, with a warning; none where
     /// nothing can occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk
     /// lights, any device; the sky unoccluded). The reference casts rays for every technique but `none`.

@@ -175,8 +175,11 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
             match result {
                 Ok(job) => {
                     let args = jobs[i].as_ref().expect("rendered");
-                    let metadata =
-                        super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+                    let metadata = super::metadata::of_render_predicted(
+                        &job.settings,
+                        &session.renderer_description(job.renderer),
+                        &job.prediction,
+                    );
                     let item = Encode {
                         job: i,
                         image: job.image,

@@ -1,13 +1,22 @@
 //! What an output file records about its render: the camera as OpenEXR's standard `worldToCamera` and
 //! `worldToNDC` matrices, and the lights and quality settings as JSON text (`sunshadeLights`,
-//! `sunshadeSettings`: in EXR inside the one JSON attribute `sunshade`, in PNG as tEXt chunks). No error bound is recorded yet: sunshade has no model of one (the speed-against-error
-//! issue adds it).
+//! `sunshadeSettings`: in EXR inside the one JSON attribute `sunshade`, in PNG as tEXt chunks), and the predicted
+//! error bound of the models used (`sunshadePredictedError`, `accuracy::predicted`).
 
 use serde_json::json;
 
+use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
+
+/// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference"), with its
+/// predicted error.
+pub fn of_render_predicted(settings: &RenderSettings, renderer: &str, prediction: &Prediction) -> Metadata {
+    let mut meta = of_render(settings, renderer);
+    meta.text.push(("sunshadePredictedError".into(), prediction.json().to_string()));
+    meta
+}
 
 /// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference").
 pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
@@ -54,5 +63,14 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
             ("worldToCamera".into(), m(cam.view_from_world())),
             ("worldToNDC".into(), m(cam.clip_from_world(aspect))),
         ],
+    }
+}
+
+/// The sun model of a render in words, for `-v`: "sun: disk, 8² samples".
+pub fn sun_model_line(settings: &RenderSettings) -> String {
+    match (settings.lights.sun.is_some(), settings.shading.sun) {
+        (false, _) => "sun: none".into(),
+        (true, SunModel::Delta) => "sun: delta (a single direction)".into(),
+        (true, SunModel::Disk) => format!("sun: disk, {}² samples", settings.shading.sun_samples_per_axis),
     }
 }

@@ -7,8 +7,10 @@ use clap::Args;
 use super::args::{parse_positive, OutputArgs, SceneArgs};
 use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::accuracy::converged::{self, ConvergenceOptions};
+use crate::accuracy::predicted;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image_with;
+use crate::shading::Shadows;
 
 /// Options of the reference rasterizer that mirror the device.
 #[derive(Args, Clone, Debug)]
@@ -50,7 +52,7 @@ pub struct ReferenceCommand {
     /// doublings in a row change each pixel by less than a tenth of --accuracy (relative, with the diff's floor
     /// of 1% of the peak). Pixels that have not converged after --max-refinements are reported, not hidden
     /// (docs/accuracy.md, "Speed against error").
-    #[arg(long, help_heading = "Quality")]
+    #[arg(long, help_heading = "Quality", conflicts_with = "tolerance")]
     pub converged: bool,
     /// The accuracy the converged reference claims (relative).
     #[arg(long, value_name = "REL", default_value_t = converged::DEFAULT_ACCURACY, value_parser = parse_positive, requires = "converged", help_heading = "Quality")]
@@ -77,6 +79,13 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let options = a.reference.options();
     let choice = cpu::shadow_choice(&scene, &settings, &options);
     settings.shading.shadows = choice.technique;
+    // With `--shadows none` asked for, the truth the bound is against is unshadowed too.
+    let can_occlude = a.scene.shadows != Shadows::None && crate::visibility::can_occlude(&scene);
+    if let Some(tolerance) = a.scene.tolerance {
+        settings.shading =
+            predicted::choose_for_tolerance(&scene, &settings, predicted::Renderer::Reference, can_occlude, tolerance)
+                .map_err(CliError::Usage)?;
+    }
     let (image, convergence) = if a.converged {
         let c = converged::render_converged(
             &scene,
@@ -100,7 +109,15 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    let mut meta = super::metadata::of_render(&settings, "cpu reference");
+    let prediction = if a.converged {
+        None
+    } else {
+        Some(predicted::predict(&scene, &settings, predicted::Renderer::Reference, can_occlude))
+    };
+    let mut meta = match &prediction {
+        Some(p) => super::metadata::of_render_predicted(&settings, "cpu reference", p),
+        None => super::metadata::of_render(&settings, "cpu reference"),
+    };
     if let Some((accuracy, refinements, unconverged, last_change)) = convergence {
         let record = serde_json::json!({
             "accuracy": accuracy, "refinements": refinements, "unconverged_pixels": unconverged,
@@ -119,6 +136,10 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             image.covered_count()
         );
         eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
+        eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings));
+        if let Some(p) = &prediction {
+            eprintln!("sunshade: {}", p.line());
+        }
         print_exposure(ev);
         print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())], started.elapsed());
     }

@@ -8,6 +8,7 @@ use super::args::{OutputArgs, SceneArgs};
 use super::diff::{compare_and_report, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
+use crate::accuracy::predicted::{self, Prediction};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
@@ -94,6 +95,8 @@ pub struct Rendered {
     pub settings: RenderSettings,
     /// Why that shadow technique.
     pub shadow_reason: String,
+    /// The predicted error of the models used.
+    pub prediction: Prediction,
     pub frame: FrameTimings,
     pub load: Duration,
     pub upload: Duration,
@@ -118,9 +121,21 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
+    let predicted_for = predicted::Renderer::Gpu {
+        exact_interpolation: r.interpolation() == crate::gpu::Interpolation::BarycentricF64,
+    };
+    let scene_ref = session.scene_ref(scene);
+    // With `--shadows none` asked for, the truth the bound is against is unshadowed too.
+    let can_occlude = a.scene.shadows != Shadows::None && crate::visibility::can_occlude(scene_ref);
+    if let Some(tolerance) = a.scene.tolerance {
+        settings.shading = predicted::choose_for_tolerance(scene_ref, &settings, predicted_for, can_occlude, tolerance)
+            .map_err(CliError::Usage)?;
+    }
+    let prediction = predicted::predict(scene_ref, &settings, predicted_for, can_occlude);
+    let (_, gpu_scene, r) = session.parts(scene, renderer);
     let (image, frame) = r.render(gpu_scene, &settings)?;
     warn_if_nothing_covered(&image, &a.scene.scene);
-    Ok(Rendered { image, settings, shadow_reason: choice.reason, frame, load, upload, scene, renderer })
+    Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
 }
 
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
@@ -199,7 +214,11 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
-    let meta = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+    let meta = super::metadata::of_render_predicted(
+        &job.settings,
+        &session.renderer_description(job.renderer),
+        &job.prediction,
+    );
     let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
@@ -223,6 +242,8 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             job.image.covered_count()
         );
         eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
+        eprintln!("sunshade: {}", super::metadata::sun_model_line(&job.settings));
+        eprintln!("sunshade: {}", job.prediction.line());
         print_exposure(ev);
         match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {
             (None, _) => eprintln!("sunshade: pipeline cache: off"),
