@@ -240,11 +240,7 @@ fn tolerance_meets_itself_on_the_reference() {
                 &reference,
                 &ConvergenceOptions { accuracy: tolerance / 10.0, max_refinements: 5 },
             );
-            let mut excluded = vec![false; 48 * 48];
-            for u in &truth.unconverged {
-                excluded[(u.y * 48 + u.x) as usize] = true;
-            }
-            let measured = image_error(&image, &truth.image, Some(&excluded)).unwrap().max_rel;
+            let measured = image_error(&image, &truth.image, Some(&truth.unconverged_mask())).unwrap().max_rel;
             let predicted = predict(scene, &t, Renderer::Reference, can_occlude).max_relative;
             report += &format!(
                 "{name}, T = {tolerance:e}: sun {:?} {}², measured {measured:.2e}, predicted {predicted:.2e}, {} \
@@ -301,11 +297,7 @@ fn tolerance_meets_itself_on_the_gpu() {
                 &reference,
                 &ConvergenceOptions { accuracy: tolerance / 10.0, max_refinements: 5 },
             );
-            let mut excluded = vec![false; 64 * 64];
-            for u in &truth.unconverged {
-                excluded[(u.y * 64 + u.x) as usize] = true;
-            }
-            let e = image_error(&image, &truth.image, Some(&excluded)).unwrap();
+            let e = image_error(&image, &truth.image, Some(&truth.unconverged_mask())).unwrap();
             println!("{name}, T = {tolerance:e}: sun {}², GPU measured {:.2e}", chosen.sun_samples_per_axis, e.max_rel);
             assert!(e.max_rel <= tolerance, "{name}: GPU {:.2e} over T = {tolerance:e}", e.max_rel);
             assert_eq!(e.coverage_mismatches, 0);

@@ -85,6 +85,16 @@ impl Converged {
         self.unconverged.is_empty()
     }
 
+    /// One flag a pixel (row-major): whether it has not converged, for leaving it out of an error measured against
+    /// this image.
+    pub fn unconverged_mask(&self) -> Vec<bool> {
+        let mut mask = vec![false; self.image.pixels().len()];
+        for u in &self.unconverged {
+            mask[(u.y * self.image.width() + u.x) as usize] = true;
+        }
+        mask
+    }
+
     /// The sample counts reached: "sun 12², lobes 23², shadow rays 12²".
     pub fn summary_counts(&self) -> String {
         let s = &self.shading;

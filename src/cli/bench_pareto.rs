@@ -90,10 +90,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         truth_settings.shading.shadows = if can_occlude { Shadows::Ray } else { Shadows::None };
         let truth = render_converged(&scene, &truth_settings, &reference, &convergence);
         let truth_time = t.elapsed();
-        let mut excluded = vec![false; (width * height) as usize];
-        for u in &truth.unconverged {
-            excluded[(u.y * width + u.x) as usize] = true;
-        }
+        let excluded = truth.unconverged_mask();
 
         let uploaded: Vec<GpuScene> = renderers.iter().map(|r| r.upload(&scene)).collect::<Result<_, _>>()?;
         let mut rows = Vec::new();
@@ -148,10 +145,10 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         out += "\n";
         for (metric, fronts, value) in [
             ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),
-            ("99th percentile of the relative error", &front_p99, |e: &ImageError| e.p99),
+            ("p99 relative error", &front_p99, |e: &ImageError| e.p99),
         ] {
             charts.push(LogLogChart {
-                title: format!("{name}, {width}x{height}: {metric} (labels: # in the table)"),
+                title: format!("{name}, {width}x{height}: {metric} (labels: table rows)"),
                 x_title: "GPU frame [ms]".into(),
                 y_title: metric.into(),
                 points: rows

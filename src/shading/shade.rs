@@ -327,7 +327,7 @@ impl SampleRays<'_> {
 /// A lobe much narrower than the disk would fall between the points of a uniform grid (a Phong lobe of e = 1e4
 /// under the lecture's disk: 71% error on 16 × 16), so the grid is graded ([`sinh_warp`]) about the point where
 /// the lobe's peak (the mirror direction of the viewer) meets the disk's plane, with the width of the lobe's
-/// footprint there, capped at 16 times the interval (uniform to 0.2%) for wide lobes. The integrand
+/// footprint there; for wide lobes it blends continuously into the uniform grid ([`uniform_blend`]). The integrand
 /// stays smooth in the warped coordinates, so the midpoint rule keeps its 1/k² convergence, and everything is a
 /// continuous function of the inputs: no sample switches on or off between the GPU and the reference.
 pub fn segment_lobe_integral(
