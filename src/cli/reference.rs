@@ -87,22 +87,8 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
                 .map_err(CliError::Usage)?;
     }
     let (image, convergence) = if a.converged {
-        let c = converged::render_converged(
-            &scene,
-            &settings,
-            &options,
-            &ConvergenceOptions { accuracy: a.accuracy, max_refinements: a.max_refinements },
-        );
-        settings.shading = c.shading;
-        if c.converged() {
-            if a.verbose {
-                eprintln!("sunshade: {}", c.summary());
-            }
-        } else {
-            super::warn(&c.summary());
-        }
-        let record = (c.accuracy, c.refinements, c.unconverged.len(), c.last_change);
-        (c.image, Some(record))
+        let (image, record) = converged_image(&scene, &mut settings, &options, a);
+        (image, Some(record))
     } else {
         (cpu::render(&scene, &settings, &options), None)
     };
@@ -118,13 +104,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         Some(p) => super::metadata::of_render_predicted(&settings, "cpu reference", p),
         None => super::metadata::of_render(&settings, "cpu reference"),
     };
-    if let Some((accuracy, refinements, unconverged, last_change)) = convergence {
-        let record = serde_json::json!({
-            "accuracy": accuracy, "refinements": refinements, "unconverged_pixels": unconverged,
-            "last_change": last_change,
-        });
-        meta.text.push(("sunshadeConverged".into(), record.to_string()));
-    }
+    meta.text.extend(convergence);
     let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
     if a.verbose {
         eprintln!(
@@ -144,4 +124,31 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         print_phases(&[("load", load_time), ("render", render_time), ("encode", t.elapsed())], started.elapsed());
     }
     Ok(())
+}
+
+/// `--converged`: the converged reference of `scene` (a warning names the pixels that did not converge), with
+/// `settings` updated to its final sample counts, and its `sunshadeConverged` record for the output's metadata.
+fn converged_image(
+    scene: &crate::scene::Scene,
+    settings: &mut crate::settings::RenderSettings,
+    options: &ReferenceOptions,
+    a: &ReferenceCommand,
+) -> (crate::film::Image, (String, String)) {
+    let c = converged::render_converged(
+        scene,
+        settings,
+        options,
+        &ConvergenceOptions { accuracy: a.accuracy, max_refinements: a.max_refinements },
+    );
+    settings.shading = c.shading;
+    if !c.converged() {
+        super::warn(&c.summary());
+    } else if a.verbose {
+        eprintln!("sunshade: {}", c.summary());
+    }
+    let record = serde_json::json!({
+        "accuracy": c.accuracy, "refinements": c.refinements, "unconverged_pixels": c.unconverged.len(),
+        "last_change": c.last_change,
+    });
+    (c.image, ("sunshadeConverged".into(), record.to_string()))
 }

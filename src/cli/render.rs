@@ -114,25 +114,23 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let renderer = session.renderer(a.device.clone(), a.interpolation)?;
     session.renderer_mut(renderer).check_size(settings.width, settings.height)?;
     let upload = session.upload(scene, renderer)?;
-    let (_, gpu_scene, r) = session.parts(scene, renderer);
+    let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let choice = r.shadow_choice(gpu_scene, &settings)?;
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
-    let predicted_for = predicted::Renderer::Gpu {
-        exact_interpolation: r.interpolation() == crate::gpu::Interpolation::BarycentricF64,
-    };
-    let scene_ref = session.scene_ref(scene);
+    let predicted_for =
+        predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
     // With `--shadows none` asked for, the truth the bound is against is unshadowed too.
-    let can_occlude = a.scene.shadows != Shadows::None && crate::visibility::can_occlude(scene_ref);
+    let can_occlude = a.scene.shadows != Shadows::None && gpu_scene.can_occlude();
     if let Some(tolerance) = a.scene.tolerance {
-        settings.shading = predicted::choose_for_tolerance(scene_ref, &settings, predicted_for, can_occlude, tolerance)
-            .map_err(CliError::Usage)?;
+        settings.shading =
+            predicted::choose_for_tolerance(scene_data, &settings, predicted_for, can_occlude, tolerance)
+                .map_err(CliError::Usage)?;
     }
-    let prediction = predicted::predict(scene_ref, &settings, predicted_for, can_occlude);
-    let (_, gpu_scene, r) = session.parts(scene, renderer);
+    let prediction = predicted::predict(scene_data, &settings, predicted_for, can_occlude);
     let (image, frame) = r.render(gpu_scene, &settings)?;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
