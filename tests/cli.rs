@@ -607,6 +607,11 @@ fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
     };
     let recorded = all["sunshadePredictedError"]["max_relative_error"].as_f64().unwrap();
     assert!((recorded - default_bound).abs() <= 0.01 * recorded, "{recorded} against {default_bound}");
+    // `--check --json` carries it beside the comparison.
+    let o = sunshade(&[&base[..8], &["--shadows", "none", "--check", "--json"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let check: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(check["predicted_error"]["max_relative_error"].as_f64(), Some(recorded));
     // Looser tolerance, fewer samples; each bound within its tolerance.
     let mut samples = Vec::new();
     for t in ["1e-2", "1e-4"] {

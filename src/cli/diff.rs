@@ -119,13 +119,20 @@ pub struct DiffCommand {
 }
 
 /// Compares, writes the heatmap if asked, prints the report; `Ok(pass)`.
+/// How a comparison is reported: text, or JSON with these extra members (`render --check --json` adds the
+/// render's predicted error).
+pub enum ReportFormat {
+    Text,
+    Json(serde_json::Map<String, serde_json::Value>),
+}
+
 pub fn compare_and_report(
     a: &Image,
     b: &Image,
     names: (&str, &str),
     options: &DiffOptions,
     heatmap: Option<&std::path::Path>,
-    json: bool,
+    format: ReportFormat,
 ) -> Result<DiffReport, CliError> {
     let (report, per_pixel): (DiffReport, Vec<PixelDiff>) =
         compare::diff(a, b, options).map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
@@ -133,12 +140,17 @@ pub fn compare_and_report(
         compare::write_heatmap(path, a.width(), a.height(), &per_pixel)
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))?;
     }
-    if super::quiet() {
+    match format {
         // -q: the exit code says it.
-    } else if json {
-        println!("{}", serde_json::to_string_pretty(&report.json(names.0, names.1)).expect("serialisable"));
-    } else {
-        print!("{}", report.text(names.0, names.1));
+        _ if super::quiet() => {}
+        ReportFormat::Json(extra) => {
+            let mut json = report.json(names.0, names.1);
+            if let Some(object) = json.as_object_mut() {
+                object.extend(extra);
+            }
+            println!("{}", serde_json::to_string_pretty(&json).expect("serialisable"));
+        }
+        ReportFormat::Text => print!("{}", report.text(names.0, names.1)),
     }
     Ok(report)
 }
@@ -185,8 +197,9 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
         crate::film::write_image(&d, o, crate::film::Exposure::Ev(0.0))?;
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
+    let format = if a.json { ReportFormat::Json(Default::default()) } else { ReportFormat::Text };
     let report =
-        compare_and_report(&ia, &ib, (&names.0, &names.1), &a.tolerances.options(), a.heatmap.as_deref(), a.json)?;
+        compare_and_report(&ia, &ib, (&names.0, &names.1), &a.tolerances.options(), a.heatmap.as_deref(), format)?;
     if report.pass {
         Ok(())
     } else {

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::args::{OutputArgs, SceneArgs};
-use super::diff::{compare_and_report, ToleranceArgs};
+use super::diff::{compare_and_report, ReportFormat, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
 use crate::accuracy::predicted::{self, Prediction};
@@ -160,13 +160,20 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     if verbose {
         eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     }
+    // The JSON also carries the render's predicted error against the truth (the comparison is against the
+    // reference with the same models).
+    let format = if a.json {
+        ReportFormat::Json([("predicted_error".to_string(), job.prediction.json())].into_iter().collect())
+    } else {
+        ReportFormat::Text
+    };
     let report = compare_and_report(
         &job.image,
         &reference,
         ("gpu", "cpu reference"),
         &a.tolerances.options(),
         a.heatmap.as_deref(),
-        a.json,
+        format,
     )?;
     if report.pass {
         return Ok(());
