@@ -1,11 +1,13 @@
 //! Speed against error: how far an image is from the truth, not only from the other renderer.
 //!
-//! - [`converged`]: the converged reference, the CPU reference with every sampled integral refined until doubling
-//!   its samples no longer changes any pixel by more than a tenth of the accuracy claimed (pixels where that does
-//!   not hold are reported);
+//! - [`converged`]: the converged reference, the CPU reference with every sampled integral refined until two
+//!   doublings of its samples in a row change no pixel by more than a tenth of the accuracy claimed (pixels where
+//!   that does not hold are reported);
 //! - [`error`]: an image's error against such a truth (max relative with the diff's floor, p99, RMSE, pixels over
 //!   1e-2, 1e-3, 1e-4);
-//! - [`pareto`]: which settings of a sweep are on the front of frame time against error.
+//! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
+//! - [`bounds`]: the sun models' error bounds, derived next to the code;
+//! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models.
 //!
 //! This module knows the reference renderer and the comparison, never Vulkan: GPU timings come from the caller.
 
