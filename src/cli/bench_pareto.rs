@@ -16,6 +16,7 @@ use super::CliError;
 use crate::accuracy::converged::{render_converged, ConvergenceOptions};
 use crate::accuracy::error::{image_error, ImageError};
 use crate::accuracy::pareto::pareto_front;
+use crate::accuracy::predicted;
 use crate::cpu::ReferenceOptions;
 use crate::gpu::{ContextOptions, GpuScene, Interpolation, Renderer};
 use crate::plot::{Canvas, LogLogChart, Point};
@@ -32,6 +33,8 @@ struct Row {
     frame_ms: f64,
     spread_ms: f64,
     error: ImageError,
+    /// The predicted bound (`accuracy::predicted`), and whether part of the image has none.
+    predicted: (f64, bool),
 }
 
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
@@ -61,7 +64,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
          GPU frame: median of {} warm runs, spread = slowest − fastest. Error against the converged reference \
          (claimed accuracy {:.0e}, at most {} doublings): per pixel |L − L_conv| / max(|L|, |L_conv|, 1% of the \
          peak), largest over RGB; the pixels where the reference itself did not converge are left out (counted per \
-         scene). ★: on the Pareto front of frame time against the max (or the p99) relative error.\n\n",
+         scene). Predicted: the bound `-v` prints for the setting (`accuracy::predicted`); † where part of the image \
+         has no bound (disk lights, the sky, penumbrae, shadow maps, f32 or device interpolation), the number \
+         covering the rest. ★: on the Pareto front of frame time against the max (or the p99) relative error.\n\n",
         today(),
         machine(),
         device_description(&info),
@@ -109,7 +114,12 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
                 times.iter().max().copied().unwrap_or_default() - times.iter().min().copied().unwrap_or_default();
             let error = image_error(&image, &truth.image, Some(&excluded))
                 .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-            rows.push(Row { label, frame_ms: ms(median(times)), spread_ms: ms(spread), error });
+            let renderer = predicted::Renderer::Gpu {
+                exact_interpolation: setting.interpolation == Interpolation::BarycentricF64,
+            };
+            let p = predicted::predict(&scene, &s, renderer, can_occlude);
+            let predicted = (p.max_relative, !p.unbounded.is_empty());
+            rows.push(Row { label, frame_ms: ms(median(times)), spread_ms: ms(spread), error, predicted });
             bar.inc(1);
         }
         let front = pareto_front(&rows.iter().map(|r| (r.frame_ms, r.error.max_rel)).collect::<Vec<_>>());
@@ -123,16 +133,18 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             truth.covered,
             truth_time.as_secs_f64(),
         );
-        out += "| # | setting | GPU frame [ms] | spread [ms] | max rel | p99 rel | RMSE [W/(m²·sr)] | px > 1e-2 | px > 1e-3 | px > 1e-4 | front (max) | front (p99) |\n";
-        out += "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|:---:|:---:|\n";
+        out += "| # | setting | GPU frame [ms] | spread [ms] | max rel | predicted | p99 rel | RMSE [W/(m²·sr)] | px > 1e-2 | px > 1e-3 | px > 1e-4 | front (max) | front (p99) |\n";
+        out += "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|:---:|:---:|\n";
         for (i, ((r, &f), &f99)) in rows.iter().zip(&front).zip(&front_p99).enumerate() {
             out += &format!(
-                "| {} | {} | {:.2} | {:.2} | {:.2e} | {:.2e} | {:.2e} | {} | {} | {} | {} | {} |\n",
+                "| {} | {} | {:.2} | {:.2} | {:.2e} | {:.1e}{} | {:.2e} | {:.2e} | {} | {} | {} | {} | {} |\n",
                 i + 1,
                 r.label,
                 r.frame_ms,
                 r.spread_ms,
                 r.error.max_rel,
+                r.predicted.0,
+                if r.predicted.1 { "†" } else { "" },
                 r.error.p99,
                 r.error.rmse,
                 r.error.over[0],
