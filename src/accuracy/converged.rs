@@ -24,7 +24,7 @@
 //! rule defines the image rather than approximating an integral that a finer grid would resolve. Interpolation is
 //! in f64 throughout the reference.
 
-use crate::compare::DiffOptions;
+use crate::compare::{image_peak, pixel_difference, DiffOptions};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
 use crate::scene::Scene;
@@ -144,25 +144,6 @@ pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
     }
 }
 
-/// The relative change of each channel from `a` to `b` with this floor, largest over RGB (as `sunshade diff`).
-fn relative_change(a: [f32; 4], b: [f32; 4], floor: f64) -> f64 {
-    (0..3)
-        .map(|c| {
-            let (a, b) = (a[c] as f64, b[c] as f64);
-            let d = (a - b).abs();
-            let denom = a.abs().max(b.abs()).max(floor);
-            if d == 0.0 {
-                0.0
-            } else if denom > 0.0 && d.is_finite() {
-                d / denom
-            } else {
-                // A NaN or an infinity is never converged.
-                f64::INFINITY
-            }
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Renders `scene` on the CPU with exact light models, refining the sample grids from those of `settings` until
 /// converged or `options.max_refinements` doublings (see the module's text). The first doubling renders the
 /// whole image; later ones only the pixels still moving (`cpu::render_selected`), so that the cost follows the
@@ -180,14 +161,7 @@ pub fn render_converged(
     let mut image = cpu::render(scene, &s, reference);
     // The floor of `sunshade diff`, from the starting image's peak (refinement moves the peak by far less than
     // the 1% the floor is of it).
-    let peak = image
-        .pixels()
-        .iter()
-        .filter(|p| p[3] > 0.0)
-        .flat_map(|p| p[..3].iter().map(|v| v.abs() as f64))
-        .filter(|v| v.is_finite())
-        .fold(0.0, f64::max);
-    let floor = DiffOptions::default().floor_fraction * peak;
+    let floor = DiffOptions::default().floor_fraction * image_peak(&image);
     let threshold = options.accuracy / 10.0;
     let mut moving: Vec<bool> = image.pixels().iter().map(|p| p[3] > 0.0).collect();
     let mut result = Converged {
@@ -213,7 +187,8 @@ pub fn render_converged(
                 continue;
             }
             let (old, new) = (image.pixels()[i], finer.pixels()[i]);
-            let change = relative_change(old, new, floor);
+            // The relative change as `sunshade diff` measures it (a NaN or an infinity never converges).
+            let change = pixel_difference(old, new, floor).rel;
             image.pixels_mut()[i] = new;
             result.last_change = result.last_change.max(change);
             passes[i] = if change < threshold { passes[i] + 1 } else { 0 };

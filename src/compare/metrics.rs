@@ -158,6 +158,50 @@ pub enum PixelDiff {
     Relative(f64),
 }
 
+/// The largest absolute radiance over RGB of an image's covered pixels, ignoring non-finite values: the peak the
+/// floor is a fraction of.
+pub fn image_peak(image: &Image) -> f64 {
+    image
+        .pixels()
+        .iter()
+        .filter(|p| p[3] > 0.0)
+        .flat_map(|p| p[..3].iter().map(|v| v.abs() as f64))
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max)
+}
+
+/// Two pixels' difference: per RGB channel `|a − b|` (NaN in either is an infinite difference, never silently
+/// zero), the largest of them, and the largest relative one `|a − b| / max(|a|, |b|, floor)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelDifference {
+    pub channels: [f64; 3],
+    pub abs: f64,
+    pub rel: f64,
+}
+
+/// The difference of pixels `a` and `b` with this floor of the relative error's denominator.
+pub fn pixel_difference(a: [f32; 4], b: [f32; 4], floor: f64) -> PixelDifference {
+    let (mut abs, mut rel) = (0.0f64, 0.0f64);
+    let mut channels = [0.0; 3];
+    for c in 0..3 {
+        let (va, vb) = (a[c] as f64, b[c] as f64);
+        let d = (va - vb).abs();
+        let d = if d.is_nan() { f64::INFINITY } else { d };
+        channels[c] = d;
+        abs = abs.max(d);
+        let denom = va.abs().max(vb.abs()).max(floor);
+        let r = if d == 0.0 {
+            0.0
+        } else if denom > 0.0 {
+            d / denom
+        } else {
+            f64::INFINITY
+        };
+        rel = rel.max(r);
+    }
+    PixelDifference { channels, abs, rel }
+}
+
 /// Compares two images of the same size. `Err` names the size mismatch.
 pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, Vec<PixelDiff>), String> {
     if (a.width(), a.height()) != (b.width(), b.height()) {
@@ -174,14 +218,7 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
             (-1..=1).any(|dy| (-1..=1).any(|dx| covered(img, x + dx, y + dy) != c))
         })
     };
-    let peak = a
-        .pixels()
-        .iter()
-        .chain(b.pixels())
-        .filter(|p| p[3] > 0.0)
-        .flat_map(|p| p[..3].iter().map(|v| v.abs() as f64))
-        .filter(|v| v.is_finite())
-        .fold(0.0, f64::max);
+    let peak = image_peak(a).max(image_peak(b));
     let floor = options.floor.max(options.floor_fraction * peak);
 
     let mut report = DiffReport {
@@ -224,23 +261,9 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
                 continue;
             }
             report.compared += 1;
-            let (mut abs, mut rel) = (0.0f64, 0.0f64);
-            for c in 0..3 {
-                let (va, vb) = (pa[c] as f64, pb[c] as f64);
-                let d = (va - vb).abs();
-                // NaN in either image is an infinite error, never silently zero.
-                let d = if d.is_nan() { f64::INFINITY } else { d };
+            let PixelDifference { channels, abs, rel } = pixel_difference(pa, pb, floor);
+            for d in channels {
                 sum_sq += d * d;
-                abs = abs.max(d);
-                let denom = va.abs().max(vb.abs()).max(floor);
-                let r = if d == 0.0 {
-                    0.0
-                } else if denom > 0.0 {
-                    d / denom
-                } else {
-                    f64::INFINITY
-                };
-                rel = rel.max(r);
             }
             let edge = boundary(x, y);
             report.max_abs = report.max_abs.max(abs);

@@ -4,7 +4,10 @@ mod heatmap;
 mod metrics;
 
 pub use heatmap::{colour_scale, heatmap};
-pub use metrics::{diff, DiffOptions, DiffReport, PixelDiff, Split, WorstPixel, F32_SHADING_PEAK_FRACTION};
+pub use metrics::{
+    diff, image_peak, pixel_difference, DiffOptions, DiffReport, PixelDiff, PixelDifference, Split, WorstPixel,
+    F32_SHADING_PEAK_FRACTION,
+};
 
 /// Writes a heatmap PNG atomically.
 pub fn write_heatmap(path: &std::path::Path, width: u32, height: u32, diffs: &[PixelDiff]) -> std::io::Result<()> {

@@ -17,6 +17,14 @@ pub struct Canvas {
 /// Side of a glyph [pixels] at scale 1.
 pub const GLYPH: i32 = 8;
 
+/// The set pixels `(column, row)` of a character's 8×8 glyph, from its top left; characters outside ASCII are '?'.
+fn glyph_pixels(ch: char) -> impl Iterator<Item = (i32, i32)> {
+    let code = if ch.is_ascii() { ch as usize } else { '?' as usize };
+    let glyph = font8x8::legacy::BASIC_LEGACY[code];
+    // font8x8: bit k of a row is column k from the left.
+    (0..8).flat_map(move |row| (0..8).filter(move |col| glyph[row] >> col & 1 == 1).map(move |col| (col, row as i32)))
+}
+
 impl Canvas {
     pub fn new(width: u32, height: u32) -> Self {
         Self { width, height, pixels: vec![[255; 3]; (width * height) as usize] }
@@ -76,17 +84,10 @@ impl Canvas {
     /// Text from its top-left corner, each glyph `8·scale` pixels square; characters outside ASCII draw as '?'.
     pub fn text(&mut self, (x, y): (i32, i32), text: &str, c: Rgb, scale: i32) {
         for (i, ch) in text.chars().enumerate() {
-            let code = if ch.is_ascii() { ch as usize } else { '?' as usize };
-            let glyph = font8x8::legacy::BASIC_LEGACY[code];
             let gx = x + i as i32 * GLYPH * scale;
-            for (row, bits) in glyph.iter().enumerate() {
-                for col in 0..8 {
-                    // font8x8: bit k of a row is column k from the left.
-                    if bits >> col & 1 == 1 {
-                        let (px, py) = (gx + col * scale, y + row as i32 * scale);
-                        self.fill((px, py), (px + scale - 1, py + scale - 1), c);
-                    }
-                }
+            for (col, row) in glyph_pixels(ch) {
+                let (px, py) = (gx + col * scale, y + row * scale);
+                self.fill((px, py), (px + scale - 1, py + scale - 1), c);
             }
         }
     }
@@ -94,15 +95,9 @@ impl Canvas {
     /// Text drawn upwards (rotated a quarter turn anticlockwise), from its bottom-left corner.
     pub fn text_up(&mut self, (x, y): (i32, i32), text: &str, c: Rgb) {
         for (i, ch) in text.chars().enumerate() {
-            let code = if ch.is_ascii() { ch as usize } else { '?' as usize };
-            let glyph = font8x8::legacy::BASIC_LEGACY[code];
             let gy = y - i as i32 * GLYPH;
-            for (row, bits) in glyph.iter().enumerate() {
-                for col in 0..8 {
-                    if bits >> col & 1 == 1 {
-                        self.set(x + row as i32, gy - col, c);
-                    }
-                }
+            for (col, row) in glyph_pixels(ch) {
+                self.set(x + row, gy - col, c);
             }
         }
     }
