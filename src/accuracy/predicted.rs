@@ -197,3 +197,22 @@ pub fn choose_for_tolerance(
         worst(&shading) + arithmetic
     ))
 }
+
+/// The models of a render and their predicted error: `--tolerance`'s choice where one is asked
+/// (`settings.shading` updated, shadows already resolved), then [`predict`] for the models used.
+/// `scene_can_occlude`: whether something in the scene can occlude a light; with `--shadows none` asked for
+/// (`asked`), the truth the bound is against is unshadowed too.
+pub fn choose_and_predict(
+    scene: &Scene,
+    settings: &mut RenderSettings,
+    renderer: Renderer,
+    asked: Shadows,
+    scene_can_occlude: bool,
+    tolerance: Option<f64>,
+) -> Result<Prediction, String> {
+    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    if let Some(tolerance) = tolerance {
+        settings.shading = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance)?;
+    }
+    Ok(predict(scene, settings, renderer, can_occlude))
+}

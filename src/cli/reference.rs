@@ -10,7 +10,6 @@ use crate::accuracy::converged::{self, ConvergenceOptions};
 use crate::accuracy::predicted;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image_with;
-use crate::shading::Shadows;
 
 /// Options of the reference rasterizer that mirror the device.
 #[derive(Args, Clone, Debug)]
@@ -77,15 +76,22 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let (scene, mut settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
     let options = a.reference.options();
-    let choice = cpu::shadow_choice(&scene, &settings, &options);
+    // Tested once: the shadow choice and the error bound both need it.
+    let scene_can_occlude = crate::visibility::can_occlude(&scene);
+    let choice = cpu::shadow_choice_where(scene_can_occlude, &settings, &options);
     settings.shading.shadows = choice.technique;
-    // With `--shadows none` asked for, the truth the bound is against is unshadowed too.
-    let can_occlude = a.scene.shadows != Shadows::None && crate::visibility::can_occlude(&scene);
-    if let Some(tolerance) = a.scene.tolerance {
-        settings.shading =
-            predicted::choose_for_tolerance(&scene, &settings, predicted::Renderer::Reference, can_occlude, tolerance)
-                .map_err(CliError::Usage)?;
-    }
+    // `--converged` has no bound to predict (it is the truth), and takes no `--tolerance`.
+    let prediction = if a.converged {
+        None
+    } else {
+        let asked = a.scene.shadows;
+        let renderer = predicted::Renderer::Reference;
+        let tolerance = a.scene.tolerance;
+        Some(
+            predicted::choose_and_predict(&scene, &mut settings, renderer, asked, scene_can_occlude, tolerance)
+                .map_err(CliError::Usage)?,
+        )
+    };
     let (image, convergence) = if a.converged {
         let (image, record) = converged_image(&scene, &mut settings, &options, a);
         (image, Some(record))
@@ -95,11 +101,6 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
     let t = Instant::now();
-    let prediction = if a.converged {
-        None
-    } else {
-        Some(predicted::predict(&scene, &settings, predicted::Renderer::Reference, can_occlude))
-    };
     let mut meta = match &prediction {
         Some(p) => super::metadata::of_render_predicted(&settings, "cpu reference", p),
         None => super::metadata::of_render(&settings, "cpu reference"),

@@ -123,14 +123,15 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     settings.shading.shadows = choice.technique;
     let predicted_for =
         predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
-    // With `--shadows none` asked for, the truth the bound is against is unshadowed too.
-    let can_occlude = a.scene.shadows != Shadows::None && gpu_scene.can_occlude();
-    if let Some(tolerance) = a.scene.tolerance {
-        settings.shading =
-            predicted::choose_for_tolerance(scene_data, &settings, predicted_for, can_occlude, tolerance)
-                .map_err(CliError::Usage)?;
-    }
-    let prediction = predicted::predict(scene_data, &settings, predicted_for, can_occlude);
+    let prediction = predicted::choose_and_predict(
+        scene_data,
+        &mut settings,
+        predicted_for,
+        a.scene.shadows,
+        gpu_scene.can_occlude(),
+        a.scene.tolerance,
+    )
+    .map_err(CliError::Usage)?;
     let (image, frame) = r.render(gpu_scene, &settings)?;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })

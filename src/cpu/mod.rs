@@ -125,17 +125,34 @@ struct Prepared {
 /// The reference's shadow technique for this scene and these settings, and why (see
 /// [`crate::visibility::choose_reference`]).
 pub fn shadow_choice(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> ShadowChoice {
+    // The scene's test runs only where `auto` needs it.
+    let can_occlude = settings.shading.shadows != Shadows::Auto || crate::visibility::can_occlude(scene);
+    shadow_choice_where(can_occlude, settings, options)
+}
+
+/// [`shadow_choice`] for a caller that has already tested whether the scene can occlude a light
+/// (`crate::visibility::can_occlude`).
+pub fn shadow_choice_where(
+    scene_can_occlude: bool,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+) -> ShadowChoice {
     let requested = settings.shading.shadows;
-    let can_occlude = requested != Shadows::Auto || crate::visibility::can_occlude(scene);
+    let can_occlude = requested != Shadows::Auto || scene_can_occlude;
     crate::visibility::choose_reference(requested, &settings.lights, can_occlude, options.device_ray_queries)
+}
+
+/// The occluders the render's shadow rays test ([`shadow_choice`]), or `None` where every light is unoccluded.
+fn occluders_for<'a>(scene: &'a Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Option<Occluders<'a>> {
+    match shadow_choice(scene, settings, options).technique {
+        Shadows::None => None,
+        _ => Some(Occluders::new(scene)),
+    }
 }
 
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
-    let occluders = match shadow_choice(scene, settings, options).technique {
-        Shadows::None => None,
-        _ => Some(Occluders::new(scene)),
-    };
+    let occluders = occluders_for(scene, settings, options);
     render_inner(scene, settings, options, occluders.as_ref(), false, None).0
 }
 
@@ -149,10 +166,7 @@ pub fn render_selected(
     selected: &[bool],
 ) -> Image {
     assert_eq!(selected.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
-    let occluders = match shadow_choice(scene, settings, options).technique {
-        Shadows::None => None,
-        _ => Some(Occluders::new(scene)),
-    };
+    let occluders = occluders_for(scene, settings, options);
     render_inner(scene, settings, options, occluders.as_ref(), false, Some(selected)).0
 }
 
@@ -177,10 +191,7 @@ pub fn render_with_fragile_pixels(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let occluders = match shadow_choice(scene, settings, options).technique {
-        Shadows::None => None,
-        _ => Some(Occluders::new(scene)),
-    };
+    let occluders = occluders_for(scene, settings, options);
     let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true, None);
     let n = image.pixels().len();
     (image, fragile.unwrap_or_else(|| vec![false; n]))
