@@ -115,6 +115,11 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
     return 0.0;
 }
 
+// The specular lobe of a material (without ks) per channel for light from l: an analytic lobe's one value in each.
+vec3 specular_lobe_rgb(MaterialGpu m, Frame p, vec3 l) {
+    return vec3(specular_lobe(m, p, l));
+}
+
 // The angular width [rad] about a lobe's peak over which the disk integral crowds its samples (see the Rust).
 float lobe_width(MaterialGpu m) {
     uint kind = VARIANT_BRDF;
@@ -154,11 +159,18 @@ vec2 sinh_warp_ends(float a, float b, float c, float w) {
     return vec2(asinh_accurate((a - c) / w), asinh_accurate((b - c) / w));
 }
 
+// The grid's sums over a disk, per unit radiance (see the Rust): the lobe's per channel over the visible samples,
+// the cosine's over all, and how uniform the grid was.
+struct SegmentSums {
+    vec3 lobe;
+    float projected;
+    float uniformity;
+};
+
 // The lobe integral with the grid's weights normalised, as far as the grid is uniform, to integrate the cosine
 // exactly: lobe (1 + uniformity (exact/projected - 1)) (a ratio estimator; see the Rust).
-// sums = (lobe, projected, uniformity).
-float normalized_lobe_integral(vec3 sums, float exact) {
-    return sums.y > 0.0 ? sums.x * (1.0 + sums.z * (exact / sums.y - 1.0)) : sums.x;
+vec3 normalized_lobe_integral(SegmentSums sums, float exact) {
+    return sums.projected > 0.0 ? sums.lobe * (1.0 + sums.uniformity * (exact / sums.projected - 1.0)) : sums.lobe;
 }
 
 // The projected solid angle [sr] of the sun's cap above the horizon: pi sin^2(delta/2) E / E_perp.
@@ -167,14 +179,14 @@ float sun_projected_solid_angle_above(float n_dot_l, float angular_diameter) {
     return PI * s * s * sun_irradiance_disk(vec3(1.0), n_dot_l, angular_diameter).x;
 }
 
-// The grid's sums over a disk, per unit radiance: (integral of lobe (n.w)+ over its visible samples, integral of
-// (n.w)+ over all of them, the grid's uniformity), for the disk of radius `radius` centred at q from the point, emitting along d:
-// segment coordinates, the grid graded about the lobe's peak (see the Rust).
-vec3 segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
+// The grid's sums over a disk, per unit radiance, for the disk of radius `radius` centred at q from the point,
+// emitting along d: segment coordinates, the grid graded about the lobe's peak (see the Rust).
+SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
     vec3 n = p.normal;
     float h = -dot(d, q);
+    SegmentSums none = SegmentSums(vec3(0.0), 0.0, 0.0);
     if (!(h > 0.0 && radius > 0.0)) {
-        return vec3(0.0);
+        return none;
     }
     vec3 n_perp = n - dot(n, d) * d;
     float mlen = length(n_perp);
@@ -185,7 +197,7 @@ vec3 segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float
         w = mlen > 0.0 ? n_perp / mlen : orthonormal_to(d);
         alpha = PI;
     } else if (nq + radius * mlen <= 0.0) {
-        return vec3(0.0);
+        return none;
     } else {
         float kappa = clamp(-nq / (radius * mlen), -1.0, 1.0);
         w = n_perp / mlen;
@@ -212,7 +224,7 @@ vec3 segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float
     float width_beta = min(footprint / max(rate_beta, 1e-30), 16.0 * alpha);
     float width_s = min(footprint / max(radius * sbc, 1e-30), 32.0);
     float k = float(per_axis);
-    float sum = 0.0;
+    vec3 sum = vec3(0.0);
     float projected = 0.0;
     vec2 beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
     vec2 s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
@@ -237,12 +249,12 @@ vec3 segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float
                 // A sample that contributes casts its shadow ray (|| short-circuits).
                 if (rays == RAYS_NONE || (rays == RAYS_ALONG ? visible_along(p.shadow_origin, omega)
                                                             : visible_to(p.shadow_origin, p.position + y))) {
-                    sum += specular_lobe(m, p, omega) * weight;
+                    sum += specular_lobe_rgb(m, p, omega) * weight;
                 }
             }
         }
     }
-    return vec3(sum / (k * k), projected / (k * k), min(blend_beta, blend_s));
+    return SegmentSums(sum / (k * k), projected / (k * k), min(blend_beta, blend_s));
 }
 
 // A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
@@ -257,7 +269,7 @@ vec3 cos_power_direction(vec3 axis, vec3 t, vec3 b, float exponent, float xi1, f
 
 // integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
 // inverse CDF, each sample weighted by lobe/pdf (see the Rust).
-float sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
     vec3 n = p.normal;
     vec3 v = p.to_viewer;
     uint kind = VARIANT_BRDF;
@@ -266,7 +278,7 @@ float sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shad
     vec3 t = orthonormal_to(axis);
     vec3 b = cross(axis, t);
     float k = float(per_axis);
-    float sum = 0.0;
+    vec3 sum = vec3(0.0);
     for (uint i = 0u; i < per_axis; ++i) {
         float xi1 = (float(i) + 0.5) / k;
         for (uint j = 0u; j < per_axis; ++j) {
@@ -329,9 +341,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
     if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
         vec3 l = lights.sun.direction.xyz;
         if (VARIANT_SUN == SUN_DELTA) {
-            float factor = specular_lobe(material, p, l) * max(dot(p.normal, l), 0.0);
-            if (SHADOWS_ON && factor > 0.0 && !visible_along(p.shadow_origin, l)) {
-                factor = 0.0;
+            vec3 factor = specular_lobe_rgb(material, p, l) * max(dot(p.normal, l), 0.0);
+            if (SHADOWS_ON && any(greaterThan(factor, vec3(0.0))) && !visible_along(p.shadow_origin, l)) {
+                factor = vec3(0.0);
             }
             if (SHADOWS_MAP_ON) {
                 factor *= sun_map_fraction;
@@ -341,9 +353,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
             float radius = tan(0.5 * delta);
-            vec3 sums = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
+            SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
                 SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
-            float integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
+            vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
             // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the
             // sun is wholly visible or wholly hidden).
             if (SHADOWS_MAP_ON) {
@@ -354,18 +366,18 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
     }
     for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
         DiskGpu d = lights.disks[i];
-        float integral;
+        vec3 integral;
         if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
             vec3 to_center = safe_normalize(d.center_radius.xyz - p.position);
-            integral = specular_lobe(material, p, to_center)
-                * disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
-            if (SHADOWS_ON && integral > 0.0 && !visible_to(p.shadow_origin, d.center_radius.xyz)) {
-                integral = 0.0;
+            float omega = disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+            integral = specular_lobe_rgb(material, p, to_center) * omega;
+            if (SHADOWS_ON && any(greaterThan(integral, vec3(0.0))) && !visible_to(p.shadow_origin, d.center_radius.xyz)) {
+                integral = vec3(0.0);
             }
         } else {
             // The grid's sum as it is (see disk_lobe_integral in the Rust).
             integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
-                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).x;
+                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).lobe;
         }
         if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
             integral *= disk_map_fraction[i];

@@ -220,6 +220,12 @@ pub fn irradiance_visible(
     e
 }
 
+/// The specular lobe of a material (without ks) per channel for light from `l`: the analytic lobes' one value in
+/// each channel.
+pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
+    [specular_lobe(brdf, p, l); 3]
+}
+
 /// The specular lobe of a material (without ks) for light from `l`.
 pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
     let (n, v) = (p.normal, p.to_viewer);
@@ -237,9 +243,10 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
 /// are exactly those through a disk of radius `tan σ` one unit away along `direction`, facing back, so the graded
 /// grid of [`segment_lobe_integral`] integrates it, lobes narrower than the sun included (a Phong lobe of
 /// e = 1e6 is 0.06° wide against the sun's 0.53°).
+/// Per channel, the first (an analytic lobe's three are equal).
 pub fn sun_lobe_integral(brdf: &Brdf, p: &SurfacePoint, direction: DVec3, angular_diameter: f64, per_axis: u32) -> f64 {
     let sums = segment_lobe_integral(brdf, p, direction, -direction, (0.5 * angular_diameter).tan(), per_axis);
-    normalized_lobe_integral(sums, sun_projected_solid_angle_above(p.normal.dot(direction), angular_diameter))
+    normalized_lobe_integral(sums, sun_projected_solid_angle_above(p.normal.dot(direction), angular_diameter))[0]
 }
 
 /// The projected solid angle [sr] of the sun's cap above a surface's horizon, `∫ (n·ω)+ dω`: the disk sun's
@@ -298,8 +305,9 @@ pub fn sinh_warp_ends(a: f64, b: f64, c: f64, w: f64) -> (f64, f64) {
 /// The grid's sum is taken as it is: the ratio of [`normalized_lobe_integral`] would bring the f32 error of the
 /// disk's closed-form projected solid angle into every lobe on the GPU (measured: 3.3e-5 against the reference on
 /// brdfs.glb's disks, over the 1e-5 of `render --check`).
+/// Per channel, the first (an analytic lobe's three are equal).
 pub fn disk_lobe_integral(brdf: &Brdf, p: &SurfacePoint, disk: &DiskGeometry, per_axis: u32) -> f64 {
-    segment_lobe_integral(brdf, p, disk.center - p.position, disk.direction, disk.radius, per_axis).lobe
+    segment_lobe_integral(brdf, p, disk.center - p.position, disk.direction, disk.radius, per_axis).lobe[0]
 }
 
 /// Which shadow rays a lobe integral's samples cast: none, along each sample's direction (a light at infinity:
@@ -346,7 +354,8 @@ pub fn segment_lobe_integral(
 /// smaller of its two [`uniform_blend`]s: 1 for a wide lobe's uniform grid, 0 for a narrow lobe's graded one).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SegmentSums {
-    pub lobe: f64,
+    /// Per channel.
+    pub lobe: [f64; 3],
     pub projected: f64,
     pub uniformity: f64,
 }
@@ -360,9 +369,9 @@ pub struct SegmentSums {
 /// cosine over the rest of the disk poorly, so there the ratio would add error (measured: Phong e = 1e5 under
 /// the sun, 5.2e-3 instead of 4e-3 on 8²) and is not applied. Where every sample is visible the result is the
 /// same as unoccluded; partly hidden disks keep their visible share of the grid.
-pub fn normalized_lobe_integral(sums: SegmentSums, exact: f64) -> f64 {
+pub fn normalized_lobe_integral(sums: SegmentSums, exact: f64) -> [f64; 3] {
     if sums.projected > 0.0 {
-        sums.lobe * (1.0 + sums.uniformity * (exact / sums.projected - 1.0))
+        sums.lobe.map(|lobe| lobe * (1.0 + sums.uniformity * (exact / sums.projected - 1.0)))
     } else {
         sums.lobe
     }
@@ -380,7 +389,7 @@ pub fn segment_lobe_integral_visible(
 ) -> SegmentSums {
     let n = p.normal;
     let h = -d.dot(q);
-    let none = SegmentSums { lobe: 0.0, projected: 0.0, uniformity: 0.0 };
+    let none = SegmentSums { lobe: [0.0; 3], projected: 0.0, uniformity: 0.0 };
     if !(h > 0.0 && radius > 0.0) {
         return none;
     }
@@ -429,7 +438,7 @@ pub fn segment_lobe_integral_visible(
     let width_beta = (footprint / rate_beta.max(1e-30)).min(16.0 * alpha);
     let width_s = (footprint / (radius * sbc).max(1e-30)).min(32.0);
     let k = per_axis as f64;
-    let (mut sum, mut projected) = (0.0, 0.0);
+    let (mut sum, mut projected) = ([0.0; 3], 0.0);
     let beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
     let s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
     let (blend_beta, blend_s) = (uniform_blend(width_beta, alpha), uniform_blend(width_s, 2.0));
@@ -450,12 +459,15 @@ pub fn segment_lobe_integral_visible(
                 let weight = cos * h / (dist2 * dist) * radius * radius * sb * sb * d_beta * d_s;
                 projected += weight;
                 if rays.is_none_or(|r| r.visible(p.position, y, omega)) {
-                    sum += specular_lobe(brdf, p, omega) * weight;
+                    let lobe = specular_lobe_rgb(brdf, p, omega);
+                    for (s, l) in sum.iter_mut().zip(lobe) {
+                        *s += l * weight;
+                    }
                 }
             }
         }
     }
-    SegmentSums { lobe: sum / (k * k), projected: projected / (k * k), uniformity: blend_beta.min(blend_s) }
+    SegmentSums { lobe: sum.map(|s| s / (k * k)), projected: projected / (k * k), uniformity: blend_beta.min(blend_s) }
 }
 
 /// `exp(x) − 1` without cancellation for small x (Kahan's trick: exact where `exp` and `ln` are accurate).
@@ -482,13 +494,19 @@ pub fn cos_power_direction(axis: DVec3, t: DVec3, b: DVec3, exponent: f64, xi1: 
 }
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the hemisphere (the sky, per unit radiance), by a stratified grid of `per_axis²`
-/// cells through the lobe's inverse CDF, each sample weighted by lobe/pdf.
+/// cells through the lobe's inverse CDF, each sample weighted by lobe/pdf. Per channel, the first (an analytic
+/// lobe's three are equal).
 pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
-    sky_lobe_integral_visible(brdf, p, per_axis, None)
+    sky_lobe_integral_visible(brdf, p, per_axis, None)[0]
 }
 
-/// [`sky_lobe_integral`] with a shadow ray along each sample's direction (`None`: unoccluded).
-pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, shadow: Option<&Shadowing>) -> f64 {
+/// [`sky_lobe_integral`] per channel, with a shadow ray along each sample's direction (`None`: unoccluded).
+pub fn sky_lobe_integral_visible(
+    brdf: &Brdf,
+    p: &SurfacePoint,
+    per_axis: u32,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
     let visible = |omega: DVec3| shadow.is_none_or(|s| s.visible_along(omega));
     let (n, v) = (p.normal, p.to_viewer);
     // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
@@ -496,7 +514,7 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
     let t = orthonormal_to(axis);
     let b = axis.cross(t);
     let k = per_axis as f64;
-    let mut sum = 0.0;
+    let mut sum = [0.0; 3];
     for i in 0..per_axis {
         let xi1 = (i as f64 + 0.5) / k;
         for j in 0..per_axis {
@@ -547,11 +565,13 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
             };
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
             if value <= 0.0 || value.is_nan() || visible(omega) {
-                sum += value;
+                for s in sum.iter_mut() {
+                    *s += value;
+                }
             }
         }
     }
-    sum / (k * k)
+    sum.map(|s| s / (k * k))
 }
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer, every light unoccluded.
@@ -585,11 +605,12 @@ pub fn radiance_out_visible(
         let l = sun.direction.as_dvec3();
         match options.sun {
             SunModel::Delta => {
-                let mut factor = specular_lobe(brdf, point, l) * point.normal.dot(l).max(0.0);
-                if factor > 0.0 && shadow.is_some_and(|s| !s.visible_along(l)) {
-                    factor = 0.0;
+                let cos = point.normal.dot(l).max(0.0);
+                let mut factor = specular_lobe_rgb(brdf, point, l).map(|lobe| lobe * cos);
+                if factor.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_along(l)) {
+                    factor = [0.0; 3];
                 }
-                for (sc, &perp) in specular.iter_mut().zip(&sun.irradiance) {
+                for ((sc, &perp), factor) in specular.iter_mut().zip(&sun.irradiance).zip(factor) {
                     *sc += factor * perp as f64;
                 }
             }
@@ -602,7 +623,7 @@ pub fn radiance_out_visible(
                 let integral =
                     normalized_lobe_integral(sums, sun_projected_solid_angle_above(point.normal.dot(l), delta));
                 let s = (0.5 * delta).sin();
-                for (sc, &perp) in specular.iter_mut().zip(&sun.irradiance) {
+                for ((sc, &perp), integral) in specular.iter_mut().zip(&sun.irradiance).zip(integral) {
                     *sc += integral * perp as f64 / (PI * s * s);
                 }
             }
@@ -620,22 +641,22 @@ pub fn radiance_out_visible(
             }
             DiskModel::SmallSource => {
                 let to_center = safe_normalize(g.center - point.position);
-                let integral = specular_lobe(brdf, point, to_center)
-                    * disk_projected_solid_angle_small_source(point.position, point.normal, &g);
-                if integral > 0.0 && shadow.is_some_and(|s| !s.visible_to(g.center)) {
-                    0.0
+                let omega = disk_projected_solid_angle_small_source(point.position, point.normal, &g);
+                let integral = specular_lobe_rgb(brdf, point, to_center).map(|lobe| lobe * omega);
+                if integral.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_to(g.center)) {
+                    [0.0; 3]
                 } else {
                     integral
                 }
             }
         };
-        for (sc, &l0) in specular.iter_mut().zip(&disk.radiance) {
+        for ((sc, &l0), integral) in specular.iter_mut().zip(&disk.radiance).zip(integral) {
             *sc += integral * l0 as f64;
         }
     }
     if let Some(sky) = &lights.sky {
         let integral = sky_lobe_integral_visible(brdf, point, options.samples_per_axis, shadow);
-        for (sc, &l0) in specular.iter_mut().zip(sky) {
+        for ((sc, &l0), integral) in specular.iter_mut().zip(sky).zip(integral) {
             *sc += integral * l0 as f64;
         }
     }
