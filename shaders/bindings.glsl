@@ -8,6 +8,7 @@
 #define BRDF_PHONG 1u
 #define BRDF_BLINN_PHONG 2u
 #define BRDF_WARD 3u
+#define BRDF_MEASURED 4u
 
 // Which lights a frame has, and their models (the VARIANT_* constants below); values match gpu::layout.
 #define LIGHT_ABSENT 0u
@@ -79,10 +80,12 @@ struct TextureRefGpu {
 };
 
 struct MaterialGpu {
-    vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert); w unused
-    vec4 ks;     // rgb: specular reflectance ks; w: Phong / Blinn-Phong exponent
-    vec4 params; // x, y: Ward alpha_x, alpha_y
-    uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided; z: 1 if alpha MASK
+    vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert; pi floor for a measured table); w unused
+    vec4 ks;     // rgb: specular reflectance ks (1 for a measured table); w: Phong / Blinn-Phong exponent, or a
+                 // measured table's lobe width [rad]
+    vec4 params; // x, y: Ward alpha_x, alpha_y; measured: rgb the table's floor [1/sr], w 1 for the nearest lookup
+    uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided; z: 1 if alpha MASK;
+                 // w: a measured table's first float in measured_values[]
     vec4 base;   // base colour factor (rgb linear, alpha)
     vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
     vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
@@ -152,6 +155,13 @@ layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
 // (bit 31: the mesh has vertex colours); read by shadow rays that meet alpha-masked triangles.
 layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
+};
+
+// Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rgb
+// rho [1/sr] interleaved (scene::measured); materials naming the same file share one copy. One float where no
+// material is measured.
+layout(std430, set = 0, binding = 11) readonly buffer MeasuredBuffer {
+    float measured_values[];
 };
 
 // Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with

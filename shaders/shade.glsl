@@ -5,6 +5,7 @@
 
 #include "bindings.glsl"
 #include "brdf.glsl"
+#include "measured.glsl"
 #include "visibility.glsl"
 #include "shadow_map.glsl"
 
@@ -116,7 +117,11 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
 }
 
 // The specular lobe of a material (without ks) per channel for light from l: an analytic lobe's one value in each.
+// A measured table's: its part above its floor.
 vec3 specular_lobe_rgb(MaterialGpu m, Frame p, vec3 l) {
+    if (VARIANT_BRDF == BRDF_MEASURED) {
+        return measured_residual(m, p.normal, l, p.to_viewer);
+    }
     return vec3(specular_lobe(m, p, l));
 }
 
@@ -131,6 +136,9 @@ float lobe_width(MaterialGpu m) {
     }
     if (kind == BRDF_WARD) {
         return 2.0 * sqrt(m.params.x * m.params.y);
+    }
+    if (kind == BRDF_MEASURED) {
+        return m.ks.w;
     }
     return PI;
 }
@@ -319,6 +327,13 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                     if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
                         sum += value;
                     }
+                }
+            } else if (kind == BRDF_MEASURED) {
+                // Cosine-weighted about n: the table's part above its floor times pi (see the Rust).
+                vec3 omega = cos_power_direction(n, t, b, 1.0, xi1, phi);
+                vec3 value = specular_lobe_rgb(m, p, omega) * PI;
+                if (!any(greaterThan(value, vec3(0.0))) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                    sum += value;
                 }
             }
         }

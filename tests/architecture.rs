@@ -79,8 +79,15 @@ fn glsl_functions(text: &str) -> Vec<String> {
 fn every_glsl_shading_function_has_a_rust_twin() {
     let rust: String = sources("src/shading").into_iter().map(|(_, t)| t).collect();
     let mut checked = 0;
-    for file in ["radiometry.glsl", "brdf.glsl", "shade.glsl", "visibility.glsl", "surface.glsl", "texture_filter.glsl"]
-    {
+    for file in [
+        "radiometry.glsl",
+        "brdf.glsl",
+        "shade.glsl",
+        "visibility.glsl",
+        "surface.glsl",
+        "texture_filter.glsl",
+        "measured.glsl",
+    ] {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders").join(file)).unwrap();
         for name in glsl_functions(&text) {
             assert!(
@@ -146,6 +153,7 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         ("visibility.glsl", "src/shading"),
         ("surface.glsl", "src/shading"),
         ("texture_filter.glsl", "src/shading"),
+        ("measured.glsl", "src/shading"),
         ("transform.glsl", "src/cpu"),
     ];
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32

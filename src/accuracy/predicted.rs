@@ -69,6 +69,7 @@ fn brdf_name(brdf: &Brdf) -> String {
         Brdf::BlinnPhong { exponent, .. } => format!("Blinn-Phong e={exponent}"),
         Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x == alpha_y => format!("Ward α={alpha_x}"),
         Brdf::Ward { alpha_x, alpha_y, .. } => format!("Ward αx={alpha_x} αy={alpha_y}"),
+        Brdf::Measured { ref table, .. } => format!("measured {}", table.name),
     }
 }
 

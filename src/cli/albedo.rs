@@ -150,6 +150,10 @@ fn scene_table(materials: &[(String, Brdf)]) -> String {
         let (kd, ks) = match *brdf {
             Brdf::Lambert { albedo } => (albedo, [0.0; 3]),
             Brdf::Phong { kd, ks, .. } | Brdf::BlinnPhong { kd, ks, .. } | Brdf::Ward { kd, ks, .. } => (kd, ks),
+            Brdf::Measured { ref table, .. } => {
+                s += &format!("| {name} | measured ({}): see `sunshade fit-brdf` |\n", table.name);
+                continue;
+            }
         };
         s += &format!("| {name} |");
         for d in INCIDENCES_DEGREES {

@@ -230,6 +230,15 @@ pub struct SceneArgs {
     #[arg(help_heading = "Materials", long, value_name = "lambert|phong|blinn-phong|ward")]
     pub brdf: Option<BrdfKind>,
 
+    /// Give every material this measured BRDF: a MERL `.binary` file (docs/measured.md).
+    #[arg(help_heading = "Materials", long, value_name = "FILE", conflicts_with = "brdf")]
+    pub merl: Option<std::path::PathBuf>,
+
+    /// How measured BRDFs are read between their samples: trilinear (continuous; the default) or the nearest bin
+    /// below, as the database's own reader does (docs/measured.md compares them).
+    #[arg(help_heading = "Materials", long, value_name = "linear|nearest")]
+    pub merl_lookup: Option<crate::shading::measured::MeasuredLookup>,
+
     /// Samples for integrating specular lobes over disk lights and the sky (a stratified grid; rounded up to a
     /// square).
     #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_SAMPLES_PER_AXIS * DEFAULT_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=65536))]

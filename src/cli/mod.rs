@@ -11,6 +11,7 @@ mod bench_pareto;
 mod bench_shadows;
 mod bench_textures;
 mod diff;
+mod fit_brdf;
 mod generated;
 mod info;
 mod metadata;
@@ -19,6 +20,7 @@ pub(crate) mod render;
 mod session;
 mod suite;
 mod sweep;
+mod tabulate_brdf;
 
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -78,6 +80,11 @@ enum Command {
     /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
     /// light integrals per sample count; with a scene, the albedo of its materials.
     Albedo(albedo::AlbedoArgs),
+    /// Fit an analytic BRDF (lambert, phong, blinn-phong, ward) to a measured MERL table: its parameters, the
+    /// fit's error, and a material extras snippet.
+    FitBrdf(fit_brdf::FitBrdfArgs),
+    /// Write an analytic BRDF as a MERL table (for tests and comparisons with measured materials).
+    TabulateBrdf(tabulate_brdf::TabulateBrdfArgs),
 }
 
 /// `-q`: warnings and notes are not printed (errors still are, on one line, and the exit code says the rest).
@@ -176,6 +183,8 @@ pub fn main() -> ExitCode {
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Albedo(a) => albedo::run(&a),
+        Command::FitBrdf(a) => fit_brdf::run(&a),
+        Command::TabulateBrdf(a) => tabulate_brdf::run(&a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -225,6 +234,13 @@ pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliErr
     let mut scene = scene::load_with_options(&a.scene, &a.load_options())?;
     if let Some(kind) = a.brdf {
         scene.map_brdfs(kind);
+    }
+    if let Some(path) = &a.merl {
+        let table = scene::measured::read_merl_file(path).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
+        scene.use_measured(&std::sync::Arc::new(table), a.merl_lookup.unwrap_or_default());
+    }
+    if let Some(lookup) = a.merl_lookup {
+        scene.set_measured_lookup(lookup);
     }
     let load_time = t.elapsed();
     for w in &scene.warnings {

@@ -18,6 +18,8 @@ struct SceneKey {
     path: PathBuf,
     scene_index: Option<usize>,
     brdf: Option<BrdfKind>,
+    merl: Option<PathBuf>,
+    merl_lookup: Option<crate::shading::measured::MeasuredLookup>,
     asset_root: Option<PathBuf>,
     allow_outside_uris: bool,
 }
@@ -28,6 +30,8 @@ impl SceneKey {
             path: a.scene.clone(),
             scene_index: a.scene_index,
             brdf: a.brdf,
+            merl: a.merl.clone(),
+            merl_lookup: a.merl_lookup,
             asset_root: a.asset_root.clone(),
             allow_outside_uris: a.allow_outside_uris,
         }

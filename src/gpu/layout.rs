@@ -12,6 +12,7 @@ pub const BRDF_LAMBERT: u32 = 0;
 pub const BRDF_PHONG: u32 = 1;
 pub const BRDF_BLINN_PHONG: u32 = 2;
 pub const BRDF_WARD: u32 = 3;
+pub const BRDF_MEASURED: u32 = 4;
 pub const LIGHT_ABSENT: u32 = 0;
 pub const SUN_DISK: u32 = 1;
 pub const SUN_DELTA: u32 = 2;
@@ -174,13 +175,47 @@ pub struct PushConstants {
     pub _pad: [u32; 3],
 }
 
-pub fn material_gpu(m: &Material) -> MaterialGpu {
+/// The measured buffer's floats (binding 11): each distinct table the materials use once (materials naming the
+/// same file share its `Arc`, and here its one copy), one after another; and per material the offset [floats] of
+/// its table (0 for the others). One 0 float where no material is measured (a binding needs a buffer).
+pub fn measured_tables(materials: &[Material]) -> (Vec<f32>, Vec<u32>) {
+    let mut data: Vec<f32> = Vec::new();
+    let mut seen: Vec<(&std::sync::Arc<crate::scene::measured::MeasuredBrdf>, u32)> = Vec::new();
+    let offsets = materials
+        .iter()
+        .map(|m| match &m.brdf {
+            Brdf::Measured { table, .. } => match seen.iter().find(|(t, _)| std::sync::Arc::ptr_eq(t, table)) {
+                Some(&(_, offset)) => offset,
+                None => {
+                    let offset = data.len() as u32;
+                    data.extend_from_slice(&table.values);
+                    seen.push((table, offset));
+                    offset
+                }
+            },
+            _ => 0,
+        })
+        .collect();
+    if data.is_empty() {
+        data.push(0.0);
+    }
+    (data, offsets)
+}
+
+/// A material's record; `measured_offset`: where its measured table (if any) starts in the measured buffer
+/// [floats] ([`measured_tables`]).
+pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
     let (kd, ks) = (m.brdf.kd(), m.brdf.ks());
-    let (kind, exponent, alpha) = match m.brdf {
-        Brdf::Lambert { .. } => (BRDF_LAMBERT, 0.0, [0.0, 0.0]),
-        Brdf::Phong { exponent, .. } => (BRDF_PHONG, exponent, [0.0, 0.0]),
-        Brdf::BlinnPhong { exponent, .. } => (BRDF_BLINN_PHONG, exponent, [0.0, 0.0]),
-        Brdf::Ward { alpha_x, alpha_y, .. } => (BRDF_WARD, 0.0, [alpha_x, alpha_y]),
+    let (kind, exponent, params) = match m.brdf {
+        Brdf::Lambert { .. } => (BRDF_LAMBERT, 0.0, [0.0; 4]),
+        Brdf::Phong { exponent, .. } => (BRDF_PHONG, exponent, [0.0; 4]),
+        Brdf::BlinnPhong { exponent, .. } => (BRDF_BLINN_PHONG, exponent, [0.0; 4]),
+        Brdf::Ward { alpha_x, alpha_y, .. } => (BRDF_WARD, 0.0, [alpha_x, alpha_y, 0.0, 0.0]),
+        Brdf::Measured { ref table, lookup } => {
+            let f = table.floor;
+            let nearest = f32::from(u8::from(lookup == crate::shading::measured::MeasuredLookup::Nearest));
+            (BRDF_MEASURED, table.lobe_width, [f[0], f[1], f[2], nearest])
+        }
     };
     let slot = |r: Option<&TextureRef>| match r {
         Some(r) => {
@@ -201,8 +236,8 @@ pub fn material_gpu(m: &Material) -> MaterialGpu {
     MaterialGpu {
         kd: [kd[0], kd[1], kd[2], 0.0],
         ks: [ks[0], ks[1], ks[2], exponent],
-        params: [alpha[0], alpha[1], 0.0, 0.0],
-        kind: [kind, m.double_sided as u32, matches!(m.alpha, AlphaMode::Mask(_)) as u32, 0],
+        params,
+        kind: [kind, m.double_sided as u32, matches!(m.alpha, AlphaMode::Mask(_)) as u32, measured_offset],
         base: [b[0], b[1], b[2], m.base_alpha],
         pbr: [m.pbr.metallic, m.pbr.roughness, m.normal_texture.map_or(1.0, |(_, s)| s), cutoff],
         emission: [m.emission[0], m.emission[1], m.emission[2], 0.0],
@@ -351,6 +386,7 @@ mod tests {
             ("BRDF_PHONG", BRDF_PHONG),
             ("BRDF_BLINN_PHONG", BRDF_BLINN_PHONG),
             ("BRDF_WARD", BRDF_WARD),
+            ("BRDF_MEASURED", BRDF_MEASURED),
             ("LIGHT_ABSENT", LIGHT_ABSENT),
             ("SUN_DISK", SUN_DISK),
             ("SUN_DELTA", SUN_DELTA),

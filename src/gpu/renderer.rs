@@ -12,8 +12,8 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, occluder_records, push_constants, texture_buffers, MaterialGpu, PushConstants,
-    ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
+    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, MaterialGpu,
+    PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
@@ -64,6 +64,8 @@ pub struct GpuScene {
     surface_vertices: Buffer,
     /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
     occluder_triangles: Buffer,
+    /// The measured BRDF tables (`layout::measured_tables`).
+    measured: Buffer,
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
@@ -270,7 +272,9 @@ impl Renderer {
         // With ray queries: every triangle's indices into the whole vertex buffer, for the acceleration structure.
         let rq = self.pipeline.has_ray_queries();
         let mut global_indices = Vec::new();
-        let materials: Vec<_> = scene.materials.iter().map(material_gpu).collect();
+        let (measured, measured_offsets) = measured_tables(&scene.materials);
+        let materials: Vec<_> =
+            scene.materials.iter().zip(&measured_offsets).map(|(m, &offset)| material_gpu(m, offset)).collect();
         for mesh in &scene.meshes {
             let vertex_offset = i32::try_from(vertices.len())
                 .map_err(|_| GpuError::TooLarge("the scene has more than 2^31 vertices".into()))?;
@@ -309,6 +313,17 @@ impl Renderer {
                 "the scene's {} vertices take {:.1} MiB; {} binds at most {:.1} MiB in one storage buffer",
                 vertices.len(),
                 vertex_bytes as f64 / (1 << 20) as f64,
+                self.dev.info.name,
+                limit as f64 / (1 << 20) as f64
+            )));
+        }
+        let measured_bytes = std::mem::size_of_val(&measured[..]) as u64;
+        if measured_bytes > limit {
+            return Err(GpuError::TooLarge(format!(
+                "the scene's measured BRDF tables take {:.1} MiB ({} distinct files, 16.7 MiB each); {} binds at most \
+                 {:.1} MiB in one storage buffer",
+                measured_bytes as f64 / (1 << 20) as f64,
+                measured.len() / (3 * crate::scene::measured::MERL_SAMPLES),
                 self.dev.info.name,
                 limit as f64 / (1 << 20) as f64
             )));
@@ -389,6 +404,7 @@ impl Renderer {
             texture_table,
             surface_vertices,
             occluder_triangles,
+            measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
             // ray queries warns that `auto` has no shadows for this scene.
@@ -577,7 +593,7 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles.
+                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs.
                 let buffers = [
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
@@ -586,6 +602,7 @@ impl Renderer {
                     (8, scene.texture_table.buffer),
                     (9, scene.surface_vertices.buffer),
                     (10, scene.occluder_triangles.buffer),
+                    (11, scene.measured.buffer),
                 ];
                 let infos = buffers
                     .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]));

@@ -11,6 +11,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("math.glsl", include_str!("../../shaders/math.glsl")),
     ("radiometry.glsl", include_str!("../../shaders/radiometry.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
+    ("measured.glsl", include_str!("../../shaders/measured.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
     ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),

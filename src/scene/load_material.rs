@@ -8,7 +8,9 @@ use serde_json::Value;
 use super::gltf::document::{lookup, MaterialDef, Root, TextureInfo};
 use super::gltf::files::AssetFiles;
 use super::gltf::image::{decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
+use super::gltf::uri::{resolve, UriTarget};
 use super::material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
+use super::measured::{parse_merl, SharedMeasuredBrdf};
 use super::texture::{uv_transform, Sampler, Texture, TextureRef, IDENTITY_UV_TRANSFORM};
 
 /// Texture sources other than PNG/JPEG that a texture may name in an extension (sunshade decodes none of them).
@@ -24,6 +26,8 @@ pub struct MaterialReader<'a> {
     pub files: &'a AssetFiles,
     /// (glTF texture, colour space) → index into `textures`.
     cache: HashMap<(u64, ColorSpace), usize>,
+    /// Measured BRDF tables by the URI that names them: materials naming the same URI share one table.
+    measured: HashMap<String, SharedMeasuredBrdf>,
     pub textures: Vec<Texture>,
     pub warnings: Vec<String>,
     /// What is left of the scene's texel budget.
@@ -39,6 +43,7 @@ impl<'a> MaterialReader<'a> {
             buffers,
             files,
             cache: HashMap::new(),
+            measured: HashMap::new(),
             textures: Vec::new(),
             warnings: Vec::new(),
             texels_left: MAX_SCENE_TEXELS,
@@ -63,6 +68,9 @@ impl<'a> MaterialReader<'a> {
         let extras = sunshade_extras(&material.extras);
         let explicit = extras.as_ref().filter(|x| x.get("brdf").is_some());
         let (brdf, mapping) = match explicit {
+            Some(x) if x.get("brdf").and_then(|v| v.as_str()) == Some("merl") => {
+                (self.measured_brdf(x).map_err(|e| format!("{name} extras: {e}"))?, None)
+            }
             Some(x) => (brdf_from_extras(x, albedo).map_err(|e| format!("{name} extras: {e}"))?, None),
             None => (Brdf::Lambert { albedo }, Some(BrdfKind::Lambert)),
         };
@@ -222,6 +230,39 @@ impl<'a> MaterialReader<'a> {
     }
 }
 
+impl MaterialReader<'_> {
+    /// `{"brdf": "merl", "file": URI, "lookup": "linear" | "nearest"}`: a MERL table in a file inside the scene's
+    /// folder (the buffer URIs' rules: relative, percent-decoded, confined; or a base64 `data:` URI), read once per
+    /// URI; `lookup` linear by default (`shading::measured`).
+    fn measured_brdf(&mut self, x: &Value) -> Result<Brdf, String> {
+        let uri = x.get("file").and_then(|v| v.as_str()).ok_or("merl needs \"file\": the table's URI")?;
+        let lookup = match x.get("lookup") {
+            None => Default::default(),
+            Some(v) => v.as_str().ok_or("\"lookup\" must be a string")?.parse()?,
+        };
+        let table = match self.measured.get(uri) {
+            Some(t) => t.clone(),
+            None => {
+                let bytes = match resolve(uri)? {
+                    UriTarget::Data(bytes) => bytes,
+                    UriTarget::File(rel) => self.files.read(&rel, uri, None)?,
+                };
+                let table = SharedMeasuredBrdf::new(parse_merl(uri, &bytes)?);
+                if table.missing > 0 {
+                    self.warnings.push(format!(
+                        "{uri}: {} of {} samples are missing (negative in the file); they are taken as 0",
+                        table.missing,
+                        3 * super::measured::MERL_SAMPLES
+                    ));
+                }
+                self.measured.insert(uri.to_string(), table.clone());
+                table
+            }
+        };
+        Ok(Brdf::Measured { table, lookup })
+    }
+}
+
 /// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
 /// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor).
 fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
@@ -249,7 +290,7 @@ fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
             };
             Brdf::Ward { kd: color("kd")?, ks: color("ks")?, alpha_x, alpha_y }
         }
-        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward")),
+        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward, merl")),
     })
 }
 

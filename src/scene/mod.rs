@@ -17,6 +17,7 @@ mod load;
 mod load_material;
 mod load_mesh;
 pub mod material;
+pub mod measured;
 pub mod tangent;
 pub mod texture;
 
@@ -96,6 +97,28 @@ impl Scene {
         for m in &mut self.materials {
             m.brdf = Brdf::from_metallic_roughness(kind, m.pbr);
             m.mapping = Some(kind);
+        }
+    }
+
+    /// Gives every material the measured BRDF `table` (`--merl`), read with `lookup`: its textures and factors
+    /// no longer set the BRDF (emission, normal maps and alpha still apply).
+    pub fn use_measured(
+        &mut self,
+        table: &measured::SharedMeasuredBrdf,
+        lookup: crate::shading::measured::MeasuredLookup,
+    ) {
+        for m in &mut self.materials {
+            m.brdf = Brdf::Measured { table: table.clone(), lookup };
+            m.mapping = None;
+        }
+    }
+
+    /// Reads every measured material's table with `lookup` (`--merl-lookup`).
+    pub fn set_measured_lookup(&mut self, lookup: crate::shading::measured::MeasuredLookup) {
+        for m in &mut self.materials {
+            if let Brdf::Measured { lookup: l, .. } = &mut m.brdf {
+                *l = lookup;
+            }
         }
     }
 

@@ -6,6 +6,8 @@
 
 pub mod albedo;
 pub mod brdf;
+pub mod brdf_fit;
+pub mod measured;
 pub mod quadrature;
 pub mod radiometry;
 mod shade;

@@ -20,6 +20,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use super::brdf::{blinn_phong_lobe, lambert_brdf, mirror, phong_lobe, ward_lobe};
+use super::measured::measured_residual;
 use super::radiometry::{
     disk_projected_solid_angle, disk_projected_solid_angle_small_source, sky_irradiance, sun_irradiance_delta,
     sun_irradiance_disk, DiskGeometry,
@@ -221,12 +222,16 @@ pub fn irradiance_visible(
 }
 
 /// The specular lobe of a material (without ks) per channel for light from `l`: the analytic lobes' one value in
-/// each channel.
+/// each channel; a measured table's part above its floor ([`measured_residual`]).
 pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
-    [specular_lobe(brdf, p, l); 3]
+    match brdf {
+        Brdf::Measured { table, lookup } => measured_residual(table, *lookup, p.normal, l, p.to_viewer),
+        _ => [specular_lobe(brdf, p, l); 3],
+    }
 }
 
-/// The specular lobe of a material (without ks) for light from `l`.
+/// The specular lobe of a material (without ks) for light from `l`; a measured table's, the mean of its
+/// channels'.
 pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
     let (n, v) = (p.normal, p.to_viewer);
     match *brdf {
@@ -236,6 +241,7 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
         Brdf::Ward { alpha_x, alpha_y, .. } => {
             ward_lobe(n, p.tangent, p.bitangent, l, v, alpha_x as f64, alpha_y as f64)
         }
+        Brdf::Measured { .. } => specular_lobe_rgb(brdf, p, l).iter().sum::<f64>() / 3.0,
     }
 }
 
@@ -266,6 +272,7 @@ pub fn lobe_width(brdf: &Brdf) -> f64 {
         Brdf::Phong { exponent, .. } => 1.0 / (exponent as f64 + 1.0).sqrt(),
         Brdf::BlinnPhong { exponent, .. } => 2.0 / (exponent as f64 + 1.0).sqrt(),
         Brdf::Ward { alpha_x, alpha_y, .. } => 2.0 * (alpha_x as f64 * alpha_y as f64).sqrt(),
+        Brdf::Measured { ref table, .. } => table.lobe_width as f64,
     }
 }
 
@@ -501,12 +508,7 @@ pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
 }
 
 /// [`sky_lobe_integral`] per channel, with a shadow ray along each sample's direction (`None`: unoccluded).
-pub fn sky_lobe_integral_visible(
-    brdf: &Brdf,
-    p: &SurfacePoint,
-    per_axis: u32,
-    shadow: Option<&Shadowing>,
-) -> [f64; 3] {
+pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, shadow: Option<&Shadowing>) -> [f64; 3] {
     let visible = |omega: DVec3| shadow.is_none_or(|s| s.visible_along(omega));
     let (n, v) = (p.normal, p.to_viewer);
     // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
@@ -521,12 +523,12 @@ pub fn sky_lobe_integral_visible(
             let xi2 = (j as f64 + 0.5) / k;
             let phi = 2.0 * PI * xi2;
             let (value, omega) = match *brdf {
-                Brdf::Lambert { .. } => (0.0, n),
+                Brdf::Lambert { .. } => ([0.0; 3], n),
                 Brdf::Phong { exponent, .. } => {
                     // cos α = (1 − ξ1)^{1/(e+1)} about r = mirror of v: pdf = (e+1)/(2π) cosᵉα, lobe/pdf = (e+2)/(e+1).
                     let e = exponent as f64;
                     let omega = cos_power_direction(axis, t, b, e, xi1, phi);
-                    ((e + 2.0) / (e + 1.0) * n.dot(omega).max(0.0), omega)
+                    ([(e + 2.0) / (e + 1.0) * n.dot(omega).max(0.0); 3], omega)
                 }
                 Brdf::BlinnPhong { exponent, .. } => {
                     // cos θh = (1 − ξ1)^{1/(e+1)} about n: pdf_h = (e+1)/(2π)(n·h)^e, dω = 4 (v·h) dh.
@@ -534,13 +536,13 @@ pub fn sky_lobe_integral_visible(
                     let h = cos_power_direction(axis, t, b, e, xi1, phi);
                     let vh = v.dot(h);
                     if vh <= 0.0 {
-                        (0.0, n)
+                        ([0.0; 3], n)
                     } else {
                         let omega = 2.0 * vh * h - v;
                         let value =
                             super::brdf::blinn_phong_normalization(e) * 4.0 * vh * n.dot(omega).max(0.0) * 2.0 * PI
                                 / (e + 1.0);
-                        (value, omega)
+                        ([value; 3], omega)
                     }
                 }
                 Brdf::Ward { alpha_x, alpha_y, .. } => {
@@ -556,17 +558,24 @@ pub fn sky_lobe_integral_visible(
                     let h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
                     let vh = v.dot(h);
                     if vh <= 0.0 {
-                        (0.0, n)
+                        ([0.0; 3], n)
                     } else {
                         let omega = 2.0 * vh * h - v;
-                        (n.dot(omega).max(0.0) / (vh * cos_d), omega)
+                        ([n.dot(omega).max(0.0) / (vh * cos_d); 3], omega)
                     }
+                }
+                Brdf::Measured { .. } => {
+                    // Cosine-weighted about n (the e = 1 case of the cos-power inverse CDF, pdf cos θ/π): the
+                    // table's part above its floor times π. A table has no inverse CDF of its own: a sharp
+                    // measured peak under the sky converges as the grid resolves it (docs/measured.md).
+                    let omega = cos_power_direction(n, t, b, 1.0, xi1, phi);
+                    (specular_lobe_rgb(brdf, p, omega).map(|x| x * PI), omega)
                 }
             };
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
-            if value <= 0.0 || value.is_nan() || visible(omega) {
-                for s in sum.iter_mut() {
-                    *s += value;
+            if !value.iter().any(|&x| x > 0.0) || visible(omega) {
+                for (s, x) in sum.iter_mut().zip(value) {
+                    *s += x;
                 }
             }
         }

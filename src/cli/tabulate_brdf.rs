@@ -1,0 +1,66 @@
+//! `sunshade tabulate-brdf --model M ... -o FILE.binary`: an analytic BRDF written as a MERL table, sampled at
+//! each bin's lower edge as sunshade's lookup places its samples (`shading::measured`). For testing measured
+//! materials against their analytic source, and for comparing lookups (docs/measured.md).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+use glam::DVec3;
+
+use super::args::parse_radiance;
+use super::CliError;
+use crate::film::write_atomically;
+use crate::scene::measured::merl_bytes;
+use crate::scene::{Brdf, BrdfKind};
+use crate::shading::measured::tabulate;
+use crate::shading::{specular_lobe, SurfacePoint};
+
+#[derive(Args, Debug)]
+pub struct TabulateBrdfArgs {
+    /// The analytic model.
+    #[arg(long, value_name = "lambert|phong|blinn-phong|ward")]
+    pub model: BrdfKind,
+    /// Diffuse reflectance kd (the albedo for Lambert): one value or r,g,b.
+    #[arg(long, value_parser = parse_radiance, value_name = "KD|R,G,B")]
+    pub kd: [f64; 3],
+    /// Specular reflectance ks: one value or r,g,b.
+    #[arg(long, value_parser = parse_radiance, value_name = "KS|R,G,B", default_value = "0")]
+    pub ks: [f64; 3],
+    /// Phong / Blinn-Phong exponent.
+    #[arg(long, default_value_t = 0.0)]
+    pub exponent: f64,
+    /// Ward α (isotropic).
+    #[arg(long, default_value_t = 0.1)]
+    pub alpha: f64,
+    /// The MERL file to write (atomically).
+    #[arg(short, long, value_name = "FILE.binary")]
+    pub output: PathBuf,
+}
+
+pub fn run(a: &TabulateBrdfArgs) -> Result<(), CliError> {
+    let (kd, ks) = (a.kd.map(|x| x as f32), a.ks.map(|x| x as f32));
+    let brdf = match a.model {
+        BrdfKind::Lambert => Brdf::Lambert { albedo: kd },
+        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent: a.exponent as f32 },
+        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent: a.exponent as f32 },
+        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: a.alpha as f32, alpha_y: a.alpha as f32 },
+    };
+    brdf.validate().map_err(CliError::Usage)?;
+    let planes = tabulate(|l, v| {
+        let p = SurfacePoint {
+            position: DVec3::ZERO,
+            normal: DVec3::Z,
+            tangent: DVec3::X,
+            bitangent: DVec3::Y,
+            to_viewer: v,
+        };
+        let lobe = specular_lobe(&brdf, &p, l);
+        let (kd, ks) = (brdf.kd(), brdf.ks());
+        [0, 1, 2].map(|c| kd[c] as f64 / std::f64::consts::PI + ks[c] as f64 * lobe)
+    });
+    let bytes = merl_bytes(&planes);
+    write_atomically(&a.output, |out| out.write_all(&bytes))
+        .map_err(|e| CliError::Failure(anyhow::anyhow!("cannot write '{}': {e}", a.output.display())))?;
+    Ok(())
+}

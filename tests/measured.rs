@@ -1,0 +1,373 @@
+//! Measured (MERL) BRDFs: synthetic tables made from analytic BRDFs (the database's files are large and not
+//! redistributable), rendered by the reference and the GPU (lavapipe, validation on) under every light.
+//!
+//! - A constant table renders as Lambert (its floor is the Lambertian part; nothing is left to sample).
+//! - A Ward BRDF tabulated into the format renders close to the analytic Ward, within a bound computed from the
+//!   table's own second differences (the trilinear lookup's error).
+//! - The GPU agrees with the reference on measured materials under the sun (disk and delta), a disk light and the
+//!   sky.
+//! - Files with missing samples load with a warning; a wrong header and a truncated file are refused in one line
+//!   naming the file.
+
+mod common;
+
+use std::sync::OnceLock;
+
+use common::{CheckedRenderer, TempDir};
+use glam::{DVec3, Vec3};
+use serde_json::json;
+use sunshade::authoring::chart::{sphere_scene, ChartMaterial};
+use sunshade::compare::{self, DiffOptions};
+use sunshade::cpu;
+use sunshade::scene::measured::{merl_bytes, MERL_SAMPLES};
+use sunshade::scene::{Brdf, DiskLight, Lights, Scene, Sun};
+use sunshade::settings::RenderSettings;
+use sunshade::shading::measured::tabulate;
+use sunshade::shading::{specular_lobe, ShadingOptions, SunModel, SurfacePoint};
+
+/// The analytic Ward of the synthetic table: kd 0.3/0.25/0.2, ks 0.2, α 0.2.
+fn ward() -> Brdf {
+    Brdf::Ward { kd: [0.3, 0.25, 0.2], ks: [0.2; 3], alpha_x: 0.2, alpha_y: 0.2 }
+}
+
+/// `kd/π + ks lobe` of an analytic BRDF at (l, v) about +z, per channel.
+fn analytic(brdf: &Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
+    let p =
+        SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v };
+    let lobe = specular_lobe(brdf, &p, l);
+    let (kd, ks) = (brdf.kd(), brdf.ks());
+    [0, 1, 2].map(|c| kd[c] as f64 / std::f64::consts::PI + ks[c] as f64 * lobe)
+}
+
+/// The Ward table's bytes, made once per test process.
+fn ward_table_bytes() -> &'static [u8] {
+    static BYTES: OnceLock<Vec<u8>> = OnceLock::new();
+    BYTES.get_or_init(|| merl_bytes(&tabulate(|l, v| analytic(&ward(), l, v))))
+}
+
+/// A sphere scene whose material is `extras`, written with the files it names.
+fn sphere(dir: &TempDir, name: &str, extras: serde_json::Value) -> Scene {
+    let m = ChartMaterial { name: name.into(), extras };
+    common::load(&dir.write(&format!("{name}.glb"), &sphere_scene(&m)))
+}
+
+fn sun(model_degrees: f64) -> Sun {
+    let t = model_degrees.to_radians();
+    Sun {
+        direction: Vec3::new(0.8 * t.sin() as f32, 0.6 * t.sin() as f32, t.cos() as f32),
+        irradiance: [1000.0; 3],
+        angular_diameter: 0.53f32.to_radians(),
+    }
+}
+
+/// Each light alone, with its model: the sun as a disk and as a direction, a disk light, the sky. The sun's
+/// angles from the (orthographic) viewer, 31° and 61°, put θ_d = 15.5° and 30.5° mid-bin for every pixel: at 30° or
+/// 60° θ_d would sit on a bin edge of the whole image, where a nearest lookup jumps with the last bit of the
+/// coordinates (measured: 26% of the pixels 1.7% apart between GPU and reference with the delta sun at 60°).
+fn light_cases() -> Vec<(&'static str, Lights, SunModel)> {
+    let disk = DiskLight {
+        center: Vec3::new(1.0, 1.5, 2.5),
+        direction: Vec3::new(-1.0, -1.5, -2.5).normalize(),
+        radius: 0.6,
+        radiance: [200.0, 150.0, 100.0],
+    };
+    vec![
+        ("sun (disk)", Lights { sun: Some(sun(31.0)), ..Default::default() }, SunModel::Disk),
+        ("sun (delta)", Lights { sun: Some(sun(61.0)), ..Default::default() }, SunModel::Delta),
+        ("disk light", Lights { disks: vec![disk], ..Default::default() }, SunModel::Disk),
+        ("sky", Lights { sky: Some([100.0, 90.0, 80.0]), ..Default::default() }, SunModel::Disk),
+    ]
+}
+
+fn settings(scene: &Scene, lights: Lights, sun_model: SunModel, size: u32) -> RenderSettings {
+    let mut s = RenderSettings::new(size, size, scene.cameras[0].1, lights);
+    s.shading = ShadingOptions { sun: sun_model, ..Default::default() };
+    s
+}
+
+fn write(dir: &TempDir, name: &str, bytes: &[u8]) {
+    std::fs::write(dir.path(name), bytes).unwrap();
+}
+
+#[test]
+fn constant_table_renders_as_lambert() {
+    let dir = TempDir::new("merl-constant");
+    let rho = [0.1f64, 0.15, 0.2];
+    let planes: [Vec<f64>; 3] = std::array::from_fn(|c| vec![rho[c]; MERL_SAMPLES]);
+    write(&dir, "constant.binary", &merl_bytes(&planes));
+    let measured = sphere(&dir, "measured", json!({ "brdf": "merl", "file": "constant.binary" }));
+    // The albedo whose ρ is the table's (f32) value.
+    let albedo: Vec<f64> = rho.iter().map(|&r| r as f32 as f64 * std::f64::consts::PI).collect();
+    let lambert = sphere(&dir, "lambert", json!({ "brdf": "lambert", "albedo": albedo }));
+    let mut gpu = CheckedRenderer::new();
+    for (what, lights, model) in light_cases() {
+        let s = settings(&measured, lights, model, 64);
+        let options = gpu.reference_options();
+        for (renderer, a, b) in [
+            ("reference", cpu::render(&measured, &s, &options), cpu::render(&lambert, &s, &options)),
+            ("GPU", gpu.render(&measured, &s), gpu.render(&lambert, &s)),
+        ] {
+            let (report, _) =
+                compare::diff(&a, &b, &DiffOptions { floor_fraction: 0.0, floor: 1e-30, ..Default::default() })
+                    .unwrap();
+            println!("{what}, {renderer}: measured constant against Lambert: max rel {:.2e}", report.max_rel_interior);
+            assert!(report.covered_b > 2000);
+            // The albedo's f32 rounding (π ρ to 6e-8) and kd = π floor rounded again: a few ulp.
+            assert!(report.max_rel_interior < 5e-7, "{what}, {renderer}: {:.3e}", report.max_rel_interior);
+        }
+    }
+}
+
+#[test]
+fn gpu_matches_reference_on_measured_materials() {
+    let dir = TempDir::new("merl-gpu");
+    write(&dir, "ward.binary", ward_table_bytes());
+    let mut gpu = CheckedRenderer::new();
+    for lookup in ["linear", "nearest"] {
+        let scene = sphere(&dir, lookup, json!({ "brdf": "merl", "file": "ward.binary", "lookup": lookup }));
+        for (what, lights, model) in light_cases() {
+            let s = settings(&scene, lights, model, 96);
+            let g = gpu.render(&scene, &s);
+            let c = cpu::render(&scene, &s, &gpu.reference_options());
+            assert!(g.pixels().iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "{what}: not finite");
+            let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+            println!(
+                "{lookup} {what}: GPU against reference max rel {:.2e}, {} of {} over tolerance",
+                report.max_rel_interior, report.over_tolerance.total, report.covered_b
+            );
+            assert_eq!(report.coverage_mismatches.total, 0);
+            if lookup == "linear" {
+                // Continuous in the directions: rounding only (measured 1.2e-6 to 6.8e-6).
+                assert!(
+                    report.max_rel_interior < 1e-4,
+                    "{what}: {:.3e} at {:?}",
+                    report.max_rel_interior,
+                    report.worst
+                );
+            } else {
+                // Nearest: a sample whose coordinates round across a bin edge jumps by the table's step between
+                // bins (a few % here) times its weight in the grid (1/256 for a disk light's 16²); measured: 15
+                // pixels of 6568 over 1e-5 with the disk light, at most 6.1e-4.
+                let over = report.over_tolerance.total as f64 / report.covered_b as f64;
+                assert!(
+                    over < 0.01 && report.max_rel_interior < 0.05,
+                    "{what}: {over:.3} over, max {:.3e}",
+                    report.max_rel_interior
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_tables_are_refused_in_one_line_and_missing_samples_warned() {
+    let dir = TempDir::new("merl-bad");
+    let good = ward_table_bytes();
+    let mut header = good.to_vec();
+    header[8..12].copy_from_slice(&360i32.to_le_bytes());
+    write(&dir, "header.binary", &header);
+    write(&dir, "truncated.binary", &good[..good.len() / 2]);
+    for (file, what) in [("header.binary", "90 × 90 × 360"), ("truncated.binary", "truncated")] {
+        let m = ChartMaterial { name: file.into(), extras: json!({ "brdf": "merl", "file": file }) };
+        let path = dir.write("bad.glb", &sphere_scene(&m));
+        let e = sunshade::scene::load(&path).unwrap_err().to_string();
+        assert!(e.contains("bad.glb") && e.contains(file) && e.contains(what) && !e.contains('\n'), "{e}");
+    }
+    // Outside the scene's folder: refused like a buffer URI.
+    let m = ChartMaterial { name: "outside".into(), extras: json!({ "brdf": "merl", "file": "../ward.binary" }) };
+    let e = sunshade::scene::load(&dir.write("outside.glb", &sphere_scene(&m))).unwrap_err().to_string();
+    assert!(e.contains("outside the asset folder") || e.contains("cannot read"), "{e}");
+    // Missing samples: loaded, warned, taken as 0.
+    let mut missing = good.to_vec();
+    for i in 0..1000 {
+        missing[12 + 8 * i..][..8].copy_from_slice(&(-1.0f64).to_le_bytes());
+    }
+    write(&dir, "missing.binary", &missing);
+    let scene = sphere(&dir, "missing", json!({ "brdf": "merl", "file": "missing.binary" }));
+    assert!(scene.warnings.iter().any(|w| w.contains("1000 of") && w.contains("missing")), "{:?}", scene.warnings);
+    let Brdf::Measured { table, .. } = &scene.materials[0].brdf else { panic!("not measured") };
+    assert_eq!((table.missing, table.value(0, 0), table.floor[0]), (1000, 0.0, 0.0));
+}
+
+/// The linear lookup of a tabulated Ward against the analytic Ward at 200 000 random pairs of directions above the
+/// horizon: within the error estimate from the table's second differences (`linear_lookup_error_at`) plus the
+/// f32 rounding of the table's values, everywhere.
+#[test]
+fn tabulated_ward_lookup_is_within_its_error_estimate() {
+    use sunshade::shading::measured::{linear_lookup_error_at, measured_brdf, MeasuredLookup};
+    let table = sunshade::scene::measured::parse_merl("ward", ward_table_bytes()).unwrap();
+    // A fixed linear congruential sequence: the same directions on every run.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let direction = |u: f64, w: f64| {
+        // Uniform on the upper hemisphere.
+        let z = u.max(1e-9);
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * (2.0 * std::f64::consts::PI * w).cos(), r * (2.0 * std::f64::consts::PI * w).sin(), z)
+    };
+    let (mut worst, mut worst_ratio, mut mean) = (0.0f64, 0.0f64, 0.0);
+    let count = 200_000;
+    for _ in 0..count {
+        let (a, b, c, d) = (uniform(), uniform(), uniform(), uniform());
+        let (l, v) = (direction(a, b), direction(c, d));
+        let want = analytic(&ward(), l, v);
+        let got = measured_brdf(&table, MeasuredLookup::Linear, DVec3::Z, l, v);
+        let estimate = linear_lookup_error_at(&table, DVec3::Z, l, v);
+        for ch in 0..3 {
+            let rel = (got[ch] - want[ch]).abs() / want[ch];
+            worst = worst.max(rel);
+            mean += rel / (3 * count) as f64;
+            worst_ratio = worst_ratio.max(rel / (estimate + 1e-6));
+            assert!(rel <= estimate + 1e-6, "l {l} v {v}: relative error {rel:.3e} over the estimate {estimate:.3e}");
+        }
+    }
+    println!("linear lookup of tabulated Ward: max rel {worst:.2e}, mean {mean:.2e}, largest error/estimate {worst_ratio:.2}");
+}
+
+/// The reference with a tabulated Ward (linear lookup) against the analytic Ward, each with 64² samples per light
+/// so that what is left is mostly the table's interpolation: a pixel integrates the BRDF against positive
+/// weights, so its relative error is at most the lookup's largest over the directions it integrates, which the
+/// table's global estimate bounds (measured 1.2e-3 to 2.6e-3 against an estimate of 0.32, reached only where
+/// light and view both graze).
+#[test]
+fn tabulated_ward_renders_close_to_the_analytic_ward() {
+    let dir = TempDir::new("merl-ward");
+    write(&dir, "ward.binary", ward_table_bytes());
+    let measured = sphere(&dir, "measured", json!({ "brdf": "merl", "file": "ward.binary" }));
+    let analytic = sphere(
+        &dir,
+        "analytic",
+        json!({ "brdf": "ward", "kd": [0.3, 0.25, 0.2], "ks": [0.2, 0.2, 0.2], "alpha": 0.2 }),
+    );
+    for (what, lights, model) in light_cases() {
+        let mut s = settings(&measured, lights, model, 48);
+        s.shading.samples_per_axis = 64;
+        s.shading.sun_samples_per_axis = 16;
+        let options = cpu::ReferenceOptions::default();
+        let (a, b) = (cpu::render(&measured, &s, &options), cpu::render(&analytic, &s, &options));
+        let (report, _) = compare::diff(&a, &b, &DiffOptions::default()).unwrap();
+        println!(
+            "{what}: tabulated against analytic max rel {:.2e}, p99 over {} pixels",
+            report.max_rel_interior, report.compared
+        );
+        assert!(report.max_rel_interior < 1e-2, "{what}: {:.3e} at {:?}", report.max_rel_interior, report.worst);
+    }
+}
+
+/// `fit_brdf` recovers the parameters of a tabulated Ward and a tabulated Blinn-Phong (to 5%; measured far
+/// closer), and a Lambert fit of a constant table its albedo.
+#[test]
+fn fit_recovers_the_parameters_of_tabulated_brdfs() {
+    use sunshade::scene::measured::MeasuredBrdf;
+    use sunshade::scene::BrdfKind;
+    use sunshade::shading::brdf_fit::fit_brdf;
+    let blinn = Brdf::BlinnPhong { kd: [0.5, 0.4, 0.3], ks: [0.1, 0.15, 0.2], exponent: 200.0 };
+    let cases = [
+        (ward(), BrdfKind::Ward, "ward"),
+        (blinn.clone(), BrdfKind::BlinnPhong, "blinn-phong"),
+        (Brdf::Lambert { albedo: [0.7, 0.5, 0.2] }, BrdfKind::Lambert, "lambert"),
+    ];
+    for (truth, kind, name) in cases {
+        let table = if name == "ward" {
+            sunshade::scene::measured::parse_merl(name, ward_table_bytes()).unwrap()
+        } else {
+            MeasuredBrdf::from_planes(name, &tabulate(|l, v| analytic(&truth, l, v))).unwrap()
+        };
+        let t = std::time::Instant::now();
+        let fit = fit_brdf(&table, kind);
+        println!(
+            "{name}: {:?}, relative RMS {:.2e} ({:.2} s)",
+            fit.brdf,
+            fit.relative_rms[0],
+            t.elapsed().as_secs_f64()
+        );
+        let close = |got: f32, want: f32| want == 0.0 && got.abs() < 1e-3 || ((got - want) / want).abs() < 0.05;
+        let (kd, ks, gkd, gks) = (truth.kd(), truth.ks(), fit.brdf.kd(), fit.brdf.ks());
+        for c in 0..3 {
+            assert!(close(gkd[c], kd[c]) && close(gks[c], ks[c]), "{name}: {:?} against {truth:?}", fit.brdf);
+        }
+        match (&truth, &fit.brdf) {
+            (Brdf::Ward { alpha_x: a, .. }, Brdf::Ward { alpha_x: b, alpha_y: c, .. }) => {
+                assert!(close(*b, *a) && b == c)
+            }
+            (Brdf::BlinnPhong { exponent: a, .. }, Brdf::BlinnPhong { exponent: b, .. }) => assert!(close(*b, *a)),
+            (Brdf::Lambert { .. }, Brdf::Lambert { .. }) => {}
+            _ => panic!("{name}: fitted {:?}", fit.brdf),
+        }
+        assert!(fit.relative_rms.iter().all(|&e| e < 1e-4), "{name}: {:?}", fit.relative_rms);
+    }
+}
+
+fn sunshade(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
+        .args(args)
+        .env("SUNSHADE_VALIDATION", "1")
+        .output()
+        .expect("run sunshade")
+}
+
+/// The command line: `tabulate-brdf` writes a table, `fit-brdf --json` fits it and its snippet loads as a
+/// material, `render --merl` puts it on every material and passes `--check` against the reference, and a bad
+/// `--merl` file fails in one line naming it, with no output written.
+#[test]
+fn command_line_tabulates_fits_and_renders_measured_materials() {
+    let dir = TempDir::new("merl-cli");
+    let table = dir.path("ward.binary");
+    let t = table.to_str().unwrap();
+    let o = sunshade(&[
+        "tabulate-brdf",
+        "--model",
+        "ward",
+        "--kd",
+        "0.3,0.25,0.2",
+        "--ks",
+        "0.2",
+        "--alpha",
+        "0.2",
+        "-o",
+        t,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&table).unwrap(), ward_table_bytes());
+    let o = sunshade(&["fit-brdf", t, "--model", "ward", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let fit: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((fit["parameters"]["alpha"].as_f64().unwrap() - 0.2).abs() < 1e-4, "{fit}");
+    assert!(fit["relative_rms"][0].as_f64().unwrap() < 1e-4 && fit["energy_conserving"] == true);
+    // The snippet is a material.
+    let snippet = sphere(&dir, "snippet", fit["extras"]["sunshade"].clone());
+    assert_eq!(snippet.materials[0].brdf, ward());
+
+    let scene =
+        dir.write("scene.glb", &sphere_scene(&ChartMaterial { name: "m".into(), extras: json!({"brdf": "lambert"}) }));
+    let out = dir.path("merl.exr");
+    let o = sunshade(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--merl",
+        t,
+        "--sky-radiance",
+        "50",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--check",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("result: PASS"));
+    let bad = dir.path("bad.binary");
+    std::fs::write(&bad, &ward_table_bytes()[..1000]).unwrap();
+    let none = dir.path("none.exr");
+    let o =
+        sunshade(&["render", scene.to_str().unwrap(), "--merl", bad.to_str().unwrap(), "-o", none.to_str().unwrap()]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{e}");
+    assert!(e.contains("bad.binary") && e.contains("truncated") && e.trim().lines().count() == 1, "{e}");
+    assert!(!none.exists());
+}
