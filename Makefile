@@ -36,6 +36,7 @@ bench: build
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
 	$(SUNSHADE) bench --textures --repeat 5 --update docs/textures.md
+	$(SUNSHADE) bench --measured --repeat 5 --update docs/measured.md
 	$(SUNSHADE) bench --pareto --repeat 5 --update docs/accuracy.md --plot docs/images/pareto.png
 	eval "$$(scripts/lavapipe-rt.sh)" && $(SUNSHADE) bench --pareto models/brdfs.glb --repeat 5 --plot docs/images/pareto-brdfs.png
 

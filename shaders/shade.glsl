@@ -275,6 +275,12 @@ vec3 cos_power_direction(vec3 axis, vec3 t, vec3 b, float exponent, float xi1, f
     return cos_a * axis + sin_a * (cos(phi) * t + sin(phi) * b);
 }
 
+// The alpha of the Ward half-vector distribution that draws a measured table's sky samples: its peak width / sqrt(2),
+// in [1e-3, 1].
+float measured_sampling_alpha(float lobe_width) {
+    return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
+}
+
 // integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
 // inverse CDF, each sample weighted by lobe/pdf (see the Rust).
 vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
@@ -329,11 +335,20 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                     }
                 }
             } else if (kind == BRDF_MEASURED) {
-                // Cosine-weighted about n: the table's part above its floor times pi (see the Rust).
-                vec3 omega = cos_power_direction(n, t, b, 1.0, xi1, phi);
-                vec3 value = specular_lobe_rgb(m, p, omega) * PI;
-                if (!any(greaterThan(value, vec3(0.0))) || !shadowed || visible_along(p.shadow_origin, omega)) {
-                    sum += value;
+                // Ward's isotropic half-vector distribution about n with the table's alpha (see the Rust).
+                float alpha = measured_sampling_alpha(m.ks.w);
+                float tan2 = -alpha * alpha * log_accurate(xi1);
+                float cos_d = 1.0 / sqrt(1.0 + tan2);
+                float sin_d = sqrt(tan2) * cos_d;
+                vec3 h = sin_d * (cos(phi) * t + sin(phi) * b) + cos_d * n;
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
+                    vec3 value = specular_lobe_rgb(m, p, omega) * weight;
+                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
                 }
             }
         }

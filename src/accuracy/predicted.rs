@@ -73,12 +73,17 @@ fn brdf_name(brdf: &Brdf) -> String {
     }
 }
 
+/// Whether a material some mesh uses is measured.
+fn has_measured(scene: &Scene) -> bool {
+    scene.meshes.iter().any(|m| matches!(scene.materials.get(m.material).map(|m| &m.brdf), Some(Brdf::Measured { .. })))
+}
+
 /// The distinct sharpest BRDFs (by lobe: albedos do not change a relative error) of the scene's materials that
 /// some mesh uses.
 fn scene_brdfs(scene: &Scene) -> Vec<Brdf> {
     let mut v: Vec<Brdf> = Vec::new();
     for mesh in &scene.meshes {
-        if let Some(m) = scene.materials.get(mesh.material) {
+        if let Some(m) = scene.materials.get(mesh.material).filter(|m| !matches!(m.brdf, Brdf::Measured { .. })) {
             let b = sharpest_brdf(m, scene);
             if !v.iter().any(|o| brdf_name(o) == brdf_name(&b)) {
                 v.push(b);
@@ -118,6 +123,9 @@ pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can
             p.max_relative = p.max_relative.max(b);
         }
     }
+    if has_measured(scene) {
+        p.unbounded.push("measured BRDFs (their tables' lookup and grids)".into());
+    }
     if !lights.disks.is_empty() {
         p.unbounded.push("the disk lights".into());
     }
@@ -155,6 +163,12 @@ pub fn choose_for_tolerance(
     tolerance: f64,
 ) -> Result<ShadingOptions, String> {
     let lights = &settings.lights;
+    if has_measured(scene) {
+        return Err(format!(
+            "--tolerance {tolerance:e}: measured BRDFs have no derived error bound (docs/measured.md measures their \
+             lookup and grids)"
+        ));
+    }
     if !lights.disks.is_empty() || lights.sky.is_some() {
         return Err(format!(
             "--tolerance {tolerance:e}: error bounds are derived for the sun so far (docs/accuracy.md, \"Error \

@@ -79,6 +79,12 @@ pub struct BenchArgs {
     /// "pareto".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures"])]
     pub pareto: bool,
+    /// Measured BRDFs: analytic BRDFs tabulated into the MERL format against their formulas (linear and nearest
+    /// lookups), and each table (the MERL files given as SCENES, else synthetic ones) against its best fit of
+    /// every analytic model: GPU frame time and image error under the sun and the sky (256 × 256 unless
+    /// --width/--height are given). Its --update regions are "measured-lookup" and "measured-fit".
+    #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto"])]
+    pub measured: bool,
     /// With --pareto: draw error against frame time (log-log, the front drawn, each point labelled by its row)
     /// into this PNG, one chart per scene.
     #[arg(long, value_name = "PNG", requires = "pareto")]
@@ -112,6 +118,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         "textures"
     } else if a.pareto {
         "pareto"
+    } else if a.measured {
+        "measured-fit"
     } else {
         ""
     };
@@ -126,6 +134,14 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.textures {
         return super::bench_textures::run(a);
+    }
+    if a.measured {
+        if a.scenes.is_empty() {
+            for doc in &a.update {
+                check_region(doc, "measured-lookup")?;
+            }
+        }
+        return super::bench_measured::run(a);
     }
     if a.pareto {
         return super::bench_pareto::run(a);

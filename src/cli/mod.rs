@@ -7,6 +7,7 @@ mod albedo;
 mod args;
 mod batch;
 mod bench;
+mod bench_measured;
 mod bench_pareto;
 mod bench_shadows;
 mod bench_textures;

@@ -500,6 +500,13 @@ pub fn cos_power_direction(axis: DVec3, t: DVec3, b: DVec3, exponent: f64, xi1: 
     cos_a * axis + sin_a * (phi.cos() * t + phi.sin() * b)
 }
 
+/// The α of the Ward half-vector distribution that draws a measured table's sky samples: its peak width
+/// `w` (2θ_h at e^{-1/2} of the peak) is Ward's `√2 α`, so `α = w/√2`, kept in [10⁻³, 1] (a table without a peak
+/// has w = π: the broadest distribution).
+pub fn measured_sampling_alpha(lobe_width: f64) -> f64 {
+    (lobe_width / std::f64::consts::SQRT_2).clamp(1e-3, 1.0)
+}
+
 /// `∫ lobe(ω) (n·ω)+ dω` over the hemisphere (the sky, per unit radiance), by a stratified grid of `per_axis²`
 /// cells through the lobe's inverse CDF, each sample weighted by lobe/pdf. Per channel, the first (an analytic
 /// lobe's three are equal).
@@ -564,12 +571,26 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
                         ([n.dot(omega).max(0.0) / (vh * cos_d); 3], omega)
                     }
                 }
-                Brdf::Measured { .. } => {
-                    // Cosine-weighted about n (the e = 1 case of the cos-power inverse CDF, pdf cos θ/π): the
-                    // table's part above its floor times π. A table has no inverse CDF of its own: a sharp
-                    // measured peak under the sky converges as the grid resolves it (docs/measured.md).
-                    let omega = cos_power_direction(n, t, b, 1.0, xi1, phi);
-                    (specular_lobe_rgb(brdf, p, omega).map(|x| x * PI), omega)
+                Brdf::Measured { ref table, .. } => {
+                    // A table has no inverse CDF of its own: its part above the floor is drawn through Ward's
+                    // isotropic half-vector distribution about n, `p_h = exp(−tan²δ/α²)/(π α² cos³δ)`, with the
+                    // α of the table's peak width ([`measured_sampling_alpha`]); `tan²δ = −α² ln ξ1` makes the
+                    // exponential ξ1 itself, and `p_ω = p_h/(4 v·h)`, so the sample's weight is
+                    // `ρ (n·ω) 4 (v·h) π α² cos³δ / ξ1` (ξ1 ≥ 1/(2k) on the midpoint grid).
+                    let alpha = measured_sampling_alpha(table.lobe_width as f64);
+                    let tan2 = -alpha * alpha * xi1.ln();
+                    let cos_d = 1.0 / (1.0 + tan2).sqrt();
+                    let sin_d = tan2.sqrt() * cos_d;
+                    let h = sin_d * (phi.cos() * t + phi.sin() * b) + cos_d * n;
+                    let vh = v.dot(h);
+                    if vh <= 0.0 {
+                        ([0.0; 3], n)
+                    } else {
+                        let omega = 2.0 * vh * h - v;
+                        let weight =
+                            n.dot(omega).max(0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
+                        (specular_lobe_rgb(brdf, p, omega).map(|x| x * weight), omega)
+                    }
                 }
             };
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
