@@ -21,7 +21,7 @@ test: setup
 	$(CARGO) test --release --workspace
 	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
 		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
-		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli -- gpu_ ray_quer; \
+		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli --test measured -- gpu_ ray_quer; \
 	else \
 		echo "make test: SKIPPED the ray-query tests: scripts/lavapipe-rt.sh could not install Mesa 25's lavapipe (above)"; \
 	fi

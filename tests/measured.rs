@@ -391,3 +391,49 @@ fn command_line_tabulates_fits_and_renders_measured_materials() {
     assert!(e.contains("bad.binary") && e.contains("truncated") && e.trim().lines().count() == 1, "{e}");
     assert!(!none.exists());
 }
+
+/// A measured sphere over a measured floor (one file, one table), under the sun and the sky with shadow rays: the
+/// GPU's ray queries against the reference's rays, differences only at pixels with a fragile ray (as for the
+/// analytic materials, tests/shadows.rs). Skipped without ray queries (make test runs it on lavapipe-rt).
+#[test]
+fn gpu_shadow_rays_on_measured_materials_agree_with_the_reference() {
+    use sunshade::authoring::shapes::{quad, uv_sphere};
+    use sunshade::authoring::{GltfBuilder, Node};
+    use sunshade::scene::{Camera, Projection};
+    use sunshade::shading::Shadows;
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let dir = TempDir::new("merl-shadow");
+    write(&dir, "ward.binary", ward_table_bytes());
+    let mut b = GltfBuilder::new();
+    let m =
+        b.add_material("m", [0.5; 3], false, Some(json!({ "sunshade": { "brdf": "merl", "file": "ward.binary" } })));
+    let floor = quad(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 0.0, 3.0), Vec3::new(3.0, 0.0, 0.0));
+    let mesh = b.add_mesh("s", &[uv_sphere(Vec3::ZERO, 1.0, 48, 96).primitive(Some(m)), floor.primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    let scene = common::load(&dir.write("shadow.glb", &b));
+    let Brdf::Measured { table, .. } = &scene.materials[0].brdf else { panic!("not measured") };
+    assert_eq!(scene.materials.len(), 1, "{}", table.name);
+    let eye = DVec3::new(0.0, 4.0, 4.0);
+    let camera = Camera::looking(
+        eye,
+        -eye.normalize(),
+        DVec3::Y,
+        Projection::Orthographic { ymag: 2.5, znear: 1.0, zfar: 12.0 },
+    )
+    .unwrap();
+    let mut lights = Lights { sun: Some(sun(31.0)), sky: Some([50.0; 3]), ..Default::default() };
+    lights.sun.as_mut().unwrap().direction = Vec3::new(0.4, 1.0, 0.2).normalize();
+    let mut s = RenderSettings::new(96, 96, camera, lights);
+    s.shading = ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: 4, ..Default::default() };
+    let g = gpu.render(&scene, &s);
+    let (c, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &gpu.reference_options());
+    let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+    let unexplained: Vec<_> =
+        report.over_tolerance_pixels.iter().filter(|&&(x, y)| !fragile[(y * c.width() + x) as usize]).collect();
+    println!(
+        "measured with shadows: max rel {:.2e}, {} over tolerance",
+        report.max_rel_interior, report.over_tolerance.total
+    );
+    assert!(unexplained.is_empty(), "GPU/reference differences away from fragile rays: {unexplained:?}");
+}

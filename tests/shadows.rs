@@ -175,7 +175,7 @@ fn penumbra_of_a_straight_edge_converges_to_the_circular_segment() {
 
 #[test]
 fn gpu_ray_queries_agree_with_the_reference_on_the_penumbra() {
-    let Some(mut gpu) = ray_query_renderer() else { return };
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
     let scene = edge_scene();
     let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
     let s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, 16);
@@ -187,22 +187,6 @@ fn gpu_ray_queries_agree_with_the_reference_on_the_penumbra() {
     let half_angle = (10f64.to_radians() as f32 as f64) / 2.0;
     let (max, _) = penumbra_errors(&g, &s, half_angle);
     assert!(max <= 1.0 / 16.0, "GPU penumbra: max error {max}");
-}
-
-/// A renderer with ray queries, or `None` (with a message) where the device has none and
-/// `SUNSHADE_REQUIRE_RAY_QUERIES=1` is not set.
-fn ray_query_renderer() -> Option<CheckedRenderer> {
-    let mut gpu = CheckedRenderer::new();
-    if gpu.renderer().device_info().ray_query {
-        return Some(gpu);
-    }
-    let name = gpu.renderer().device_info().name.clone();
-    assert!(
-        std::env::var("SUNSHADE_REQUIRE_RAY_QUERIES").map_or(true, |v| v != "1"),
-        "SUNSHADE_REQUIRE_RAY_QUERIES=1 but {name} has no ray queries"
-    );
-    eprintln!("skipped: {name} has no ray queries (make test runs this on scripts/lavapipe-rt.sh's lavapipe)");
-    None
 }
 
 /// Sample points on every triangle of an 80-triangle icosphere lit by a sun from `l`: (lit points, those with
@@ -376,7 +360,7 @@ fn the_sun_at_the_horizon_throws_long_shadows() {
 fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
     // Every scene of models/ with its own lights, shadows by ray queries against the f64 reference, to the
     // tolerance of `render --check`.
-    let Some(mut gpu) = ray_query_renderer() else { return };
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     let mut checked = 0;
     for name in ["room.gltf", "teapot.glb", "spheres.glb", "cube.glb", "brdfs.glb", "overcast.glb", "sunset.glb"] {
@@ -526,7 +510,7 @@ fn gpu_ray_query_differences_lie_at_fragile_rays() {
     // sun and the sky: the GPU's ray queries and the reference's f64 rays may answer differently only for rays
     // that pass within 2^-18 of the scene's size from an occluder's boundary, and the reference flags those
     // pixels; every pixel over the tolerance must be one of them.
-    let Some(mut gpu) = ray_query_renderer() else { return };
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
     let soup =
         sunshade::authoring::shapes::triangle_soup(Vec3::new(0.0, 0.6, 0.0), Vec3::new(0.8, 0.4, 0.8), 3000, 0.2, 7);
     let sc = scene(&[floor(1.5), soup]);
@@ -552,7 +536,7 @@ fn gpu_ray_queries_agree_with_the_reference_at_every_scale_and_at_grazing_sun() 
     // The blocks (a box standing on the floor, a 1 mm plate) at 1 mm, 1 m and 10 km, under a 45° sun and a sun
     // 0.5° above the horizon, seen from above: the GPU's shadow rays against the reference's, to the check
     // tolerance, differences allowed only at fragile rays.
-    let Some(mut gpu) = ray_query_renderer() else { return };
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
     for scale in [1e-3f32, 1.0, 1e3] {
         let sc = blocks_scene(scale, 5.0);
         let camera = camera_down(DVec3::new(1.5, 0.0, 0.0) * scale as f64, 3.0 * scale as f64, 10.0 * scale as f64);
@@ -709,7 +693,7 @@ fn gpu_shadow_maps_pass_light_through_alpha_masked_cutouts() {
 
 #[test]
 fn gpu_ray_queries_pass_light_through_alpha_masked_cutouts() {
-    let Some(mut gpu) = ray_query_renderer() else { return };
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
     let (scene, s) = masked_cutout_scene();
     let g = gpu.render(&scene, &s);
     let (c, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &gpu.reference_options());

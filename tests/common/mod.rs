@@ -71,3 +71,19 @@ pub fn load(path: &Path) -> Scene {
 pub fn bits(image: &Image) -> Vec<u32> {
     image.pixels().iter().flatten().map(|v| v.to_bits()).collect()
 }
+
+/// A renderer with ray queries, or `None` (with a message) where the device has none and
+/// `SUNSHADE_REQUIRE_RAY_QUERIES=1` is not set.
+pub fn ray_query_renderer() -> Option<CheckedRenderer> {
+    let mut gpu = CheckedRenderer::new();
+    if gpu.renderer().device_info().ray_query {
+        return Some(gpu);
+    }
+    let name = gpu.renderer().device_info().name.clone();
+    assert!(
+        std::env::var("SUNSHADE_REQUIRE_RAY_QUERIES").map_or(true, |v| v != "1"),
+        "SUNSHADE_REQUIRE_RAY_QUERIES=1 but {name} has no ray queries"
+    );
+    eprintln!("skipped: {name} has no ray queries (make test runs this on scripts/lavapipe-rt.sh's lavapipe)");
+    None
+}
