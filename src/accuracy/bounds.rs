@@ -226,6 +226,66 @@ pub fn horizon_bound(r: f64) -> f64 {
     (2.0 / (3.0 * PI) * r / FLOOR_FRACTION).min(1.0)
 }
 
+/// The largest lobe value [1/sr] `lobe(l, v)` with the light on the surface's horizon (where the delta sun's cap
+/// straddles it) and the viewer above it (polar angle ≤ 88°), at the sun-view angles the camera can show (within
+/// 1°): a scan of viewer polar angles and light azimuths, each step at most a quarter of the lobe's width (and 1°
+/// and 0.5°), three viewer azimuths for an anisotropic lobe. 0 without a lobe.
+pub fn horizon_lobe(brdf: &Brdf, angles: SunViewAngles) -> f64 {
+    if matches!(brdf, Brdf::Lambert { .. }) {
+        return 0.0;
+    }
+    let width = lobe_width(brdf);
+    let polar_step = 1f64.to_radians().min(0.25 * width);
+    let psi_step = 0.5f64.to_radians().min(0.25 * width);
+    let margin = 1f64.to_radians();
+    let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
+    let azimuths: &[f64] = if anisotropic { &[0.0, 45.0, 90.0] } else { &[0.0] };
+    let polar_count = (88f64.to_radians() / polar_step).ceil() as usize;
+    let psi_count = (2.0 * PI / psi_step).ceil() as usize;
+    (0..=polar_count)
+        .into_par_iter()
+        .map(|i| {
+            let theta = (i as f64 * polar_step).min(88f64.to_radians());
+            let mut best = 0.0f64;
+            for &phi in azimuths {
+                let p = phi.to_radians();
+                let v = DVec3::new(theta.sin() * p.cos(), theta.sin() * p.sin(), theta.cos());
+                let point = SurfacePoint {
+                    position: DVec3::ZERO,
+                    normal: DVec3::Z,
+                    tangent: DVec3::X,
+                    bitangent: DVec3::Y,
+                    to_viewer: v,
+                };
+                for j in 0..psi_count {
+                    let psi = j as f64 * psi_step;
+                    let l = DVec3::new(psi.cos(), psi.sin(), 0.0);
+                    let a = v.dot(l).clamp(-1.0, 1.0).acos();
+                    if a >= angles.min - margin && a <= angles.max + margin {
+                        best = best.max(specular_lobe(brdf, &point, l));
+                    }
+                }
+            }
+            best
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
+/// The delta sun's absolute error [W/(m²·sr)] where its cap straddles a surface's horizon, for a material of
+/// largest reflectances `kd_max`, `ks_max` (over channels) and lobe `brdf`: `(2/(3π)) r E⊥ (kd_max/π + ks_max
+/// horizon_lobe)` (see the module's text), `e_perp` the sun's largest channel [W/m²].
+pub fn horizon_error(brdf: &Brdf, kd_max: f64, ks_max: f64, r: f64, e_perp: f64, angles: SunViewAngles) -> f64 {
+    2.0 / (3.0 * PI) * r * e_perp * (kd_max / PI + ks_max * horizon_lobe(brdf, angles))
+}
+
+/// A lower bound of the truth's peak [W/(m²·sr)] from the peak `rendered` of a delta-sun render of the same
+/// scene: at the pixel where the render peaks the truth is at least the render less its error, which is at most
+/// `lobe_bound` of the larger of the truth and the floor (so of the truth's peak P) plus the horizon's absolute
+/// error and the renderer's relative `arithmetic`: `P ≥ (rendered (1 − arithmetic) − horizon) / (1 + lobe_bound)`.
+pub fn peak_lower_bound(rendered: f64, arithmetic: f64, horizon: f64, lobe_bound: f64) -> f64 {
+    ((rendered * (1.0 - arithmetic) - horizon) / (1.0 + lobe_bound)).max(0.0)
+}
+
 /// The sharpest BRDF a material can give at any pixel: its own, or for a metallic-roughness mapping the one of
 /// its smallest roughness (the factor times the smallest texel of the roughness texture: filtering only averages
 /// texels), with the mapping's limits.
@@ -293,6 +353,24 @@ mod tests {
     }
 
     const ALL: SunViewAngles = SunViewAngles::ALL;
+
+    #[test]
+    fn the_horizon_lobe_and_the_peak_bound() {
+        // Lambert has no lobe; Phong's largest value with the light on the horizon and the viewer at most 88°
+        // from the normal is where v is nearest the mirror of l (−l, on the horizon): α = 2°, (e + 2)/(2π) cos^e(2°), when every sun-view angle
+        // is allowed; none where the camera shows the sun only near the viewer.
+        assert_eq!(horizon_lobe(&Brdf::Lambert { albedo: [1.0; 3] }, ALL), 0.0);
+        let e = 100.0;
+        let phong = Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: e as f32 };
+        let want = (e + 2.0) / (2.0 * PI) * 2f64.to_radians().cos().powf(e);
+        let got = horizon_lobe(&phong, ALL);
+        assert!((got - want).abs() < 1e-3 * want, "{got} against {want}");
+        let near = SunViewAngles { min: 0.3, max: 0.4 };
+        assert!(horizon_lobe(&phong, near) < 1e-6 * want);
+        // P ≥ (rendered (1 − a) − horizon) / (1 + lobe bound), and never negative.
+        assert!((peak_lower_bound(100.0, 0.0, 10.0, 0.5) - 60.0).abs() < 1e-12);
+        assert_eq!(peak_lower_bound(1.0, 0.0, 2.0, 0.0), 0.0);
+    }
 
     #[test]
     fn bounds_grow_with_the_sun_and_the_lobes_sharpness_and_shrink_with_the_grid() {

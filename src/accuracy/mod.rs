@@ -7,7 +7,8 @@
 //!   1e-2, 1e-3, 1e-4);
 //! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
 //! - [`bounds`]: the sun models' error bounds, derived next to the code;
-//! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models.
+//! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models;
+//! - [`trial`]: `--tolerance` on the reference, with the delta sun tried first where its own image's peak decides.
 //!
 //! This module knows the reference renderer and the comparison, never Vulkan: GPU timings come from the caller.
 
@@ -16,3 +17,4 @@ pub mod converged;
 pub mod error;
 pub mod pareto;
 pub mod predicted;
+pub mod trial;

@@ -12,8 +12,8 @@ use crate::settings::RenderSettings;
 use crate::shading::{ShadingOptions, Shadows, SunModel};
 
 use super::bounds::{
-    horizon_bound, sharpest_brdf, sun_delta_bound, sun_grid_bound, sun_horizon_in_view, SunViewAngles, GPU_ARITHMETIC,
-    MIN_GRID_FOR_BOUND,
+    horizon_bound, horizon_error, peak_lower_bound, sharpest_brdf, sun_delta_bound, sun_grid_bound,
+    sun_horizon_in_view, SunViewAngles, FLOOR_FRACTION, GPU_ARITHMETIC, MIN_GRID_FOR_BOUND,
 };
 
 /// The largest sun grid `--tolerance` considers [cells a side].
@@ -81,16 +81,67 @@ fn has_measured(scene: &Scene) -> bool {
 /// The distinct sharpest BRDFs (by lobe: albedos do not change a relative error) of the scene's materials that
 /// some mesh uses.
 fn scene_brdfs(scene: &Scene) -> Vec<Brdf> {
-    let mut v: Vec<Brdf> = Vec::new();
+    scene_lobes(scene).into_iter().map(|l| l.brdf).collect()
+}
+
+/// A distinct sharpest lobe of the scene's materials and the largest reflectances (over channels and the
+/// materials that have it) it is scaled by: kd and ks as given, or for a metallic-roughness mapping at most the
+/// base colour factor's largest channel (textures and vertex colours only multiply it by at most 1; ks at least
+/// the mapping's 0.04).
+struct SceneLobe {
+    brdf: Brdf,
+    kd_max: f64,
+    ks_max: f64,
+}
+
+fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
+    let mut v: Vec<SceneLobe> = Vec::new();
     for mesh in &scene.meshes {
         if let Some(m) = scene.materials.get(mesh.material).filter(|m| !matches!(m.brdf, Brdf::Measured { .. })) {
-            let b = sharpest_brdf(m, scene);
-            if !v.iter().any(|o| brdf_name(o) == brdf_name(&b)) {
-                v.push(b);
+            let brdf = sharpest_brdf(m, scene);
+            let largest = |c: [f32; 3]| c.iter().fold(0.0f64, |a, &x| a.max(x as f64));
+            let (kd_max, ks_max) = match m.mapping {
+                None => (largest(m.brdf.kd()), largest(m.brdf.ks())),
+                Some(crate::scene::BrdfKind::Lambert) => (largest(m.pbr.base_color), 0.0),
+                Some(_) => (largest(m.pbr.base_color), largest(m.pbr.base_color).max(0.04)),
+            };
+            match v.iter_mut().find(|o| brdf_name(&o.brdf) == brdf_name(&brdf)) {
+                Some(o) => {
+                    o.kd_max = o.kd_max.max(kd_max);
+                    o.ks_max = o.ks_max.max(ks_max);
+                }
+                None => v.push(SceneLobe { brdf, kd_max, ks_max }),
             }
         }
     }
     v
+}
+
+/// The delta sun's horizon term per lobe of the scene (in [`scene_lobes`]' order) given the peak `rendered` of a
+/// delta render of it [W/(m²·sr)]: each lobe's absolute horizon error (`bounds::horizon_error`) over the floor of
+/// the truth's peak, that peak bounded below by `bounds::peak_lower_bound`; never more than the floor-based
+/// [`horizon_bound`]. `None` where the scene shows no horizon to the sun.
+fn horizon_terms(scene: &Scene, settings: &RenderSettings, arithmetic: f64, rendered: Option<f64>) -> Option<Vec<f64>> {
+    let sun = settings.lights.sun.as_ref()?;
+    let r = 0.5 * sun.angular_diameter as f64;
+    let l = sun.direction.as_dvec3();
+    if !sun_horizon_in_view(scene, l, r) {
+        return None;
+    }
+    let lobes = scene_lobes(scene);
+    let Some(rendered) = rendered else { return Some(vec![horizon_bound(r); lobes.len()]) };
+    let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
+    let e_perp = sun.irradiance.iter().fold(0.0f64, |a, &x| a.max(x as f64));
+    let errors: Vec<f64> =
+        lobes.iter().map(|o| horizon_error(&o.brdf, o.kd_max, o.ks_max, r, e_perp, angles)).collect();
+    let lobe_bound = lobes.iter().map(|o| sun_delta_bound(&o.brdf, r, angles)).fold(0.0, f64::max);
+    let peak = peak_lower_bound(rendered, arithmetic, errors.iter().fold(0.0, |a: f64, &b| a.max(b)), lobe_bound);
+    Some(
+        errors
+            .iter()
+            .map(|&e| if peak > 0.0 { (e / (FLOOR_FRACTION * peak)).min(horizon_bound(r)) } else { horizon_bound(r) })
+            .collect(),
+    )
 }
 
 /// The sun's bound for one BRDF under these options; `horizon` is the scene's horizon term.
@@ -104,6 +155,18 @@ fn sun_bound(brdf: &Brdf, shading: &ShadingOptions, r: f64, horizon: f64, angles
 /// The predicted error of rendering `scene` with `settings` (whose shadow technique is the one used) on
 /// `renderer`; `can_occlude`: whether something in the scene can occlude a light.
 pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can_occlude: bool) -> Prediction {
+    predict_with_peak(scene, settings, renderer, can_occlude, None)
+}
+
+/// [`predict`], where a delta sun's render is known to peak at `rendered` [W/(m²·sr)] (its own image's peak): the
+/// horizon term is then taken against that peak ([`horizon_terms`]) instead of the material's own response.
+pub fn predict_with_peak(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    rendered: Option<f64>,
+) -> Prediction {
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let lights = &settings.lights;
     let shading = &settings.shading;
@@ -111,15 +174,22 @@ pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can
         let r = 0.5 * sun.angular_diameter as f64;
         let l = sun.direction.as_dvec3();
         let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
-        let horizon =
-            if shading.sun == SunModel::Delta && sun_horizon_in_view(scene, l, r) { horizon_bound(r) } else { 0.0 };
-        let model = match shading.sun {
-            SunModel::Delta => "delta sun".to_string(),
-            SunModel::Disk => format!("disk sun {}²", shading.sun_samples_per_axis),
+        let arithmetic = if matches!(renderer, Renderer::Gpu { .. }) { GPU_ARITHMETIC } else { 0.0 };
+        let horizons = match shading.sun {
+            SunModel::Delta => horizon_terms(scene, settings, arithmetic, rendered),
+            SunModel::Disk => None,
         };
-        for brdf in scene_brdfs(scene) {
-            let b = sun_bound(&brdf, shading, r, horizon, angles);
-            p.terms.push((format!("{model}, {}:", brdf_name(&brdf)), b));
+        let model = match (shading.sun, rendered.is_some() && horizons.is_some()) {
+            (SunModel::Delta, false) => "delta sun".to_string(),
+            (SunModel::Delta, true) => {
+                format!("delta sun (horizon against the image's peak, {:.3e})", rendered.unwrap_or(0.0))
+            }
+            (SunModel::Disk, _) => format!("disk sun {}²", shading.sun_samples_per_axis),
+        };
+        for (i, brdf) in scene_brdfs(scene).iter().enumerate() {
+            let horizon = horizons.as_ref().map_or(0.0, |h| h[i]);
+            let b = sun_bound(brdf, shading, r, horizon, angles);
+            p.terms.push((format!("{model}, {}:", brdf_name(brdf)), b));
             p.max_relative = p.max_relative.max(b);
         }
     }
@@ -162,6 +232,45 @@ pub fn choose_for_tolerance(
     can_occlude: bool,
     tolerance: f64,
 ) -> Result<ShadingOptions, String> {
+    choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, None)
+}
+
+/// Whether a delta-sun render of `scene` is worth trying for `tolerance` before choosing ([`delta_peak`]'s
+/// caller renders it and passes its peak to [`choose_for_tolerance_with_peak`]): the choice without it is not the
+/// delta sun, the scene shows the sun a horizon, and every other term of the delta sun's bound meets the tolerance,
+/// so that only the horizon term, taken against the render's peak, decides.
+pub fn delta_worth_trying(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    tolerance: f64,
+) -> bool {
+    let Ok(choice) = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance) else { return false };
+    let Some(sun) = &settings.lights.sun else { return false };
+    if choice.sun == SunModel::Delta {
+        return false;
+    }
+    let r = 0.5 * sun.angular_diameter as f64;
+    let l = sun.direction.as_dvec3();
+    if !sun_horizon_in_view(scene, l, r) {
+        return false;
+    }
+    let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
+    let arithmetic = if matches!(renderer, Renderer::Gpu { .. }) { GPU_ARITHMETIC } else { 0.0 };
+    scene_brdfs(scene).iter().map(|b| sun_delta_bound(b, r, angles)).fold(0.0, f64::max) + arithmetic <= tolerance
+}
+
+/// [`choose_for_tolerance`], the delta sun's horizon term taken against the peak `delta_peak` [W/(m²·sr)] of a
+/// delta render of the same scene and settings where one was made ([`delta_worth_trying`]).
+pub fn choose_for_tolerance_with_peak(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    tolerance: f64,
+    delta_peak: Option<f64>,
+) -> Result<ShadingOptions, String> {
     let lights = &settings.lights;
     if has_measured(scene) {
         return Err(format!(
@@ -191,9 +300,15 @@ pub fn choose_for_tolerance(
     let r = 0.5 * sun.angular_diameter as f64;
     let l = sun.direction.as_dvec3();
     let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
-    let horizon = if sun_horizon_in_view(scene, l, r) { horizon_bound(r) } else { 0.0 };
+    let horizons = horizon_terms(scene, settings, arithmetic, delta_peak);
     let brdfs = scene_brdfs(scene);
-    let worst = |s: &ShadingOptions| brdfs.iter().map(|b| sun_bound(b, s, r, horizon, angles)).fold(0.0, f64::max);
+    let worst = |s: &ShadingOptions| {
+        brdfs
+            .iter()
+            .enumerate()
+            .map(|(i, b)| sun_bound(b, s, r, horizons.as_ref().map_or(0.0, |h| h[i]), angles))
+            .fold(0.0, f64::max)
+    };
     let meets = |s: &ShadingOptions| worst(s) + arithmetic <= tolerance;
     shading.sun = SunModel::Delta;
     if meets(&shading) {
@@ -217,6 +332,8 @@ pub fn choose_for_tolerance(
 /// (`settings.shading` updated, shadows already resolved), then [`predict`] for the models used.
 /// `scene_can_occlude`: whether something in the scene can occlude a light; with `--shadows none` asked for
 /// (`asked`), the truth the bound is against is unshadowed too.
+/// `delta_peak`: the peak of a delta-sun render of the scene made for the choice ([`delta_worth_trying`]), also
+/// the prediction's where the delta sun is chosen.
 pub fn choose_and_predict(
     scene: &Scene,
     settings: &mut RenderSettings,
@@ -224,10 +341,27 @@ pub fn choose_and_predict(
     asked: Shadows,
     scene_can_occlude: bool,
     tolerance: Option<f64>,
+    delta_peak: Option<f64>,
 ) -> Result<Prediction, String> {
     let can_occlude = asked != Shadows::None && scene_can_occlude;
     if let Some(tolerance) = tolerance {
-        settings.shading = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance)?;
+        settings.shading =
+            choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, delta_peak)?;
     }
-    Ok(predict(scene, settings, renderer, can_occlude))
+    let peak = delta_peak.filter(|_| settings.shading.sun == SunModel::Delta);
+    Ok(predict_with_peak(scene, settings, renderer, can_occlude, peak))
+}
+
+/// Whether `choose_and_predict` should be given a delta render's peak: `--tolerance` asked, and
+/// [`delta_worth_trying`] (the same `asked` shadows rule).
+pub fn delta_trial(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    asked: Shadows,
+    scene_can_occlude: bool,
+    tolerance: Option<f64>,
+) -> bool {
+    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    tolerance.is_some_and(|t| delta_worth_trying(scene, settings, renderer, can_occlude, t))
 }

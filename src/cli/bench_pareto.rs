@@ -117,7 +117,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             let renderer = predicted::Renderer::Gpu {
                 exact_interpolation: setting.interpolation == Interpolation::BarycentricF64,
             };
-            let p = predicted::predict(&scene, &s, renderer, can_occlude);
+            // A delta sun's horizon term is taken against its own image's peak.
+            let peak = (s.shading.sun == crate::shading::SunModel::Delta).then(|| crate::compare::image_peak(&image));
+            let p = predicted::predict_with_peak(&scene, &s, renderer, can_occlude, peak);
             let predicted = (p.max_relative, !p.unbounded.is_empty());
             rows.push(Row { label, frame_ms: ms(median(times)), spread_ms: ms(spread), error, predicted });
             bar.inc(1);

@@ -7,7 +7,7 @@ use clap::Args;
 use super::args::{parse_positive, OutputArgs, SceneArgs};
 use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::accuracy::converged::{self, ConvergenceOptions};
-use crate::accuracy::predicted;
+use crate::accuracy::trial::reference_within_tolerance;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image_with;
 
@@ -81,22 +81,15 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let choice = cpu::shadow_choice_where(scene_can_occlude, &settings, &options);
     settings.shading.shadows = choice.technique;
     // `--converged` has no bound to predict (it is the truth), and takes no `--tolerance`.
-    let prediction = if a.converged {
-        None
-    } else {
-        let asked = a.scene.shadows;
-        let renderer = predicted::Renderer::Reference;
-        let tolerance = a.scene.tolerance;
-        Some(
-            predicted::choose_and_predict(&scene, &mut settings, renderer, asked, scene_can_occlude, tolerance)
-                .map_err(CliError::Usage)?,
-        )
-    };
-    let (image, convergence) = if a.converged {
+    let (image, prediction, convergence) = if a.converged {
         let (image, record) = converged_image(&scene, &mut settings, &options, a);
-        (image, Some(record))
+        (image, None, Some(record))
     } else {
-        (cpu::render(&scene, &settings, &options), None)
+        let (asked, tolerance) = (a.scene.shadows, a.scene.tolerance);
+        let (image, prediction) =
+            reference_within_tolerance(&scene, &mut settings, &options, asked, scene_can_occlude, tolerance)
+                .map_err(CliError::Usage)?;
+        (image, Some(prediction), None)
     };
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);

@@ -13,7 +13,7 @@ use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
 use crate::settings::RenderSettings;
-use crate::shading::Shadows;
+use crate::shading::{Shadows, SunModel};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -123,16 +123,39 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     settings.shading.shadows = choice.technique;
     let predicted_for =
         predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
-    let prediction = predicted::choose_and_predict(
-        scene_data,
-        &mut settings,
-        predicted_for,
-        a.scene.shadows,
-        gpu_scene.can_occlude(),
-        a.scene.tolerance,
-    )
-    .map_err(CliError::Usage)?;
-    let (image, frame) = r.render(gpu_scene, &settings)?;
+    let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
+    // `--tolerance` may try the delta sun first: its horizon term is then taken against its own image's peak.
+    let trial = if predicted::delta_trial(scene_data, &settings, predicted_for, asked, can_occlude, tolerance) {
+        let mut delta = settings.clone();
+        delta.shading.sun = SunModel::Delta;
+        Some(r.render(gpu_scene, &delta)?)
+    } else {
+        None
+    };
+    let peak = trial.as_ref().map(|(image, _)| crate::compare::image_peak(image));
+    let prediction =
+        predicted::choose_and_predict(scene_data, &mut settings, predicted_for, asked, can_occlude, tolerance, peak)
+            .map_err(CliError::Usage)?;
+    let (image, frame) = match trial {
+        Some(delta) if settings.shading.sun == SunModel::Delta => delta,
+        Some((_, tried)) => {
+            // The trial's time counts: it is part of this render's cost.
+            let (image, mut frame) = r.render(gpu_scene, &settings)?;
+            frame.pipelines += tried.pipelines;
+            frame.render += tried.render;
+            frame.readback += tried.readback;
+            (image, frame)
+        }
+        None => r.render(gpu_scene, &settings)?,
+    };
+    // A delta render asked for (or chosen without a trial): its horizon term against its own image's peak.
+    let prediction = if settings.shading.sun == SunModel::Delta && peak.is_none() {
+        let can_occlude = asked != Shadows::None && can_occlude;
+        let peak = Some(crate::compare::image_peak(&image));
+        predicted::predict_with_peak(scene_data, &settings, predicted_for, can_occlude, peak)
+    } else {
+        prediction
+    };
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
 }
