@@ -192,6 +192,10 @@ pub fn predict_with_peak(
             p.terms.push((format!("{model}, {}:", brdf_name(brdf)), b));
             p.max_relative = p.max_relative.max(b);
         }
+        if shading.sun == SunModel::Delta && can_occlude && shading.shadows != Shadows::None {
+            p.terms.push(("delta sun's hard shadow edge across the penumbra:".into(), 1.0));
+            p.max_relative = 1.0;
+        }
     }
     if has_measured(scene) {
         p.unbounded.push("measured BRDFs (their tables' lookup and grids)".into());
@@ -248,7 +252,7 @@ pub fn delta_worth_trying(
 ) -> bool {
     let Ok(choice) = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance) else { return false };
     let Some(sun) = &settings.lights.sun else { return false };
-    if choice.sun == SunModel::Delta {
+    if choice.sun == SunModel::Delta || can_occlude {
         return false;
     }
     let r = 0.5 * sun.angular_diameter as f64;
@@ -310,8 +314,10 @@ pub fn choose_for_tolerance_with_peak(
             .fold(0.0, f64::max)
     };
     let meets = |s: &ShadingOptions| worst(s) + arithmetic <= tolerance;
+    // Where the scene shadows itself the delta sun's single shadow ray draws a hard edge across the penumbra
+    // (pixels up to 100% off), so only the disk is considered there.
     shading.sun = SunModel::Delta;
-    if meets(&shading) {
+    if !can_occlude && meets(&shading) {
         return Ok(shading);
     }
     shading.sun = SunModel::Disk;
