@@ -23,7 +23,7 @@ use sunshade::scene::measured::{merl_bytes, MERL_SAMPLES};
 use sunshade::scene::{Brdf, DiskLight, Lights, Scene, Sun};
 use sunshade::settings::RenderSettings;
 use sunshade::shading::measured::tabulate;
-use sunshade::shading::{specular_lobe, DiskModel, ShadingOptions, SunModel, SurfacePoint};
+use sunshade::shading::{DiskModel, ShadingOptions, SunModel};
 
 /// The analytic Ward of the synthetic table: kd 0.3/0.25/0.2, ks 0.2, α 0.2.
 fn ward() -> Brdf {
@@ -32,11 +32,7 @@ fn ward() -> Brdf {
 
 /// `kd/π + ks lobe` of an analytic BRDF at (l, v) about +z, per channel.
 fn analytic(brdf: &Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
-    let p =
-        SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v };
-    let lobe = specular_lobe(brdf, &p, l);
-    let (kd, ks) = (brdf.kd(), brdf.ks());
-    [0, 1, 2].map(|c| kd[c] as f64 / std::f64::consts::PI + ks[c] as f64 * lobe)
+    sunshade::shading::measured::brdf_about_z(brdf, l, v)
 }
 
 /// The Ward table's bytes, made once per test process.

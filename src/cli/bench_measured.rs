@@ -27,22 +27,13 @@ use crate::scene::measured::{read_merl_file, MeasuredBrdf};
 use crate::scene::{self, Brdf, BrdfKind, LoadOptions, Scene};
 use crate::settings::{self, CameraOptions, RenderSettings, SunOptions};
 use crate::shading::brdf_fit::fit_brdf;
-use crate::shading::measured::{tabulate, MeasuredLookup};
-use crate::shading::{specular_lobe, Shadows, SurfacePoint};
+use crate::shading::measured::{brdf_about_z, tabulate, MeasuredLookup};
+use crate::shading::Shadows;
 use crate::Image;
 
-/// `kd/π + ks lobe` of an analytic BRDF plus `extra`'s, per channel, about +z.
+/// The sum of analytic BRDFs per channel about +z.
 fn analytic_rho(brdfs: &[Brdf], l: DVec3, v: DVec3) -> [f64; 3] {
-    let p =
-        SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v };
-    let mut rho = [0.0; 3];
-    for b in brdfs {
-        let (kd, ks, lobe) = (b.kd(), b.ks(), specular_lobe(b, &p, l));
-        for c in 0..3 {
-            rho[c] += kd[c] as f64 / std::f64::consts::PI + ks[c] as f64 * lobe;
-        }
-    }
-    rho
+    brdfs.iter().map(|b| brdf_about_z(b, l, v)).fold([0.0; 3], |a, r| [a[0] + r[0], a[1] + r[1], a[2] + r[2]])
 }
 
 fn table_of(name: &str, brdfs: &[Brdf]) -> Result<MeasuredBrdf, CliError> {

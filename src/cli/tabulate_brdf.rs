@@ -6,15 +6,13 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use clap::Args;
-use glam::DVec3;
 
 use super::args::parse_radiance;
 use super::CliError;
 use crate::film::write_atomically;
 use crate::scene::measured::merl_bytes;
 use crate::scene::{Brdf, BrdfKind};
-use crate::shading::measured::tabulate;
-use crate::shading::{specular_lobe, SurfacePoint};
+use crate::shading::measured::{brdf_about_z, tabulate};
 
 #[derive(Args, Debug)]
 pub struct TabulateBrdfArgs {
@@ -47,18 +45,7 @@ pub fn run(a: &TabulateBrdfArgs) -> Result<(), CliError> {
         BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: a.alpha as f32, alpha_y: a.alpha as f32 },
     };
     brdf.validate().map_err(CliError::Usage)?;
-    let planes = tabulate(|l, v| {
-        let p = SurfacePoint {
-            position: DVec3::ZERO,
-            normal: DVec3::Z,
-            tangent: DVec3::X,
-            bitangent: DVec3::Y,
-            to_viewer: v,
-        };
-        let lobe = specular_lobe(&brdf, &p, l);
-        let (kd, ks) = (brdf.kd(), brdf.ks());
-        [0, 1, 2].map(|c| kd[c] as f64 / std::f64::consts::PI + ks[c] as f64 * lobe)
-    });
+    let planes = tabulate(|l, v| brdf_about_z(&brdf, l, v));
     let bytes = merl_bytes(&planes);
     write_atomically(&a.output, |out| out.write_all(&bytes))
         .map_err(|e| CliError::Failure(anyhow::anyhow!("cannot write '{}': {e}", a.output.display())))?;

@@ -25,8 +25,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::measured::half_diff_directions;
-use super::shade::{specular_lobe, SurfacePoint};
+use super::measured::{brdf_about_z, half_diff_directions, lobe_about_z};
 use crate::scene::measured::{merl_index, MeasuredBrdf, PHI_D_BINS, THETA_D_BINS, THETA_H_BINS};
 use crate::scene::{Brdf, BrdfKind};
 
@@ -120,14 +119,7 @@ fn lobe_sums(samples: &[FitSample], lobe: &Brdf) -> LobeSums {
         .map(|chunk| {
             let mut t = LobeSums::default();
             for s in chunk {
-                let p = SurfacePoint {
-                    position: DVec3::ZERO,
-                    normal: DVec3::Z,
-                    tangent: DVec3::X,
-                    bitangent: DVec3::Y,
-                    to_viewer: s.v,
-                };
-                let l = specular_lobe(lobe, &p, s.l);
+                let l = lobe_about_z(lobe, s.l, s.v);
                 t.ll += s.weight * l * l;
                 t.xl += s.weight * x * l;
                 for c in 0..3 {
@@ -252,22 +244,14 @@ pub fn fit_brdf(table: &MeasuredBrdf, kind: BrdfKind) -> Fit {
 /// The objective's relative RMS per channel for `brdf` over `samples`, summed directly (the normal equations'
 /// expansion cancels where the fit is close).
 pub fn relative_rms(samples: &[FitSample], brdf: &Brdf) -> [f64; 3] {
-    let (kd, ks) = (brdf.kd(), brdf.ks());
     let (num, den) = samples
         .par_chunks(8192)
         .map(|chunk| {
             let (mut num, mut den) = ([0.0; 3], [0.0; 3]);
             for s in chunk {
-                let p = SurfacePoint {
-                    position: DVec3::ZERO,
-                    normal: DVec3::Z,
-                    tangent: DVec3::X,
-                    bitangent: DVec3::Y,
-                    to_viewer: s.v,
-                };
-                let lobe = specular_lobe(brdf, &p, s.l);
+                let model = brdf_about_z(brdf, s.l, s.v);
                 for c in 0..3 {
-                    let model = kd[c] as f64 / PI + ks[c] as f64 * lobe;
+                    let model = model[c];
                     num[c] += s.weight * (model - s.rho[c]).powi(2);
                     den[c] += s.weight * s.rho[c] * s.rho[c];
                 }

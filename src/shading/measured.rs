@@ -207,6 +207,25 @@ pub fn half_diff_directions(theta_h: f64, theta_d: f64, phi_d: f64) -> (DVec3, D
     (l, v)
 }
 
+/// An analytic BRDF's specular lobe (without ks) for light from `l` seen from `v` about the normal +z, tangent +x:
+/// the frame [`half_diff_directions`] and [`tabulate`] use.
+pub fn lobe_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> f64 {
+    let p = super::SurfacePoint {
+        position: DVec3::ZERO,
+        normal: DVec3::Z,
+        tangent: DVec3::X,
+        bitangent: DVec3::Y,
+        to_viewer: v,
+    };
+    super::specular_lobe(brdf, &p, l)
+}
+
+/// An analytic BRDF's value `kd/π + ks lobe` [1/sr] per channel about the normal +z ([`lobe_about_z`]).
+pub fn brdf_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
+    let (kd, ks, lobe) = (brdf.kd(), brdf.ks(), lobe_about_z(brdf, l, v));
+    [0, 1, 2].map(|c| kd[c] as f64 / PI + ks[c] as f64 * lobe)
+}
+
 /// A table of `rho(l, v)` per channel [1/sr] at each sample's angles (normal +z), as [`MeasuredBrdf::from_planes`]
 /// takes it: for synthetic files made from analytic BRDFs.
 pub fn tabulate(mut rho: impl FnMut(DVec3, DVec3) -> [f64; 3]) -> [Vec<f64>; 3] {
