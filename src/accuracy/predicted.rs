@@ -3,13 +3,14 @@
 //!
 //! What is bounded so far: the sun (delta or disk, its grid) over every material of the scene, the sharpest
 //! lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. What is not, and is named
-//! in [`Prediction::unbounded`] instead of being silently left out: disk lights and the sky (their lobe grids),
+//! in [`Prediction::unbounded`] instead of being silently left out: disk lights and the sky on specular surfaces
+//! (their lobe grids; on Lambertian ones their closed forms are exact, and the small-source estimate unbounded),
 //! penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and shadows turned
 //! off in a scene that can shadow itself (there the error is up to 100%).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
-use crate::shading::{ShadingOptions, Shadows, SunModel};
+use crate::shading::{DiskModel, ShadingOptions, Shadows, SunModel};
 
 use super::bounds::{
     horizon_bound, horizon_error, peak_lower_bound, sharpest_brdf, sun_delta_bound, sun_grid_bound,
@@ -71,6 +72,12 @@ fn brdf_name(brdf: &Brdf) -> String {
         Brdf::Ward { alpha_x, alpha_y, .. } => format!("Ward αx={alpha_x} αy={alpha_y}"),
         Brdf::Measured { ref table, .. } => format!("measured {}", table.name),
     }
+}
+
+/// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
+/// the closed-form irradiance is then the whole of their light, exact).
+fn only_lambertian(scene: &Scene) -> bool {
+    !has_measured(scene) && scene_lobes(scene).iter().all(|l| matches!(l.brdf, Brdf::Lambert { .. }))
 }
 
 /// Whether a material some mesh uses is measured.
@@ -200,11 +207,20 @@ pub fn predict_with_peak(
     if has_measured(scene) {
         p.unbounded.push("measured BRDFs (their tables' lookup and grids)".into());
     }
+    let lambertian = only_lambertian(scene);
     if !lights.disks.is_empty() {
-        p.unbounded.push("the disk lights".into());
+        match (lambertian, shading.disk) {
+            (true, DiskModel::Exact) => p.terms.push(("disk lights, exact, on Lambertian surfaces:".into(), 0.0)),
+            (true, DiskModel::SmallSource) => p.unbounded.push("the disk lights' small-source estimate".into()),
+            (false, _) => p.unbounded.push("the disk lights (their lobe grids)".into()),
+        }
     }
     if lights.sky.is_some() {
-        p.unbounded.push("the sky".into());
+        if lambertian {
+            p.terms.push(("the sky on Lambertian surfaces:".into(), 0.0));
+        } else {
+            p.unbounded.push("the sky (its lobe grid)".into());
+        }
     }
     if can_occlude {
         match shading.shadows {
@@ -282,14 +298,24 @@ pub fn choose_for_tolerance_with_peak(
              lookup and grids)"
         ));
     }
-    if !lights.disks.is_empty() || lights.sky.is_some() {
+    if (!lights.disks.is_empty() || lights.sky.is_some()) && !only_lambertian(scene) {
         return Err(format!(
-            "--tolerance {tolerance:e}: error bounds are derived for the sun so far (docs/accuracy.md, \"Error \
-             bounds\"); this scene has {}",
+            "--tolerance {tolerance:e}: under disk lights and the sky only Lambertian surfaces have a bound (their \
+             closed forms), and this scene has {} and specular materials (docs/accuracy.md, \"Error bounds\")",
             if lights.sky.is_some() { "a sky" } else { "disk lights" }
         ));
     }
+    if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude {
+        return Err(format!(
+            "--tolerance {tolerance:e}: the scene can shadow itself, and the visible fraction of disk lights and the \
+             sky through occluders has no bound (a shadow-ray grid errs by the share of its cells an occluder's edge \
+             crosses); --shadows none bounds the render against the unshadowed truth"
+        ));
+    }
     let mut shading = settings.shading;
+    // Lambertian surfaces under disk lights: the exact model is the closed form (no error); the small-source
+    // estimate has no bound.
+    shading.disk = DiskModel::Exact;
     if let Renderer::Gpu { exact_interpolation: false } = renderer {
         return Err(format!("--tolerance {tolerance:e}: f32 or device interpolation has no error bound: use f64"));
     }

@@ -251,9 +251,11 @@ pub struct SceneArgs {
 
     /// Choose the cheapest sun model (delta, or the disk with the fewest samples) whose derived error bound, with
     /// the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
-    /// the models and the predicted bound (docs/accuracy.md, "Error bounds"). Bounds exist for the sun so far:
-    /// scenes with disk lights or a sky, f32 interpolation, and shadows other than rays (or `--shadows none`, which
-    /// measures against the unshadowed truth) are refused.
+    /// the models and the predicted bound (docs/accuracy.md, "Error bounds"). The sun is bounded for every
+    /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
+    /// (exact) and the sky only on Lambertian surfaces and unshadowed (their closed forms). Refused: specular or
+    /// measured materials under disk lights or a sky, their light through occluders, f32 interpolation, and shadows
+    /// other than rays (or `--shadows none`, which measures against the unshadowed truth).
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
