@@ -170,7 +170,14 @@ fn bad_tables_are_refused_in_one_line_and_missing_samples_warned() {
     header[8..12].copy_from_slice(&360i32.to_le_bytes());
     write(&dir, "header.binary", &header);
     write(&dir, "truncated.binary", &good[..good.len() / 2]);
-    for (file, what) in [("header.binary", "90 × 90 × 360"), ("truncated.binary", "truncated")] {
+    let mut long = good.to_vec();
+    long.extend_from_slice(&[0; 8]);
+    write(&dir, "long.binary", &long);
+    for (file, what) in [
+        ("header.binary", "90 × 90 × 360"),
+        ("truncated.binary", "truncated"),
+        ("long.binary", "more than the 34992012 expected of a MERL BRDF"),
+    ] {
         let m = ChartMaterial { name: file.into(), extras: json!({ "brdf": "merl", "file": file }) };
         let path = dir.write("bad.glb", &sphere_scene(&m));
         let e = sunshade::scene::load(&path).unwrap_err().to_string();

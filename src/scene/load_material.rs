@@ -10,7 +10,7 @@ use super::gltf::files::AssetFiles;
 use super::gltf::image::{decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
 use super::gltf::uri::{resolve, UriTarget};
 use super::material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
-use super::measured::{parse_merl, SharedMeasuredBrdf};
+use super::measured::{parse_merl, SharedMeasuredBrdf, MERL_FILE_BYTES};
 use super::texture::{uv_transform, Sampler, Texture, TextureRef, IDENTITY_UV_TRANSFORM};
 
 /// Texture sources other than PNG/JPEG that a texture may name in an extension (sunshade decodes none of them).
@@ -245,7 +245,10 @@ impl MaterialReader<'_> {
             None => {
                 let bytes = match resolve(uri)? {
                     UriTarget::Data(bytes) => bytes,
-                    UriTarget::File(rel) => self.files.read(&rel, uri, None)?,
+                    UriTarget::File(rel) => self
+                        .files
+                        .read_at_most(&rel, uri, MERL_FILE_BYTES as u64)
+                        .map_err(|e| format!("{e} of a MERL BRDF"))?,
                 };
                 let table = SharedMeasuredBrdf::new(parse_merl(uri, &bytes)?);
                 if table.missing > 0 {

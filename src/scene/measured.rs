@@ -187,7 +187,8 @@ pub fn merl_bytes(rho: &[Vec<f64>; 3]) -> Vec<u8> {
 /// errors name the file.
 pub fn read_merl_file(path: &std::path::Path) -> Result<MeasuredBrdf, String> {
     let name = path.display().to_string();
-    let bytes = super::gltf::files::read_regular_file(path, None).map_err(|e| format!("{name}: {e}"))?;
+    let bytes = super::gltf::files::read_regular_file_at_most(path, MERL_FILE_BYTES as u64)
+        .map_err(|e| format!("{name}: {e} of a MERL BRDF"))?;
     parse_merl(&name, &bytes)
 }
 

@@ -62,6 +62,19 @@ impl AssetFiles {
     /// The first `needed` bytes of the file a percent-decoded relative URI names. `uri` is the URI as written, for
     /// messages.
     pub fn read(&self, relative: &str, uri: &str, needed: Option<u64>) -> Result<Vec<u8>, String> {
+        let path = self.confined_path(relative, uri)?;
+        read_regular_file(&path, needed).map_err(|e| format!("'{uri}': {e}"))
+    }
+
+    /// The whole file a percent-decoded relative URI names, refused before reading when it holds more than
+    /// `at_most` bytes (a table of known size: a larger file is not read into memory to be refused).
+    pub fn read_at_most(&self, relative: &str, uri: &str, at_most: u64) -> Result<Vec<u8>, String> {
+        let path = self.confined_path(relative, uri)?;
+        read_regular_file_at_most(&path, at_most).map_err(|e| format!("'{uri}': {e}"))
+    }
+
+    /// The canonical path of the file a percent-decoded relative URI names, checked against the asset folder.
+    fn confined_path(&self, relative: &str, uri: &str) -> Result<std::path::PathBuf, String> {
         if relative.contains('\0') {
             return Err(format!("URI '{uri}' contains a NUL byte"));
         }
@@ -84,8 +97,18 @@ impl AssetFiles {
                 ));
             }
         }
-        read_regular_file(&canonical, needed).map_err(|e| format!("'{uri}': {e}"))
+        Ok(canonical)
     }
+}
+
+/// Reads a whole regular file of at most `at_most` bytes; a larger one is refused from its size, unread.
+pub fn read_regular_file_at_most(path: &Path, at_most: u64) -> Result<Vec<u8>, String> {
+    let size = fs::metadata(path).map_err(|e| e.to_string())?.len();
+    if size > at_most {
+        return Err(format!("the file holds {size} bytes, more than the {at_most} expected"));
+    }
+    // Exactly the bytes the size said: a file that grows meanwhile is not read further.
+    read_regular_file(path, Some(size))
 }
 
 /// Reads a regular file: all of it (`needed` = `None`, at most [`MAX_FILE_BYTES`]) or its first `needed` bytes,
