@@ -371,6 +371,14 @@ fn command_line_tabulates_fits_and_renders_measured_materials() {
     ]);
     assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).contains("result: PASS"));
+    // The image says which measurement it shows.
+    let meta = exr::meta::MetaData::read_from_file(&out, false).unwrap();
+    let all: serde_json::Value = match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
+    };
+    assert_eq!(all["sunshadeMeasured"][0]["file"], json!(t), "{all}");
+    assert_eq!(all["sunshadeMeasured"][0]["lookup"], json!("linear"));
     // No error bound is derived for tables: --tolerance says so instead of promising one.
     let o = sunshade(&[
         "reference",

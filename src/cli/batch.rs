@@ -175,11 +175,12 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
             match result {
                 Ok(job) => {
                     let args = jobs[i].as_ref().expect("rendered");
-                    let metadata = super::metadata::of_render_predicted(
+                    let mut metadata = super::metadata::of_render_predicted(
                         &job.settings,
                         &session.renderer_description(job.renderer),
                         &job.prediction,
                     );
+                    metadata.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
                     let item = Encode {
                         job: i,
                         image: job.image,

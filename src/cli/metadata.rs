@@ -1,7 +1,8 @@
 //! What an output file records about its render: the camera as OpenEXR's standard `worldToCamera` and
 //! `worldToNDC` matrices, and the lights and quality settings as JSON text (`sunshadeLights`,
 //! `sunshadeSettings`: in EXR inside the one JSON attribute `sunshade`, in PNG as tEXt chunks), and the predicted
-//! error bound of the models used (`sunshadePredictedError`, `accuracy::predicted`).
+//! error bound of the models used (`sunshadePredictedError`, `accuracy::predicted`), and the measured BRDF tables
+//! its materials use (`sunshadeMeasured`).
 
 use serde_json::json;
 
@@ -64,6 +65,24 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
             ("worldToNDC".into(), m(cam.clip_from_world(aspect))),
         ],
     }
+}
+
+/// `sunshadeMeasured`: the measured BRDF tables the scene's materials render with (material, file, lookup), or
+/// nothing where none is measured, so that an image says which measurement it shows.
+pub fn measured_materials(scene: &crate::scene::Scene) -> Option<(String, String)> {
+    let list: Vec<_> = scene
+        .materials
+        .iter()
+        .filter_map(|m| match &m.brdf {
+            crate::scene::Brdf::Measured { table, lookup } => Some(json!({
+                "material": m.name,
+                "file": table.name,
+                "lookup": if *lookup == crate::shading::measured::MeasuredLookup::Nearest { "nearest" } else { "linear" },
+            })),
+            _ => None,
+        })
+        .collect();
+    (!list.is_empty()).then(|| ("sunshadeMeasured".to_string(), serde_json::Value::Array(list).to_string()))
 }
 
 /// The sun model of a render in words, for `-v`: "sun: disk, 8² samples".

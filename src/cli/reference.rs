@@ -99,6 +99,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         None => super::metadata::of_render(&settings, "cpu reference"),
     };
     meta.text.extend(convergence);
+    meta.text.extend(super::metadata::measured_materials(&scene));
     let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
     if a.verbose {
         eprintln!(

@@ -243,11 +243,12 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
-    let meta = super::metadata::of_render_predicted(
+    let mut meta = super::metadata::of_render_predicted(
         &job.settings,
         &session.renderer_description(job.renderer),
         &job.prediction,
     );
+    meta.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
     let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
