@@ -448,3 +448,43 @@ fn gpu_shadow_rays_on_measured_materials_agree_with_the_reference() {
     );
     assert!(unexplained.is_empty(), "GPU/reference differences away from fragile rays: {unexplained:?}");
 }
+
+/// `sunshade albedo SCENE` gives a measured material's directional albedo (by quadrature over the table): the
+/// tabulated Ward's is within 1% of the analytic Ward's at every incidence up to 85° (measured 2.0e-4 to 3.6e-3).
+#[test]
+fn albedo_of_a_measured_material_matches_its_analytic_source() {
+    let dir = TempDir::new("merl-albedo");
+    write(&dir, "ward.binary", ward_table_bytes());
+    let measured = dir.write(
+        "m.glb",
+        &sphere_scene(&ChartMaterial { name: "m".into(), extras: json!({ "brdf": "merl", "file": "ward.binary" }) }),
+    );
+    let analytic = dir.write(
+        "a.glb",
+        &sphere_scene(&ChartMaterial {
+            name: "a".into(),
+            extras: json!({ "brdf": "ward", "kd": [0.3, 0.25, 0.2], "ks": [0.2, 0.2, 0.2], "alpha": 0.2 }),
+        }),
+    );
+    let table = |path: &std::path::Path| -> Vec<Vec<f64>> {
+        let o = sunshade(&["albedo", path.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        let row = text.lines().find(|l| l.starts_with("| material '")).unwrap_or_else(|| panic!("{text}")).to_string();
+        row.split('|')
+            .skip(2)
+            .filter(|c| !c.trim().is_empty())
+            .map(|c| c.split(',').map(|x| x.trim().parse::<f64>().unwrap()).collect())
+            .collect()
+    };
+    let (m, a) = (table(&measured), table(&analytic));
+    assert_eq!(m.len(), 5);
+    // 0°, 30°, 60°, 85° (89.9° grazes where the table holds its last θ_d bin).
+    for i in 0..4 {
+        for c in 0..3 {
+            let rel = (m[i][c] - a[i][c]).abs() / a[i][c];
+            println!("incidence {i}, channel {c}: measured {:.4}, analytic {:.4} ({rel:.1e})", m[i][c], a[i][c]);
+            assert!(rel < 1e-2, "incidence {i}, channel {c}: {} against {}", m[i][c], a[i][c]);
+        }
+    }
+}

@@ -21,6 +21,7 @@ use crate::shading::albedo::lobe_albedo;
 use crate::shading::radiometry::DiskGeometry;
 use std::f64::consts::PI;
 
+use crate::shading::measured::measured_albedo;
 use crate::shading::{disk_lobe_integral, sky_lobe_integral, sun_lobe_integral, SurfacePoint};
 
 #[derive(Args, Debug)]
@@ -34,6 +35,10 @@ pub struct AlbedoArgs {
     #[arg(long)]
     pub json: bool,
 }
+
+/// Grid side of a measured table's albedo quadrature (`shading::measured::measured_albedo`): 512² lookups, cells
+/// of about 0.35° near the normal.
+const MEASURED_ALBEDO_GRID: u32 = 512;
 
 /// Incidence angles [degrees] of the albedo tables.
 const INCIDENCES_DEGREES: [f64; 5] = [0.0, 30.0, 60.0, 85.0, 89.9];
@@ -150,8 +155,14 @@ fn scene_table(materials: &[(String, Brdf)]) -> String {
         let (kd, ks) = match *brdf {
             Brdf::Lambert { albedo } => (albedo, [0.0; 3]),
             Brdf::Phong { kd, ks, .. } | Brdf::BlinnPhong { kd, ks, .. } | Brdf::Ward { kd, ks, .. } => (kd, ks),
-            Brdf::Measured { ref table, .. } => {
-                s += &format!("| {name} | measured ({}): see `sunshade fit-brdf` |\n", table.name);
+            Brdf::Measured { ref table, lookup } => {
+                // The table's own albedo (no kd/ks split): quadrature over the light's hemisphere.
+                s += &format!("| {name} (measured, {}) |", table.name);
+                for d in INCIDENCES_DEGREES {
+                    let a = measured_albedo(table, lookup, d.to_radians(), MEASURED_ALBEDO_GRID);
+                    s += &format!(" {:.4}, {:.4}, {:.4} |", a[0], a[1], a[2]);
+                }
+                s += "\n";
                 continue;
             }
         };

@@ -207,6 +207,30 @@ pub fn half_diff_directions(theta_h: f64, theta_d: f64, phi_d: f64) -> (DVec3, D
     (l, v)
 }
 
+/// A table's directional albedo per channel for a viewer at `theta` [rad] from the normal: `∫ ρ(l, v) cos θ_l dω_l`
+/// over the hemisphere, by a `per_axis²` stratified midpoint grid drawn cosine-weighted (pdf `cos θ/π`, so each
+/// sample weighs `π ρ / per_axis²`). Exact for a constant table; a peak narrower than the grid's cells (about
+/// `π/per_axis` rad) is resolved only on average.
+pub fn measured_albedo(table: &MeasuredBrdf, lookup: MeasuredLookup, theta: f64, per_axis: u32) -> [f64; 3] {
+    let v = DVec3::new(theta.sin(), 0.0, theta.cos());
+    let k = per_axis as f64;
+    let mut sum = [0.0; 3];
+    for i in 0..per_axis {
+        // cos θ_l = √(1 − ξ1): the cosine-weighted inverse CDF.
+        let xi1 = (i as f64 + 0.5) / k;
+        let (sin_l, cos_l) = (xi1.sqrt(), (1.0 - xi1).sqrt());
+        for j in 0..per_axis {
+            let phi = 2.0 * PI * (j as f64 + 0.5) / k;
+            let l = DVec3::new(sin_l * phi.cos(), sin_l * phi.sin(), cos_l);
+            let rho = measured_brdf(table, lookup, DVec3::Z, l, v);
+            for c in 0..3 {
+                sum[c] += rho[c];
+            }
+        }
+    }
+    sum.map(|x| PI * x / (k * k))
+}
+
 /// An analytic BRDF's specular lobe (without ks) for light from `l` seen from `v` about the normal +z, tangent +x:
 /// the frame [`half_diff_directions`] and [`tabulate`] use.
 pub fn lobe_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> f64 {
@@ -273,6 +297,19 @@ mod tests {
         assert_eq!(measured_axis(179.5, 180, true), (179, 0, 0.5));
         assert_eq!(measured_axis(89.5, 90, false), (89, 89, 0.5));
         assert_eq!(measured_axis(95.0, 90, false), (89, 89, 1.0));
+    }
+
+    #[test]
+    fn a_constant_tables_albedo_is_pi_times_its_value() {
+        let planes: [Vec<f64>; 3] = std::array::from_fn(|c| vec![0.05 * (c + 1) as f64; MERL_SAMPLES]);
+        let t = MeasuredBrdf::from_planes("c", &planes).unwrap();
+        for theta in [0.0, 1.0, 1.5] {
+            let a = measured_albedo(&t, MeasuredLookup::Linear, theta, 64);
+            for (c, a) in a.iter().enumerate() {
+                let want = PI * (0.05 * (c + 1) as f64) as f32 as f64;
+                assert!((a - want).abs() < 1e-12, "{theta}: {a} against {want}");
+            }
+        }
     }
 
     #[test]

@@ -11,7 +11,10 @@
 //!   model: the lobe towards the centre times the small-source projected solid angle;
 //! - sky: `samples²` directions drawn by a stratified grid through each lobe's own inverse CDF (Phong: cos α about
 //!   the mirror direction; Blinn-Phong and Ward: the half vector), so that lobe/pdf is constant or smooth and
-//!   only the horizon is left to resolve.
+//!   only the horizon is left to resolve; a measured table through Ward's, with the α of its peak.
+//!
+//! A measured table (`Brdf::Measured`) is split the same way: its floor is the Lambertian part, the rest its
+//! "lobe", per channel ([`specular_lobe_rgb`]), through the same grids.
 //!
 //! Convergence in the sample counts is measured in docs/accuracy.md ("BRDFs").
 
