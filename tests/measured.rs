@@ -176,7 +176,7 @@ fn bad_tables_are_refused_in_one_line_and_missing_samples_warned() {
     for (file, what) in [
         ("header.binary", "90 × 90 × 360"),
         ("truncated.binary", "truncated"),
-        ("long.binary", "more than the 34992012 expected of a MERL BRDF"),
+        ("long.binary", "MERL BRDF 'long.binary': the file holds 34992020 bytes, more than the 34992012 expected"),
     ] {
         let m = ChartMaterial { name: file.into(), extras: json!({ "brdf": "merl", "file": file }) };
         let path = dir.write("bad.glb", &sphere_scene(&m));
@@ -187,6 +187,21 @@ fn bad_tables_are_refused_in_one_line_and_missing_samples_warned() {
     let m = ChartMaterial { name: "outside".into(), extras: json!({ "brdf": "merl", "file": "../ward.binary" }) };
     let e = sunshade::scene::load(&dir.write("outside.glb", &sphere_scene(&m))).unwrap_err().to_string();
     assert!(e.contains("outside the asset folder") || e.contains("cannot read"), "{e}");
+    // Not regular files: a FIFO (opening it for reading would block), a folder, a link out to /dev/zero; and a
+    // --merl path that is a device. Each refused in one line, nothing read.
+    #[cfg(unix)]
+    {
+        assert!(std::process::Command::new("mkfifo").arg(dir.path("pipe.binary")).status().unwrap().success());
+        std::fs::create_dir(dir.path("folder.binary")).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", dir.path("zero.binary")).unwrap();
+        for (file, what) in [("pipe.binary", "FIFO"), ("folder.binary", "director"), ("zero.binary", "outside")] {
+            let m = ChartMaterial { name: file.into(), extras: json!({ "brdf": "merl", "file": file }) };
+            let e = sunshade::scene::load(&dir.write("odd.glb", &sphere_scene(&m))).unwrap_err().to_string();
+            assert!(e.contains(file) && e.contains(what) && !e.contains('\n'), "{file}: {e}");
+        }
+        let e = sunshade::scene::measured::read_merl_file(std::path::Path::new("/dev/zero")).unwrap_err();
+        assert!(e.contains("/dev/zero") && !e.contains('\n'), "{e}");
+    }
     // Missing samples: loaded, warned, taken as 0.
     let mut missing = good.to_vec();
     for i in 0..1000 {

@@ -248,7 +248,7 @@ impl MaterialReader<'_> {
                     UriTarget::File(rel) => self
                         .files
                         .read_at_most(&rel, uri, MERL_FILE_BYTES as u64)
-                        .map_err(|e| format!("{e} of a MERL BRDF"))?,
+                        .map_err(|e| format!("MERL BRDF {e}"))?,
                 };
                 let table = SharedMeasuredBrdf::new(parse_merl(uri, &bytes)?);
                 if table.missing > 0 {

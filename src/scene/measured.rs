@@ -188,7 +188,7 @@ pub fn merl_bytes(rho: &[Vec<f64>; 3]) -> Vec<u8> {
 pub fn read_merl_file(path: &std::path::Path) -> Result<MeasuredBrdf, String> {
     let name = path.display().to_string();
     let bytes = super::gltf::files::read_regular_file_at_most(path, MERL_FILE_BYTES as u64)
-        .map_err(|e| format!("{name}: {e} of a MERL BRDF"))?;
+        .map_err(|e| format!("MERL BRDF '{name}': {e}"))?;
     parse_merl(&name, &bytes)
 }
 
