@@ -85,7 +85,7 @@ struct MaterialGpu {
                  // measured table's lobe width [rad]
     vec4 params; // x, y: Ward alpha_x, alpha_y; measured: rgb the table's floor [1/sr], w 1 for the nearest lookup
     uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided; z: 1 if alpha MASK;
-                 // w: a measured table's first float in measured_values[]
+                 // w: a measured table's first sample in measured_values[]
     vec4 base;   // base colour factor (rgb linear, alpha)
     vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
     vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
@@ -157,11 +157,11 @@ layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
 
-// Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rgb
-// rho [1/sr] interleaved (scene::measured); materials naming the same file share one copy. One float where no
-// material is measured.
+// Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rho
+// [1/sr] as rgb (a unused: one 16-byte load per sample; gpu::layout::measured_tables); materials naming the same
+// file share one copy. One zero sample where no material is measured.
 layout(std430, set = 0, binding = 11) readonly buffer MeasuredBuffer {
-    float measured_values[];
+    vec4 measured_values[];
 };
 
 // Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with

@@ -58,11 +58,10 @@ vec3 lerp(vec3 a, vec3 b, float t) {
     return a + t * (b - a);
 }
 
-// The table's rgb at bins (i, j, k) of the table starting at float `offset` of measured_values[].
+// The table's rgb at bins (i, j, k) of the table starting at sample `offset` of measured_values[].
 vec3 measured_sample(uint offset, float i, float j, float k) {
     uint index = uint(k) + PHI_D_BINS * (uint(j) + THETA_D_BINS * uint(i));
-    uint at = offset + 3u * index;
-    return vec3(measured_values[at], measured_values[at + 1u], measured_values[at + 2u]);
+    return measured_values[offset + index].rgb;
 }
 
 // rho [1/sr] per channel of the table at `offset` for light from l seen from v about n (0 below the horizon);
@@ -90,7 +89,7 @@ vec3 measured_brdf(uint offset, bool nearest, vec3 n, vec3 l, vec3 v) {
 }
 
 // The table's part above its floor (params.rgb; the material's kd is pi floor): what the sample grids integrate.
-// The table starts at float kind.w of measured_values[]; params.w is 1 for the nearest lookup.
+// The table starts at sample kind.w of measured_values[]; params.w is 1 for the nearest lookup.
 vec3 measured_residual(MaterialGpu m, vec3 n, vec3 l, vec3 v) {
     if (!(dot(n, l) > 0.0 && dot(n, v) > 0.0)) {
         return vec3(0.0);

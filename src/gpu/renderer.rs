@@ -320,10 +320,10 @@ impl Renderer {
         let measured_bytes = std::mem::size_of_val(&measured[..]) as u64;
         if measured_bytes > limit {
             return Err(GpuError::TooLarge(format!(
-                "the scene's measured BRDF tables take {:.1} MiB ({} distinct files, 16.7 MiB each); {} binds at most \
+                "the scene's measured BRDF tables take {:.1} MiB ({} distinct files, 22.2 MiB each); {} binds at most \
                  {:.1} MiB in one storage buffer",
                 measured_bytes as f64 / (1 << 20) as f64,
-                measured.len() / (3 * crate::scene::measured::MERL_SAMPLES),
+                measured.len() / (4 * crate::scene::measured::MERL_SAMPLES),
                 self.dev.info.name,
                 limit as f64 / (1 << 20) as f64
             )));
