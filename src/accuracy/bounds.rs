@@ -124,10 +124,36 @@ fn configurations(width: f64, angles: SunViewAngles, azimuths: &[f64]) -> Vec<(D
 /// A lobe's largest cell-scale curvatures against the floor: `max (|f₁₁| + |f₂₂|)` and `max |f₁₁ + f₂₂|` over the
 /// configurations of the module's text with the sun-view angles `angles`, by second differences of step `step`
 /// [rad]. 0 for a BRDF without a lobe.
+///
+/// The scan is a pure function of its arguments and costs ~10 ms a material; its results are kept for the
+/// process (a batch of renders, `--tolerance` trying grid after grid, asks the same questions again).
 pub fn lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f64) {
     if matches!(brdf, Brdf::Lambert { .. }) {
         return (0.0, 0.0);
     }
+    type Key = (String, u64, u64, u64);
+    type Scanned = std::collections::HashMap<Key, (f64, f64)>;
+    static SCANNED: std::sync::Mutex<Option<Scanned>> = std::sync::Mutex::new(None);
+    /// At most this many results are kept (then all are dropped): a long batch of moving cameras stays bounded.
+    const KEPT: usize = 4096;
+    // The BRDF's parameters by their debug text: f32 values print exactly (shortest round trip).
+    let key = (format!("{brdf:?}"), step.to_bits(), angles.min.to_bits(), angles.max.to_bits());
+    if let Some(&found) = SCANNED.lock().ok().as_ref().and_then(|c| c.as_ref()?.get(&key)) {
+        return found;
+    }
+    let result = scan_lobe_curvature(brdf, step, angles);
+    if let Ok(mut c) = SCANNED.lock() {
+        let map = c.get_or_insert_with(Scanned::new);
+        if map.len() >= KEPT {
+            map.clear();
+        }
+        map.insert(key, result);
+    }
+    result
+}
+
+/// [`lobe_curvature`]'s scan itself.
+fn scan_lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f64) {
     let n = DVec3::Z;
     let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
     let azimuths: &[f64] = if anisotropic { &[0.0, 45.0, 90.0] } else { &[0.0] };
