@@ -38,12 +38,8 @@ pub struct TabulateBrdfArgs {
 
 pub fn run(a: &TabulateBrdfArgs) -> Result<(), CliError> {
     let (kd, ks) = (a.kd.map(|x| x as f32), a.ks.map(|x| x as f32));
-    let brdf = match a.model {
-        BrdfKind::Lambert => Brdf::Lambert { albedo: kd },
-        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent: a.exponent as f32 },
-        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent: a.exponent as f32 },
-        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: a.alpha as f32, alpha_y: a.alpha as f32 },
-    };
+    let shape = if a.model == BrdfKind::Ward { a.alpha } else { a.exponent };
+    let brdf = Brdf::of_kind(a.model, kd, ks, shape as f32);
     brdf.validate().map_err(CliError::Usage)?;
     let planes = tabulate(|l, v| brdf_about_z(&brdf, l, v));
     let bytes = merl_bytes(&planes);

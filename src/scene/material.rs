@@ -60,6 +60,17 @@ pub const MAX_EXPONENT: f32 = 1e7;
 pub const MIN_MAPPED_ALPHA: f32 = 1e-3;
 
 impl Brdf {
+    /// An analytic model of `kind` with reflectances kd (Lambert: the albedo) and ks and its one shape
+    /// parameter: the exponent for Phong and Blinn-Phong, α (isotropic) for Ward, ignored for Lambert.
+    pub fn of_kind(kind: BrdfKind, kd: [f32; 3], ks: [f32; 3], shape: f32) -> Brdf {
+        match kind {
+            BrdfKind::Lambert => Brdf::Lambert { albedo: kd },
+            BrdfKind::Phong => Brdf::Phong { kd, ks, exponent: shape },
+            BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent: shape },
+            BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: shape, alpha_y: shape },
+        }
+    }
+
     /// The diffuse reflectance kd (the albedo for Lambert).
     pub fn kd(&self) -> [f32; 3] {
         match *self {

@@ -163,13 +163,7 @@ fn solve_channel(f: &FixedSums, l: &LobeSums, c: usize) -> (f64, f64, f64) {
 
 /// The model with shape parameter `shape` (exponent, or Ward's α) and unit reflectances, for the lobe alone.
 fn lobe_of(kind: BrdfKind, shape: f64) -> Brdf {
-    let (kd, ks) = ([0.0; 3], [1.0; 3]);
-    match kind {
-        BrdfKind::Lambert => Brdf::Lambert { albedo: kd },
-        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent: shape as f32 },
-        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent: shape as f32 },
-        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: shape as f32, alpha_y: shape as f32 },
-    }
+    Brdf::of_kind(kind, [0.0; 3], [1.0; 3], shape as f32)
 }
 
 /// The shape's search range: exponents 0.1 to 1e5 (Phong, Blinn-Phong), Ward α 0.002 to 1.
@@ -232,12 +226,7 @@ pub fn fit_brdf(table: &MeasuredBrdf, kind: BrdfKind) -> Fit {
     };
     let kd = channels.map(|c| c.0 as f32);
     let ks = channels.map(|c| c.1 as f32);
-    let brdf = match kind {
-        BrdfKind::Lambert => Brdf::Lambert { albedo: kd },
-        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent: shape as f32 },
-        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent: shape as f32 },
-        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: shape as f32, alpha_y: shape as f32 },
-    };
+    let brdf = Brdf::of_kind(kind, kd, ks, shape as f32);
     Fit { relative_rms: relative_rms(&samples, &brdf), brdf, samples: samples.len() }
 }
 
