@@ -45,7 +45,7 @@ use rayon::prelude::*;
 
 use crate::scene::material::{MAX_EXPONENT, MIN_MAPPED_ALPHA};
 use crate::scene::{Brdf, BrdfKind, Camera, Material, Projection, Scene};
-use crate::shading::{lobe_width, orthonormal_to, specular_lobe, SurfacePoint};
+use crate::shading::{lobe_about_z, lobe_width, orthonormal_to};
 
 /// The diff's floor, as a fraction of the image's peak.
 pub const FLOOR_FRACTION: f64 = 0.01;
@@ -131,20 +131,24 @@ pub fn lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f6
     if matches!(brdf, Brdf::Lambert { .. }) {
         return (0.0, 0.0);
     }
+    kept_scan(format!("curvature {brdf:?}"), step, angles, || scan_lobe_curvature(brdf, step, angles))
+}
+
+/// A scan's result (one or two maxima) kept for the process: `what` names the scan and its BRDF (by the debug text
+/// of its parameters: f32 values print exactly, the shortest round trip), with its step and sun-view angles; `scan`
+/// runs where it is not kept yet. At most [`KEPT_SCANS`] results are kept (then all are dropped): a long batch of
+/// moving cameras stays bounded.
+fn kept_scan(what: String, step: f64, angles: SunViewAngles, scan: impl FnOnce() -> (f64, f64)) -> (f64, f64) {
     type Key = (String, u64, u64, u64);
-    type Scanned = std::collections::HashMap<Key, (f64, f64)>;
-    static SCANNED: std::sync::Mutex<Option<Scanned>> = std::sync::Mutex::new(None);
-    /// At most this many results are kept (then all are dropped): a long batch of moving cameras stays bounded.
-    const KEPT: usize = 4096;
-    // The BRDF's parameters by their debug text: f32 values print exactly (shortest round trip).
-    let key = (format!("{brdf:?}"), step.to_bits(), angles.min.to_bits(), angles.max.to_bits());
-    if let Some(&found) = SCANNED.lock().ok().as_ref().and_then(|c| c.as_ref()?.get(&key)) {
+    static KEPT: std::sync::Mutex<Option<std::collections::HashMap<Key, (f64, f64)>>> = std::sync::Mutex::new(None);
+    let key = (what, step.to_bits(), angles.min.to_bits(), angles.max.to_bits());
+    if let Some(&found) = KEPT.lock().ok().as_ref().and_then(|c| c.as_ref()?.get(&key)) {
         return found;
     }
-    let result = scan_lobe_curvature(brdf, step, angles);
-    if let Ok(mut c) = SCANNED.lock() {
-        let map = c.get_or_insert_with(Scanned::new);
-        if map.len() >= KEPT {
+    let result = scan();
+    if let Ok(mut c) = KEPT.lock() {
+        let map = c.get_or_insert_with(Default::default);
+        if map.len() >= KEPT_SCANS {
             map.clear();
         }
         map.insert(key, result);
@@ -152,22 +156,26 @@ pub fn lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f6
     result
 }
 
+/// How many scan results [`kept_scan`] keeps at most.
+const KEPT_SCANS: usize = 4096;
+
+/// The viewer azimuths [degrees] the scans take: three for an anisotropic lobe, one otherwise.
+fn view_azimuths(brdf: &Brdf) -> &'static [f64] {
+    let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
+    if anisotropic {
+        &[0.0, 45.0, 90.0]
+    } else {
+        &[0.0]
+    }
+}
+
 /// [`lobe_curvature`]'s scan itself.
 fn scan_lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f64) {
     let n = DVec3::Z;
-    let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
-    let azimuths: &[f64] = if anisotropic { &[0.0, 45.0, 90.0] } else { &[0.0] };
-    let pairs = configurations(lobe_width(brdf), angles, azimuths);
-    let point = |v: DVec3| SurfacePoint {
-        position: DVec3::ZERO,
-        normal: n,
-        tangent: DVec3::X,
-        bitangent: DVec3::Y,
-        to_viewer: v,
-    };
+    let pairs = configurations(lobe_width(brdf), angles, view_azimuths(brdf));
     // The cosine unclamped: the grid's segment coordinates clip the cap at the horizon exactly, so the kink of
     // `(n·ω)+` is never inside a cell (stencils that reach below the horizon are skipped).
-    let f = |v: DVec3, l: DVec3| specular_lobe(brdf, &point(v), l) * n.dot(l);
+    let f = |v: DVec3, l: DVec3| lobe_about_z(brdf, l, v) * n.dot(l);
     // Every render predicts its error, so the scan (about 1e5 lobe evaluations a material) runs on the threads
     // rayon has; a maximum does not depend on the order it is taken in.
     let peak = pairs.par_iter().map(|&(v, l)| f(v, l)).reduce(|| 0.0f64, f64::max);
@@ -260,12 +268,16 @@ pub fn horizon_lobe(brdf: &Brdf, angles: SunViewAngles) -> f64 {
     if matches!(brdf, Brdf::Lambert { .. }) {
         return 0.0;
     }
+    kept_scan(format!("horizon {brdf:?}"), 0.0, angles, || (scan_horizon_lobe(brdf, angles), 0.0)).0
+}
+
+/// [`horizon_lobe`]'s scan itself.
+fn scan_horizon_lobe(brdf: &Brdf, angles: SunViewAngles) -> f64 {
     let width = lobe_width(brdf);
     let polar_step = 1f64.to_radians().min(0.25 * width);
     let psi_step = 0.5f64.to_radians().min(0.25 * width);
     let margin = 1f64.to_radians();
-    let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
-    let azimuths: &[f64] = if anisotropic { &[0.0, 45.0, 90.0] } else { &[0.0] };
+    let azimuths = view_azimuths(brdf);
     let polar_count = (88f64.to_radians() / polar_step).ceil() as usize;
     let psi_count = (2.0 * PI / psi_step).ceil() as usize;
     (0..=polar_count)
@@ -276,19 +288,12 @@ pub fn horizon_lobe(brdf: &Brdf, angles: SunViewAngles) -> f64 {
             for &phi in azimuths {
                 let p = phi.to_radians();
                 let v = DVec3::new(theta.sin() * p.cos(), theta.sin() * p.sin(), theta.cos());
-                let point = SurfacePoint {
-                    position: DVec3::ZERO,
-                    normal: DVec3::Z,
-                    tangent: DVec3::X,
-                    bitangent: DVec3::Y,
-                    to_viewer: v,
-                };
                 for j in 0..psi_count {
                     let psi = j as f64 * psi_step;
                     let l = DVec3::new(psi.cos(), psi.sin(), 0.0);
                     let a = v.dot(l).clamp(-1.0, 1.0).acos();
                     if a >= angles.min - margin && a <= angles.max + margin {
-                        best = best.max(specular_lobe(brdf, &point, l));
+                        best = best.max(lobe_about_z(brdf, l, v));
                     }
                 }
             }

@@ -29,6 +29,17 @@ pub enum Renderer {
     Reference,
 }
 
+impl Renderer {
+    /// The relative error its arithmetic adds to every bound: the GPU's f32 shading ([`GPU_ARITHMETIC`]); none for
+    /// the f64 reference.
+    pub fn arithmetic(self) -> f64 {
+        match self {
+            Renderer::Gpu { .. } => GPU_ARITHMETIC,
+            Renderer::Reference => 0.0,
+        }
+    }
+}
+
 /// A render's predicted max relative error (with the diff's floor) and what it covers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prediction {
@@ -181,7 +192,7 @@ pub fn predict_with_peak(
         let r = 0.5 * sun.angular_diameter as f64;
         let l = sun.direction.as_dvec3();
         let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
-        let arithmetic = if matches!(renderer, Renderer::Gpu { .. }) { GPU_ARITHMETIC } else { 0.0 };
+        let arithmetic = renderer.arithmetic();
         let horizons = match shading.sun {
             SunModel::Delta => horizon_terms(scene, settings, arithmetic, rendered),
             SunModel::Disk => None,
@@ -266,9 +277,12 @@ pub fn delta_worth_trying(
     can_occlude: bool,
     tolerance: f64,
 ) -> bool {
-    let Ok(choice) = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance) else { return false };
     let Some(sun) = &settings.lights.sun else { return false };
-    if choice.sun == SunModel::Delta || can_occlude {
+    if can_occlude {
+        return false;
+    }
+    let Ok(choice) = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance) else { return false };
+    if choice.sun == SunModel::Delta {
         return false;
     }
     let r = 0.5 * sun.angular_diameter as f64;
@@ -277,7 +291,7 @@ pub fn delta_worth_trying(
         return false;
     }
     let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
-    let arithmetic = if matches!(renderer, Renderer::Gpu { .. }) { GPU_ARITHMETIC } else { 0.0 };
+    let arithmetic = renderer.arithmetic();
     scene_brdfs(scene).iter().map(|b| sun_delta_bound(b, r, angles)).fold(0.0, f64::max) + arithmetic <= tolerance
 }
 
@@ -325,7 +339,7 @@ pub fn choose_for_tolerance_with_peak(
              with ray queries) render its shadows with a known error outside penumbrae"
         ));
     }
-    let arithmetic = if matches!(renderer, Renderer::Gpu { .. }) { GPU_ARITHMETIC } else { 0.0 };
+    let arithmetic = renderer.arithmetic();
     let Some(sun) = &lights.sun else { return Ok(shading) };
     let r = 0.5 * sun.angular_diameter as f64;
     let l = sun.direction.as_dvec3();

@@ -231,22 +231,10 @@ pub fn measured_albedo(table: &MeasuredBrdf, lookup: MeasuredLookup, theta: f64,
     sum.map(|x| PI * x / (k * k))
 }
 
-/// An analytic BRDF's specular lobe (without ks) for light from `l` seen from `v` about the normal +z, tangent +x:
-/// the frame [`half_diff_directions`] and [`tabulate`] use.
-pub fn lobe_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> f64 {
-    let p = super::SurfacePoint {
-        position: DVec3::ZERO,
-        normal: DVec3::Z,
-        tangent: DVec3::X,
-        bitangent: DVec3::Y,
-        to_viewer: v,
-    };
-    super::specular_lobe(brdf, &p, l)
-}
-
-/// An analytic BRDF's value `kd/π + ks lobe` [1/sr] per channel about the normal +z ([`lobe_about_z`]).
+/// An analytic BRDF's value `kd/π + ks lobe` [1/sr] per channel about the normal +z ([`super::lobe_about_z`]), the
+/// frame [`half_diff_directions`] and [`tabulate`] use.
 pub fn brdf_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
-    let (kd, ks, lobe) = (brdf.kd(), brdf.ks(), lobe_about_z(brdf, l, v));
+    let (kd, ks, lobe) = (brdf.kd(), brdf.ks(), super::lobe_about_z(brdf, l, v));
     [0, 1, 2].map(|c| kd[c] as f64 / PI + ks[c] as f64 * lobe)
 }
 

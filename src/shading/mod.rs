@@ -16,9 +16,9 @@ pub mod texture_filter;
 pub mod visibility;
 
 pub use shade::{
-    disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, lobe_width, normalized_lobe_integral,
-    orthonormal_to, radiance_out, radiance_out_visible, safe_normalize, sky_lobe_integral, specular_lobe,
-    sun_lobe_integral, DiskModel, ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS,
+    disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, lobe_about_z, lobe_width,
+    normalized_lobe_integral, orthonormal_to, radiance_out, radiance_out_visible, safe_normalize, sky_lobe_integral,
+    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS,
     DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{

@@ -233,6 +233,14 @@ pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
     }
 }
 
+/// A material's specular lobe (without ks) for light from `l` seen from `v` about the normal +z, tangent +x,
+/// bitangent +y: the frame of the bounds' scans and of tabulated tables.
+pub fn lobe_about_z(brdf: &Brdf, l: DVec3, v: DVec3) -> f64 {
+    let p =
+        SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v };
+    specular_lobe(brdf, &p, l)
+}
+
 /// The specular lobe of a material (without ks) for light from `l`; a measured table's, the mean of its
 /// channels'.
 pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
