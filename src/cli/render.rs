@@ -9,11 +9,12 @@ use super::diff::{compare_and_report, ReportFormat, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
 use crate::accuracy::predicted::{self, Prediction};
+use crate::accuracy::trial::{render_within_tolerance, TrialError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
 use crate::settings::RenderSettings;
-use crate::shading::{Shadows, SunModel};
+use crate::shading::Shadows;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -124,38 +125,28 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let predicted_for =
         predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
     let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
-    // `--tolerance` may try the delta sun first: its horizon term is then taken against its own image's peak.
-    let trial = if predicted::delta_trial(scene_data, &settings, predicted_for, asked, can_occlude, tolerance) {
-        let mut delta = settings.clone();
-        delta.shading.sun = SunModel::Delta;
-        Some(r.render(gpu_scene, &delta)?)
-    } else {
-        None
-    };
-    let peak = trial.as_ref().map(|(image, _)| crate::compare::image_peak(image));
-    let prediction =
-        predicted::choose_and_predict(scene_data, &mut settings, predicted_for, asked, can_occlude, tolerance, peak)
-            .map_err(CliError::Usage)?;
-    let (image, frame) = match trial {
-        Some(delta) if settings.shading.sun == SunModel::Delta => delta,
-        Some((_, tried)) => {
-            // The trial's time counts: it is part of this render's cost.
-            let (image, mut frame) = r.render(gpu_scene, &settings)?;
-            frame.pipelines += tried.pipelines;
-            frame.render += tried.render;
-            frame.readback += tried.readback;
-            (image, frame)
-        }
-        None => r.render(gpu_scene, &settings)?,
-    };
-    // A delta render asked for (or chosen without a trial): its horizon term against its own image's peak.
-    let prediction = if settings.shading.sun == SunModel::Delta && peak.is_none() {
-        let can_occlude = asked != Shadows::None && can_occlude;
-        let peak = Some(crate::compare::image_peak(&image));
-        predicted::predict_with_peak(scene_data, &settings, predicted_for, can_occlude, peak)
-    } else {
-        prediction
-    };
+    let done = render_within_tolerance(
+        scene_data,
+        &mut settings,
+        predicted_for,
+        asked,
+        can_occlude,
+        tolerance,
+        |s| r.render(gpu_scene, s),
+        |(image, _)| image,
+    )
+    .map_err(|e| match e {
+        TrialError::Tolerance(why) => CliError::Usage(why),
+        TrialError::Render(e) => CliError::from(e),
+    })?;
+    let (image, mut frame) = done.kept;
+    if let Some((_, tried)) = done.discarded_trial {
+        // The trial's time counts: it is part of this render's cost.
+        frame.pipelines += tried.pipelines;
+        frame.render += tried.render;
+        frame.readback += tried.readback;
+    }
+    let prediction = done.prediction;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
 }
