@@ -100,6 +100,22 @@ pub struct BenchArgs {
     pub json: bool,
 }
 
+/// A GPU measurement: one warm-up frame (the device compiles the variant's shaders at its first draw), whose image
+/// is returned, then `repeat` timed frames' render phases.
+pub(super) fn warm_frames(
+    renderer: &mut Renderer,
+    uploaded: &crate::gpu::GpuScene,
+    s: &crate::settings::RenderSettings,
+    repeat: u32,
+) -> Result<(crate::Image, Vec<Duration>), CliError> {
+    let (image, _) = renderer.render(uploaded, s)?;
+    let mut times = Vec::with_capacity(repeat as usize);
+    for _ in 0..repeat {
+        times.push(renderer.render(uploaded, s)?.1.render);
+    }
+    Ok((image, times))
+}
+
 pub(super) fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
     v[v.len() / 2]
@@ -338,11 +354,7 @@ fn bench_scenes(
         // This table measures the renderers' agreement unshadowed (shadows have their own table).
         s.shading.shadows = Shadows::None;
         let gpu_scene = renderer.upload(&scene)?;
-        let (gpu_image, _) = renderer.render(&gpu_scene, &s)?; // warm-up: the device compiles shaders at first draw
-        let mut gpu_times = Vec::new();
-        for _ in 0..a.repeat {
-            gpu_times.push(renderer.render(&gpu_scene, &s)?.1.render);
-        }
+        let (gpu_image, gpu_times) = warm_frames(renderer, &gpu_scene, &s, a.repeat)?;
         let cpu_image = cpu::render(&scene, &s, &options);
         let mut cpu_times = Vec::new();
         for _ in 0..a.repeat {

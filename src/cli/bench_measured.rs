@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use glam::DVec3;
 
-use super::bench::{bench_renderer, measured_by, median, ms, BenchArgs};
+use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
 use super::generated::{print_output, update_region};
 use super::CliError;
 use crate::authoring::chart::{self, ChartMaterial};
@@ -92,12 +92,7 @@ fn light_cases(sphere: &Scene, size: (u32, u32)) -> Result<Vec<(&'static str, Re
 /// The GPU's median frame time, after a warm-up frame.
 fn gpu_frame(renderer: &mut Renderer, scene: &Scene, s: &RenderSettings, repeat: u32) -> Result<Duration, CliError> {
     let uploaded = renderer.upload(scene)?;
-    renderer.render(&uploaded, s)?;
-    let mut times = Vec::new();
-    for _ in 0..repeat {
-        times.push(renderer.render(&uploaded, s)?.1.render);
-    }
-    Ok(median(times))
+    Ok(median(warm_frames(renderer, &uploaded, s, repeat)?.1))
 }
 
 /// `max rel` (with the diff's floor), relative RMSE (RMSE over the peak) and pixels over 1e-3 of `a` against

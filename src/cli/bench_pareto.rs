@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::bench::{build, default_scenes, device_description, median, ms, BenchArgs};
+use super::bench::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
 use super::generated::{machine, print_output, today, update_region};
 use super::sweep::{sweep, Relevance};
 use super::CliError;
@@ -104,12 +104,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             bar.set_message(format!("{name}: {label}"));
             let k = modes.iter().position(|&m| m == setting.interpolation).expect("a renderer per mode");
             s.shading = setting.shading;
-            // Warm-up: the device compiles the variant's shaders at its first draw.
-            let (image, _) = renderers[k].render(&uploaded[k], &s)?;
-            let mut times = Vec::new();
-            for _ in 0..a.repeat {
-                times.push(renderers[k].render(&uploaded[k], &s)?.1.render);
-            }
+            let (image, times) = warm_frames(&mut renderers[k], &uploaded[k], &s, a.repeat)?;
             let spread =
                 times.iter().max().copied().unwrap_or_default() - times.iter().min().copied().unwrap_or_default();
             let error = image_error(&image, &truth.image, Some(&excluded))

@@ -5,11 +5,11 @@
 //! surface under one light) over the pixels the converged reference finds shadowed at all. The last column counts
 //! the GPU's pixels over the `render --check` tolerance against the reference's rays with the same samples.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use glam::Vec3;
 
-use super::bench::{bench_renderer, build, device_description, median, ms, BenchArgs};
+use super::bench::{bench_renderer, build, device_description, median, ms, warm_frames, BenchArgs};
 use super::generated::{machine, print_output, today, update_region};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
@@ -161,11 +161,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             );
             let cpu_time = t.elapsed();
             let gpu = if info.ray_query || technique != Shadows::Ray {
-                let (g, _) = renderer.render(&gpu_scene, &sk)?; // warm-up: pipelines
-                let mut times: Vec<Duration> = Vec::new();
-                for _ in 0..a.repeat {
-                    times.push(renderer.render(&gpu_scene, &sk)?.1.render);
-                }
+                let (g, times) = warm_frames(&mut renderer, &gpu_scene, &sk, a.repeat)?;
                 let (report, _) = compare::diff(&g, &cpu_image, &DiffOptions::default())
                     .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
                 Some((g, median(times), report.over_tolerance.total))

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::bench::{bench_renderer, measured_by, median, ms, BenchArgs};
+use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
 use super::generated::{print_output, update_region};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
@@ -75,11 +75,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let plain = untextured(&scene);
         let mut time = |scene: &Scene| -> Result<(Duration, Duration, crate::Image, crate::Image), CliError> {
             let gpu_scene = renderer.upload(scene)?;
-            let (g, _) = renderer.render(&gpu_scene, &s)?; // warm-up: pipelines
-            let mut gpu = Vec::new();
-            for _ in 0..a.repeat {
-                gpu.push(renderer.render(&gpu_scene, &s)?.1.render);
-            }
+            let (g, gpu) = warm_frames(&mut renderer, &gpu_scene, &s, a.repeat)?;
             let c = cpu::render(scene, &s, &reference);
             let mut cpu_times = Vec::new();
             for _ in 0..a.repeat {
