@@ -17,7 +17,9 @@ use sunshade::scene::{Brdf, Camera, Lights, Material, Mesh, MetallicRoughness, P
 use sunshade::settings::RenderSettings;
 use sunshade::shading::quadrature::integrate_composite;
 use sunshade::shading::visibility::shadow_ray_origin;
-use sunshade::shading::{irradiance_visible, Occlusion, ShadingOptions, Shadowing, Shadows, SurfacePoint};
+use sunshade::shading::{
+    irradiance_visible, Occlusion, ShadingOptions, ShadowedLights, Shadowing, Shadows, SurfacePoint,
+};
 use sunshade::visibility::Bvh;
 use sunshade::Image;
 
@@ -220,7 +222,12 @@ fn terminator_counts(l: DVec3) -> ((usize, usize), (usize, usize)) {
                 for (origin, count) in
                     [(shadow_ray_origin(t, &normals, b, x, n), &mut hanika), (x + offset * face, &mut naive)]
                 {
-                    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 4 };
+                    let sh = Shadowing {
+                        origin,
+                        occluders: &bvh as &dyn Occlusion,
+                        samples_per_axis: 4,
+                        lights: ShadowedLights::ALL,
+                    };
                     let e = irradiance_visible(&point, &lights, &options, Some(&sh))[0];
                     let e0 = irradiance_visible(&point, &lights, &options, None)[0];
                     count.0 += 1;
@@ -306,7 +313,7 @@ fn floor_sun_visible(scene: &Scene, floor_half: f64, p: DVec3, l: DVec3) -> f64 
         DVec3::new(0.0, 0.0, floor_half),
     ];
     let origin = shadow_ray_origin(&corners, &[DVec3::Y; 3], [1.0 / 3.0; 3], p, DVec3::Y);
-    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 1 };
+    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 1, lights: ShadowedLights::ALL };
     f64::from(u8::from(sh.visible_along(l.normalize())))
 }
 

@@ -16,7 +16,9 @@ use crate::shading::surface::{
     SURFACE_COLORS, SURFACE_EMISSION, SURFACE_EVAL, SURFACE_NORMAL_MAP,
 };
 use crate::shading::visibility::shadow_ray_origin;
-use crate::shading::{radiance_out, radiance_out_visible, safe_normalize, Occlusion, Shadowing, SurfacePoint};
+use crate::shading::{
+    radiance_out, radiance_out_visible, safe_normalize, Occlusion, ShadowedLights, Shadowing, SurfacePoint,
+};
 
 /// The pixel's surface inputs ([`SurfaceSample`]): each set's texture coordinates at the pixel centre and at
 /// its right and lower neighbours, and the vertex colour, interpolated in f64 with the fragment shader's
@@ -96,17 +98,27 @@ pub(super) fn shade(
     let Some(occluders) = occluders else {
         return add_emission(radiance_out(&brdf, &point, &settings.lights, &settings.shading));
     };
-    // The shadow rays' origin from the triangle's corners and vertex normals (on the side being shaded).
-    let corner = |k: usize| DVec3::new(t.attributes[k][0], t.attributes[k][1], t.attributes[k][2]);
+    let shadow = Shadowing {
+        origin: shadow_origin(t, w, position, normal),
+        occluders,
+        samples_per_axis: settings.shading.shadow_samples_per_axis,
+        lights: ShadowedLights::of(settings.shading.shadows),
+    };
+    add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &settings.shading, Some(&shadow)))
+}
+
+/// The shadow rays' origin for the point `position` with barycentrics `w` and interpolated unit normal `normal`
+/// (on the side being shaded) of triangle `t`, from its corners and vertex normals
+/// ([`shadow_ray_origin`]).
+fn shadow_origin(t: &Prepared, w: [f64; 3], position: DVec3, normal: DVec3) -> DVec3 {
     let sign = if t.flip_normal { -1.0 } else { 1.0 };
     let vertex_normal =
         |k: usize| sign * safe_normalize(DVec3::new(t.attributes[k][3], t.attributes[k][4], t.attributes[k][5]));
-    let corners = [corner(0), corner(1), corner(2)];
     let normals = [vertex_normal(0), vertex_normal(1), vertex_normal(2)];
-    let shadow = Shadowing {
-        origin: shadow_ray_origin(&corners, &normals, w, position, normal),
-        occluders,
-        samples_per_axis: settings.shading.shadow_samples_per_axis,
-    };
-    add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &settings.shading, Some(&shadow)))
+    shadow_ray_origin(&corners(t), &normals, w, position, normal)
+}
+
+/// The world corners [m] of triangle `t`.
+fn corners(t: &Prepared) -> [DVec3; 3] {
+    [0, 1, 2].map(|k| DVec3::new(t.attributes[k][0], t.attributes[k][1], t.attributes[k][2]))
 }

@@ -153,7 +153,19 @@ fn occluders_for<'a>(scene: &'a Scene, settings: &RenderSettings, options: &Refe
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
     let occluders = occluders_for(scene, settings, options);
-    render_inner(scene, settings, options, occluders.as_ref(), false, None).0
+    let shader = plain_shader(scene, settings, occluders.as_ref());
+    render_inner(scene, settings, options, None, &shader).0
+}
+
+/// The per-pixel work of [`render`]: shading, with these occluders (`None`: every light unoccluded); no pixel is
+/// flagged.
+fn plain_shader<'a>(
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
+    occluders: Option<&'a Occluders<'_>>,
+) -> impl Fn(&Prepared, (u32, u32), [f64; 3]) -> ([f64; 3], bool) + Sync + 'a {
+    let viewer = settings.viewer();
+    move |t, xy, w| (shade(scene, settings, t, xy, w, viewer, occluders.map(|o| o as &dyn Occlusion)), false)
 }
 
 /// [`render`] for the pixels flagged in `selected` only (row-major, one flag a pixel); every other pixel is left
@@ -167,7 +179,8 @@ pub fn render_selected(
 ) -> Image {
     assert_eq!(selected.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
     let occluders = occluders_for(scene, settings, options);
-    render_inner(scene, settings, options, occluders.as_ref(), false, Some(selected)).0
+    let shader = plain_shader(scene, settings, occluders.as_ref());
+    render_inner(scene, settings, options, Some(selected), &shader).0
 }
 
 /// How near a shadow ray may pass an occluder's edge before its answer counts as fragile: `2⁻¹⁸` of the
@@ -192,9 +205,28 @@ pub fn render_with_fragile_pixels(
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
     let occluders = occluders_for(scene, settings, options);
-    let (image, fragile) = render_inner(scene, settings, options, occluders.as_ref(), true, None);
-    let n = image.pixels().len();
-    (image, fragile.unwrap_or_else(|| vec![false; n]))
+    let viewer = settings.viewer();
+    let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
+    render_inner(scene, settings, options, None, &|t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
+        let mut flagged = false;
+        let radiance = match &occluders {
+            Some(bvh) => {
+                let rec = Recording { occluders: bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
+                let r = shade(scene, settings, t, (x, y), w, viewer, Some(&rec));
+                flagged = rec.fragile.load(std::sync::atomic::Ordering::Relaxed);
+                r
+            }
+            None => shade(scene, settings, t, (x, y), w, viewer, None),
+        };
+        if t.surface != 0 {
+            let s = surface_sample(settings, t, x, y);
+            let material = &scene.materials[t.material];
+            if surface_discontinuity(material, &scene.textures, &s, t.surface) < FRAGILE_TEXTURE_RELATIVE {
+                flagged = true;
+            }
+        }
+        (radiance, flagged)
+    })
 }
 
 /// Occluders that remember whether any ray they answered was fragile (one per pixel): it grazed an edge, or met
@@ -219,16 +251,20 @@ impl Occlusion for Recording<'_> {
     }
 }
 
-/// The render, with these occluders (`None`: every light unoccluded), with `fragile` the per-pixel mask of
-/// fragile shadow rays, and shading only the pixels `selected` flags (`None`: all).
+/// What [`render_inner`] runs for each visible pixel: `(triangle, (x, y), barycentrics)` → (radiance
+/// [W/(m²·sr)], whether to flag the pixel).
+type PixelShader<'a> = dyn Fn(&Prepared, (u32, u32), [f64; 3]) -> ([f64; 3], bool) + Sync + 'a;
+
+/// The render: rasterization and visibility as the device does them, then `shade_pixel(triangle, (x, y),
+/// barycentrics)` for each visible pixel (only the pixels `selected` flags; `None`: all), which gives its
+/// radiance and whether to flag it; the flags come back as a row-major mask.
 fn render_inner(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
-    occluders: Option<&Occluders>,
-    fragile: bool,
     selected: Option<&[bool]>,
-) -> (Image, Option<Vec<bool>>) {
+    shade_pixel: &PixelShader,
+) -> (Image, Vec<bool>) {
     let (width, height) = (settings.width, settings.height);
     let triangles = prepare(scene, settings, options);
 
@@ -241,17 +277,16 @@ fn render_inner(
         }
     }
 
-    let viewer = settings.viewer();
     let mut image = Image::new(width, height);
-    let mut mask = vec![false; if fragile { (width * height) as usize } else { 0 }];
-    let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
+    let mut mask = vec![false; (width * height) as usize];
     let band_pixels = (BAND_ROWS * width) as usize;
-    // Without the mask its bands are empty slices, one per band all the same.
-    let mut no_mask = vec![[false; 0]; band_count];
-    let mask_bands: Vec<&mut [bool]> =
-        if fragile { mask.chunks_mut(band_pixels).collect() } else { no_mask.iter_mut().map(|m| &mut m[..]).collect() };
-    image.pixels_mut().par_chunks_mut(band_pixels).zip(mask_bands).zip(bins.par_iter()).enumerate().for_each(
-        |(band, ((pixels, flagged), bin))| {
+    image
+        .pixels_mut()
+        .par_chunks_mut(band_pixels)
+        .zip(mask.par_chunks_mut(band_pixels))
+        .zip(bins.par_iter())
+        .enumerate()
+        .for_each(|(band, ((pixels, flagged), bin))| {
             let y0 = band as u32 * BAND_ROWS;
             let rows = pixels.len() as u32 / width;
             // Visibility: the nearest triangle per pixel, then shade each pixel once.
@@ -279,29 +314,12 @@ fn render_inner(
                 let (x, y) = (k as u32 % width, y0 + k as u32 / width);
                 let t = &triangles[ti as usize];
                 let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
-                let radiance = match (occluders, fragile) {
-                    (Some(bvh), true) => {
-                        let rec = Recording { occluders: bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
-                        let r = shade(scene, settings, t, (x, y), w.to_array(), viewer, Some(&rec));
-                        if rec.fragile.load(std::sync::atomic::Ordering::Relaxed) {
-                            flagged[k] = true;
-                        }
-                        r
-                    }
-                    (o, _) => shade(scene, settings, t, (x, y), w.to_array(), viewer, o.map(|b| b as &dyn Occlusion)),
-                };
-                if fragile && t.surface != 0 {
-                    let s = surface_sample(settings, t, x, y);
-                    let material = &scene.materials[t.material];
-                    if surface_discontinuity(material, &scene.textures, &s, t.surface) < FRAGILE_TEXTURE_RELATIVE {
-                        flagged[k] = true;
-                    }
-                }
+                let (radiance, flag) = shade_pixel(t, (x, y), w.to_array());
+                flagged[k] = flag;
                 pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
             }
-        },
-    );
-    (image, fragile.then_some(mask))
+        });
+    (image, mask)
 }
 
 /// For each pixel, the distance [pixels] from its sample to the nearest edge of any triangle whose bounds

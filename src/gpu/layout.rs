@@ -23,7 +23,7 @@ pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
 /// Disk lights with a shadow map of their own (`MAX_DISK_MAPS` in the shaders).
-pub const MAX_DISK_MAPS: usize = 4;
+pub const MAX_DISK_MAPS: usize = crate::shading::MAPPED_DISKS;
 pub const WRAP_REPEAT: u32 = 0;
 pub const WRAP_MIRRORED_REPEAT: u32 = 1;
 pub const WRAP_CLAMP_TO_EDGE: u32 = 2;

@@ -22,6 +22,6 @@ pub use shade::{
     DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{
-    Occlusion, ShadowMapFilter, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
-    DEFAULT_SHADOW_SAMPLES_PER_AXIS,
+    Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
+    DEFAULT_SHADOW_SAMPLES_PER_AXIS, MAPPED_DISKS,
 };

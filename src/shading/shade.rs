@@ -181,7 +181,7 @@ pub fn irradiance_visible(
                 SunModel::Delta => sun_irradiance_delta(perp as f64, n_dot_l),
             };
         }
-        let v = match shadow {
+        let v = match shadow.and_then(Shadowing::for_sun) {
             Some(s) if unoccluded.iter().any(|&x| x > 0.0) => match options.sun {
                 SunModel::Disk => sun_visible_fraction(s, point.normal, l, delta),
                 SunModel::Delta => f64::from(u8::from(s.visible_along(l))),
@@ -192,13 +192,13 @@ pub fn irradiance_visible(
             *ec += u * v;
         }
     }
-    for disk in &lights.disks {
+    for (i, disk) in lights.disks.iter().enumerate() {
         let g = disk_geometry(disk);
         let omega = match options.disk {
             DiskModel::Exact => disk_projected_solid_angle(point.position, point.normal, &g),
             DiskModel::SmallSource => disk_projected_solid_angle_small_source(point.position, point.normal, &g),
         };
-        let v = match shadow {
+        let v = match shadow.and_then(|s| s.for_disk(i)) {
             Some(s) if omega > 0.0 => match options.disk {
                 DiskModel::Exact => {
                     disk_visible_fraction(s, point.position, point.normal, g.center, g.direction, g.radius)
@@ -213,7 +213,7 @@ pub fn irradiance_visible(
         }
     }
     if let Some(sky) = &lights.sky {
-        let v = match shadow {
+        let v = match shadow.and_then(Shadowing::for_sky) {
             Some(s) if point.normal.y > -1.0 => sky_visible_fraction(s, point.normal),
             _ => 1.0,
         };
@@ -643,6 +643,7 @@ pub fn radiance_out_visible(
     // Specular part: per unit radiance (or irradiance), then per channel.
     let mut specular = [0.0; 3];
     if let Some(sun) = &lights.sun {
+        let shadow = shadow.and_then(Shadowing::for_sun);
         let l = sun.direction.as_dvec3();
         match options.sun {
             SunModel::Delta => {
@@ -670,8 +671,9 @@ pub fn radiance_out_visible(
             }
         }
     }
-    for disk in &lights.disks {
+    for (i, disk) in lights.disks.iter().enumerate() {
         let g = disk_geometry(disk);
+        let shadow = shadow.and_then(|s| s.for_disk(i));
         let integral = match options.disk {
             DiskModel::Exact => {
                 let rays = shadow.map(SampleRays::ToPoint);
@@ -696,7 +698,8 @@ pub fn radiance_out_visible(
         }
     }
     if let Some(sky) = &lights.sky {
-        let integral = sky_lobe_integral_visible(brdf, point, options.samples_per_axis, shadow);
+        let integral =
+            sky_lobe_integral_visible(brdf, point, options.samples_per_axis, shadow.and_then(Shadowing::for_sky));
         for ((sc, &l0), integral) in specular.iter_mut().zip(sky).zip(integral) {
             *sc += integral * l0 as f64;
         }

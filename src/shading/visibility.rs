@@ -132,6 +132,38 @@ impl Occlusion for Unoccluded {
     }
 }
 
+/// Which lights a render shadows: every light where it casts rays; where it reads shadow maps, the sun and the
+/// first [`MAPPED_DISKS`] disk lights (the lights with a map), the sky and further disks unoccluded. The reference
+/// mirrors the GPU's choice with exact rays for the lights the maps stand for, so that `render --check` compares
+/// the same model (docs/accuracy.md, "Shadows").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowedLights {
+    pub sun: bool,
+    /// The first this many disk lights are shadowed.
+    pub disks: usize,
+    pub sky: bool,
+}
+
+/// The disk lights a shadow-map render gives a map of their own (the first ones; `MAX_DISK_MAPS` in the shaders).
+pub const MAPPED_DISKS: usize = 4;
+
+impl ShadowedLights {
+    /// Every light (rays).
+    pub const ALL: Self = Self { sun: true, disks: usize::MAX, sky: true };
+    /// The lights a shadow-map render shadows.
+    pub const MAPPED: Self = Self { sun: true, disks: MAPPED_DISKS, sky: false };
+
+    /// The lights technique `shadows` shadows (`None` and `Auto` have no rays to cast: every light, for a caller
+    /// that casts them anyway).
+    pub fn of(shadows: Shadows) -> Self {
+        if shadows == Shadows::Map {
+            Self::MAPPED
+        } else {
+            Self::ALL
+        }
+    }
+}
+
 /// What a shading point needs to cast shadow rays.
 #[derive(Clone, Copy)]
 pub struct Shadowing<'a> {
@@ -140,9 +172,26 @@ pub struct Shadowing<'a> {
     pub occluders: &'a dyn Occlusion,
     /// Samples per axis of the visible-fraction grids.
     pub samples_per_axis: u32,
+    /// The lights these rays shadow; the others are unoccluded.
+    pub lights: ShadowedLights,
 }
 
-impl Shadowing<'_> {
+impl<'a> Shadowing<'a> {
+    /// These rays for the sun, if it is shadowed.
+    pub fn for_sun(&self) -> Option<&Self> {
+        self.lights.sun.then_some(self)
+    }
+
+    /// These rays for disk light `i`, if it is shadowed.
+    pub fn for_disk(&self, i: usize) -> Option<&Self> {
+        (i < self.lights.disks).then_some(self)
+    }
+
+    /// These rays for the sky, if it is shadowed.
+    pub fn for_sky(&self) -> Option<&Self> {
+        self.lights.sky.then_some(self)
+    }
+
     /// Whether the direction `direction` (to a light at infinity: the sun, the sky) is unblocked.
     pub fn visible_along(&self, direction: DVec3) -> bool {
         !self.occluders.occluded(self.origin, direction, f64::INFINITY)
@@ -325,7 +374,7 @@ mod tests {
     }
 
     fn shadowing<'a>(occ: &'a dyn Occlusion, k: u32) -> Shadowing<'a> {
-        Shadowing { origin: DVec3::ZERO, occluders: occ, samples_per_axis: k }
+        Shadowing { origin: DVec3::ZERO, occluders: occ, samples_per_axis: k, lights: ShadowedLights::ALL }
     }
 
     #[test]
