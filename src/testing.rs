@@ -50,6 +50,9 @@ pub enum TestingError {
     Gpu(#[from] GpuError),
     #[error(transparent)]
     Image(#[from] ImageIoError),
+    /// The images differ beyond the tolerances (the comparison's report), or cannot be compared.
+    #[error("{0}")]
+    Compare(String),
 }
 
 impl From<CliError> for TestingError {
@@ -89,6 +92,27 @@ impl Job {
 pub fn reference(job: &Job, options: &ReferenceOptions) -> Result<Image, TestingError> {
     let (scene, settings) = job.prepare()?;
     Ok(cpu::render(&scene, &settings, options))
+}
+
+/// Renders the job's CPU reference and compares `image`, the job's GPU render, with it as `render --check` does:
+/// where the render used shadow maps (`--shadows map`, or `auto` on a device without ray queries, as `options`
+/// says: [`CheckedRenderer::reference_options`]) the pixels whose map lookups reach an occluder's edge are
+/// counted apart ([`DiffReport::excused`]), not failed. `Err` holds the report of a failed comparison.
+pub fn check_against_reference(
+    job: &Job,
+    image: &Image,
+    options: &ReferenceOptions,
+    diff: &DiffOptions,
+) -> Result<DiffReport, TestingError> {
+    let (scene, settings) = job.prepare()?;
+    let (reference, edges) = cpu::render_with_map_edges(&scene, &settings, options);
+    let (report, _) = compare::diff_excusing(image, &reference, diff, Some((&edges, cpu::map_edges::CLASS)))
+        .map_err(TestingError::Compare)?;
+    if report.pass {
+        Ok(report)
+    } else {
+        Err(TestingError::Compare(report.text("gpu", "cpu reference")))
+    }
 }
 
 /// A GPU renderer with the validation layer on. Any validation message fails: after each render, and when the

@@ -746,4 +746,29 @@ fn shadow_flags_warnings_and_refusals() {
         assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
         assert!(stderr(&o).contains("no ray queries") && stderr(&o).contains("lavapipe-rt.sh"), "{}", stderr(&o));
     }
+    // `auto`: rays with ray queries, shadow maps without; `render --check` passes either way, and with the maps
+    // its report counts their edges apart (JSON `excused`), where every difference over tolerance lies.
+    let teapot = models.join("teapot.glb");
+    let base = ["render", s(&teapot), "-o", s(&out), "--width", "256", "--height", "192", "--check"];
+    let o = sunshade(&[&base[..], &["-v"]].concat());
+    assert!(o.status.success(), "{}{}", stderr(&o), String::from_utf8_lossy(&o.stdout));
+    let technique = if rq {
+        "shadows: ray (auto: the device has ray queries)"
+    } else {
+        "shadows: map (auto: the device has no ray queries"
+    };
+    assert!(stderr(&o).contains(technique), "{}", stderr(&o));
+    let o = sunshade(&[&base[..], &["--json"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["pass"], true, "{report}");
+    if rq {
+        assert!(report["excused"].is_null(), "{report}");
+    } else {
+        let class = &report["excused"];
+        let (n, over) = (class["compared"].as_u64().unwrap(), class["over_tolerance"].as_u64().unwrap());
+        assert!(n > 0 && n * 10 < report["compared"].as_u64().unwrap(), "{report}");
+        assert!(over > 0, "the maps differ from the rays somewhere, else this tests nothing: {report}");
+        assert_eq!(report["over_tolerance"]["total"], 0, "{report}");
+    }
 }

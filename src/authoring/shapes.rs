@@ -78,9 +78,12 @@ pub fn uv_sphere(center: Vec3, radius: f32, stacks: u32, slices: u32) -> MeshDat
     let mut m = MeshData::default();
     for i in 0..=stacks {
         let theta = std::f64::consts::PI * i as f64 / stacks as f64;
+        // The poles and the seam exactly where their neighbours put them (sin π and sin 2π are 1e-16, not 0), so
+        // that the surface is closed to the last bit (`visibility::can_occlude` welds exact coordinates).
+        let (sin_t, cos_t) = if i == stacks { (0.0, -1.0) } else { theta.sin_cos() };
         for j in 0..=slices {
-            let phi = 2.0 * std::f64::consts::PI * j as f64 / slices as f64;
-            let n = glam::DVec3::new(theta.sin() * phi.sin(), theta.cos(), theta.sin() * phi.cos());
+            let phi = if j == slices { 0.0 } else { 2.0 * std::f64::consts::PI * j as f64 / slices as f64 };
+            let n = glam::DVec3::new(sin_t * phi.sin(), cos_t, sin_t * phi.cos());
             m.normals.push(n.as_vec3().to_array());
             m.positions.push((center + n.as_vec3() * radius).to_array());
         }

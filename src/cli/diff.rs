@@ -133,9 +133,10 @@ pub fn compare_and_report(
     options: &DiffOptions,
     heatmap: Option<&std::path::Path>,
     format: ReportFormat,
+    excused: Option<(&[bool], &str)>,
 ) -> Result<DiffReport, CliError> {
-    let (report, per_pixel): (DiffReport, Vec<PixelDiff>) =
-        compare::diff(a, b, options).map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
+    let (report, per_pixel): (DiffReport, Vec<PixelDiff>) = compare::diff_excusing(a, b, options, excused)
+        .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
     if let Some(path) = heatmap {
         compare::write_heatmap(path, a.width(), a.height(), &per_pixel)
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))?;
@@ -198,8 +199,15 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
     let format = if a.json { ReportFormat::Json(Default::default()) } else { ReportFormat::Text };
-    let report =
-        compare_and_report(&ia, &ib, (&names.0, &names.1), &a.tolerances.options(), a.heatmap.as_deref(), format)?;
+    let report = compare_and_report(
+        &ia,
+        &ib,
+        (&names.0, &names.1),
+        &a.tolerances.options(),
+        a.heatmap.as_deref(),
+        format,
+        None,
+    )?;
     if report.pass {
         Ok(())
     } else {

@@ -153,9 +153,17 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
 /// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
-pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> Image {
+/// For a shadow-map render, also the pixels where the maps may answer otherwise than its rays
+/// (`cpu::render_with_map_edges`), which a check counts apart.
+pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> (Image, Option<Vec<bool>>) {
     let options = reference_options(session, a, job);
-    cpu::render(session.scene_ref(job.scene), &job.settings, &options)
+    let scene = session.scene_ref(job.scene);
+    if job.settings.shading.shadows == Shadows::Map {
+        let (image, edges) = cpu::render_with_map_edges(scene, &job.settings, &options);
+        (image, Some(edges))
+    } else {
+        (cpu::render(scene, &job.settings, &options), None)
+    }
 }
 
 /// The reference options that mirror the device that rendered `job`.
@@ -171,7 +179,7 @@ fn reference_options(session: &mut Session, a: &RenderArgs, job: &Rendered) -> R
 /// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
 pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose: bool) -> Result<(), CliError> {
     let t = Instant::now();
-    let reference = reference_of(session, a, job);
+    let (reference, map_edges) = reference_of(session, a, job);
     if verbose {
         eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     }
@@ -189,6 +197,7 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
         &a.tolerances.options(),
         a.heatmap.as_deref(),
         format,
+        map_edges.as_deref().map(|m| (m, cpu::map_edges::CLASS)),
     )?;
     if report.pass {
         return Ok(());

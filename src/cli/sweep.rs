@@ -92,8 +92,8 @@ pub fn sweep(r: &Relevance, default_mode: Interpolation, modes: &[Interpolation]
         shadows: match (r.shadows, r.ray_queries) {
             (false, _) => Shadows::None,
             (true, true) => Shadows::Ray,
-            // `auto` without ray queries renders unshadowed (docs/accuracy.md, "Shadows").
-            (true, false) => Shadows::None,
+            // `auto` without ray queries: shadow maps (docs/accuracy.md, "Shadows").
+            (true, false) => Shadows::Map,
         },
         ..Default::default()
     };

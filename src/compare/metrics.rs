@@ -145,6 +145,22 @@ pub struct DiffReport {
     pub pass: bool,
     /// Passed with pixels over the warn level.
     pub warn: bool,
+    /// The class of pixels counted apart, if the comparison was given one ([`diff_excusing`]).
+    pub excused: Option<Excused>,
+}
+
+/// Pixels counted apart from the tolerances: a class where the two images are known to differ by the models
+/// compared (a shadow map's edges against exact rays), reported but not failed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Excused {
+    /// What the class is, for the report.
+    pub class: String,
+    /// Pixels of the class covered in both images.
+    pub compared: usize,
+    /// Of them, over tolerance (not counted in [`DiffReport::over_tolerance`]).
+    pub over_tolerance: usize,
+    /// The largest relative error among them.
+    pub max_rel: f64,
 }
 
 /// Per-pixel results, for the heatmap.
@@ -204,6 +220,18 @@ pub fn pixel_difference(a: [f32; 4], b: [f32; 4], floor: f64) -> PixelDifference
 
 /// Compares two images of the same size. `Err` names the size mismatch.
 pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, Vec<PixelDiff>), String> {
+    diff_excusing(a, b, options, None)
+}
+
+/// [`diff`], with the pixels flagged in `excused` (row-major mask, and the class's name) counted apart: their
+/// differences enter the metrics (max, RMSE, worst pixel) but not the tolerance counts, the hard failures or the
+/// warn level; [`DiffReport::excused`] reports them.
+pub fn diff_excusing(
+    a: &Image,
+    b: &Image,
+    options: &DiffOptions,
+    excused: Option<(&[bool], &str)>,
+) -> Result<(DiffReport, Vec<PixelDiff>), String> {
     if (a.width(), a.height()) != (b.width(), b.height()) {
         return Err(format!("sizes differ: {}x{} and {}x{}", a.width(), a.height(), b.width(), b.height()));
     }
@@ -244,6 +272,12 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
         options: *options,
         pass: true,
         warn: false,
+        excused: excused.map(|(_, class)| Excused {
+            class: class.to_string(),
+            compared: 0,
+            over_tolerance: 0,
+            max_rel: 0.0,
+        }),
     };
     let mut per_pixel = Vec::with_capacity((w * h) as usize);
     let mut sum_sq = 0.0;
@@ -281,6 +315,15 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
             ];
             let mut given = checks.iter().flatten().peekable();
             let over = given.peek().is_some() && given.all(|&over| over);
+            if let (Some(class), Some((mask, _))) = (report.excused.as_mut(), excused) {
+                if mask.get((y * w + x) as usize) == Some(&true) {
+                    class.compared += 1;
+                    class.over_tolerance += usize::from(over);
+                    class.max_rel = class.max_rel.max(rel);
+                    per_pixel.push(PixelDiff::Relative(rel));
+                    continue;
+                }
+            }
             if over {
                 report.over_tolerance.add(edge);
                 report.over_tolerance_pixels.push((x, y));
@@ -364,6 +407,12 @@ impl DiffReport {
         if let Some(h) = o.hard_fail {
             s += &format!("over hard fail (rel > {h:e}): {}\n", self.hard_failures);
         }
+        if let Some(e) = &self.excused {
+            s += &format!(
+                "counted apart, not failed: {} pixels at {}; {} of them over tolerance, max rel error {:.3e}\n",
+                e.compared, e.class, e.over_tolerance, e.max_rel
+            );
+        }
         if let Some(wp) = &self.worst {
             s += &format!(
                 "worst pixel: ({}, {}) rel {:.3e} abs {:.3e}\n  A = [{:e}, {:e}, {:e}, {}]\n  B = [{:e}, {:e}, {:e}, {}]\n",
@@ -402,6 +451,7 @@ impl DiffReport {
             },
             "pass": self.pass,
             "warn": self.warn,
+            "excused": self.excused.as_ref().map(|e| json!({ "class": e.class, "compared": e.compared, "over_tolerance": e.over_tolerance, "max_rel": finite(e.max_rel) })),
         })
     }
 }

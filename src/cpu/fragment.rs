@@ -122,3 +122,26 @@ fn shadow_origin(t: &Prepared, w: [f64; 3], position: DVec3, normal: DVec3) -> D
 fn corners(t: &Prepared) -> [DVec3; 3] {
     [0, 1, 2].map(|k| DVec3::new(t.attributes[k][0], t.attributes[k][1], t.attributes[k][2]))
 }
+
+/// Where a pixel's shadow rays leave from: the point [m], its interpolated unit normal (on the side being
+/// shaded, before any normal map), the rays' origin and the unit face normal on the normal's side.
+pub(super) struct RayFrame {
+    pub position: DVec3,
+    pub normal: DVec3,
+    pub origin: DVec3,
+    pub face: DVec3,
+}
+
+/// The [`RayFrame`] of the point with barycentrics `w` of triangle `t`, as [`shade`] computes it.
+pub(super) fn ray_frame(t: &Prepared, w: [f64; 3]) -> RayFrame {
+    let at = |k: usize| w[0] * t.attributes[0][k] + w[1] * t.attributes[1][k] + w[2] * t.attributes[2][k];
+    let position = DVec3::new(at(0), at(1), at(2));
+    let mut normal = safe_normalize(DVec3::new(at(3), at(4), at(5)));
+    if t.flip_normal {
+        normal = -normal;
+    }
+    let p = corners(t);
+    let face = safe_normalize((p[1] - p[0]).cross(p[2] - p[0]));
+    let face = if face.dot(normal) < 0.0 { -face } else { face };
+    RayFrame { position, normal, origin: shadow_origin(t, w, position, normal), face }
+}

@@ -21,6 +21,7 @@ pub mod barycentric;
 pub mod clip;
 mod fragment;
 pub mod interpolate;
+pub mod map_edges;
 mod occluders;
 pub mod raster;
 pub mod transform;
@@ -31,7 +32,7 @@ use rayon::prelude::*;
 
 use self::barycentric::{pixel_ndc, triangle_barycentrics};
 use self::clip::{clip_mask, clip_triangle, ClipVertex, ATTRIBUTES};
-use self::fragment::{covers, shade, surface_sample};
+use self::fragment::{covers, ray_frame, shade, surface_sample};
 use self::interpolate::Interpolator;
 pub use self::occluders::{occluder_bvh, Occluders};
 use self::raster::RasterTriangle;
@@ -226,6 +227,33 @@ pub fn render_with_fragile_pixels(
             }
         }
         (radiance, flagged)
+    })
+}
+
+/// [`render`], and for each pixel whether it is a *map edge* ([`map_edges`]): where a `--shadows map` render's
+/// lookups can reach an occluder's edge, so that the map may answer otherwise than the reference's rays.
+/// Without shadow maps (settings other than `map`, or no occluders) no pixel is flagged. Slower than [`render`]:
+/// up to [`map_edges::REACH_GRID`]² more rays per pixel and mapped light.
+pub fn render_with_map_edges(
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+) -> (Image, Vec<bool>) {
+    let occluders = occluders_for(scene, settings, options);
+    let mapped = shadow_choice(scene, settings, options).technique == Shadows::Map;
+    let reach = map_edges::MapReach::new(scene, settings);
+    let viewer = settings.viewer();
+    render_inner(scene, settings, options, None, &|t: &Prepared, xy: (u32, u32), w: [f64; 3]| {
+        let o = occluders.as_ref();
+        let radiance = shade(scene, settings, t, xy, w, viewer, o.map(|o| o as &dyn Occlusion));
+        let edge = match o {
+            Some(o) if mapped => {
+                let f = ray_frame(t, w);
+                reach.is_edge(o, f.origin, f.face, f.position, f.normal)
+            }
+            _ => false,
+        };
+        (radiance, edge)
     })
 }
 

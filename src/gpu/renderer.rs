@@ -406,16 +406,15 @@ impl Renderer {
             occluder_triangles,
             measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
             draws,
-            // Decided here, once per upload (24 ms for 20k triangles): it also decides whether a device without
-            // ray queries warns that `auto` has no shadows for this scene.
+            // Decided here, once per upload (24 ms for 20k triangles): `auto` renders no shadow pass where it is
+            // false, on any device.
             can_occlude: crate::visibility::can_occlude(scene),
             bounds: scene.bounds(),
         })
     }
 
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
-    /// the device has ray queries; without them it renders every light unoccluded with a warning (the shadow map
-    /// is not yet the default there: `--shadows map` asks for it). `map` shadows the sun and the first
+    /// the device has ray queries and reads shadow maps where it has none. `map` shadows the sun and the first
     /// `MAX_DISK_MAPS` disk lights from their maps and leaves the sky (and further disks) unoccluded, with a
     /// warning where the scene has them. `ray` without ray queries is refused.
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {

@@ -22,9 +22,8 @@ impl ShadowChoice {
 
 /// The technique for `requested` on a scene whose triangles can (`can_occlude`, from
 /// [`super::can_occlude`]) or cannot occlude a light, on a device with or without ray queries.
-/// `Auto` gives rays with ray queries; without them, for now, no shadows, with a warning (shadow maps are asked
-/// for with `map`: docs/accuracy.md, "Shadows", says why `auto` does not choose them). `Ray` without ray queries
-/// is refused by the caller.
+/// `Auto` gives rays with ray queries, and shadow maps (the sun and the first disk lights; the sky unoccluded,
+/// warned) without them. `Ray` without ray queries is refused by the caller.
 pub fn choose(requested: Shadows, lights: &Lights, can_occlude: bool, ray_queries: bool) -> ShadowChoice {
     match requested {
         Shadows::None => ShadowChoice::new(Shadows::None, "--shadows none"),
@@ -34,21 +33,17 @@ pub fn choose(requested: Shadows, lights: &Lights, can_occlude: bool, ray_querie
             "auto: the scene is one closed convex body, which cannot shadow itself (the image is exact unshadowed)",
         ),
         Shadows::Auto if ray_queries => ShadowChoice::new(Shadows::Ray, "auto: the device has ray queries"),
-        Shadows::Auto => ShadowChoice {
-            technique: Shadows::None,
-            reason: "auto: the device has no ray queries; every light is unoccluded (no shadows); --shadows map gives \
-                     the sun's and the disk lights' shadows from shadow maps"
-                .into(),
-            warning: true,
-        },
+        Shadows::Auto => ShadowChoice::new(Shadows::Map, "auto: the device has no ray queries: shadow maps"),
         Shadows::Ray => ShadowChoice::new(Shadows::Ray, "--shadows ray"),
         Shadows::Map => ShadowChoice::new(Shadows::Map, "--shadows map"),
     }
 }
 
-/// The reference's technique: rays for every technique but `none` (it is the truth the GPU's techniques are
-/// measured against), nothing where `auto` finds that nothing can occlude, and, mirroring a device without ray
-/// queries (`device_ray_queries` false), nothing where that device's `auto` casts nothing.
+/// The reference's technique: the GPU's, mirrored on a device with or without ray queries
+/// (`device_ray_queries`), with f64 rays for every technique but `none`: it is the truth the GPU's techniques
+/// are measured against. For `map` the rays shadow the lights the maps stand for (the sun and the first
+/// disks, `ShadowedLights::MAPPED`), so that `render --check` compares the same model; the maps' own error lies
+/// at shadow edges (`cpu::render_with_map_edges`).
 pub fn choose_reference(
     requested: Shadows,
     lights: &Lights,
@@ -56,12 +51,17 @@ pub fn choose_reference(
     device_ray_queries: bool,
 ) -> ShadowChoice {
     let mut choice = choose(requested, lights, can_occlude, device_ray_queries);
-    if choice.technique == Shadows::Map {
-        choice = ShadowChoice::new(Shadows::Ray, "the reference casts rays for --shadows map");
-    } else if requested == Shadows::Auto && choice.technique == Shadows::Ray {
-        choice = ShadowChoice::new(Shadows::Ray, "auto: the scene can shadow itself; the reference casts f64 rays");
-    } else if requested == Shadows::Auto && choice.warning {
-        choice.reason = "auto, mirroring a device without ray queries (and so without shadows)".into();
+    match choice.technique {
+        Shadows::Map => {
+            choice.reason = format!(
+                "{}; the reference casts f64 rays for the lights the maps shadow (the sun, the first disk lights)",
+                choice.reason
+            );
+        }
+        Shadows::Ray if requested == Shadows::Auto => {
+            choice.reason = "auto: the scene can shadow itself; the reference casts f64 rays".into();
+        }
+        _ => {}
     }
     choice
 }
@@ -78,15 +78,15 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(choose(Shadows::Auto, &lit, true, true).technique, Shadows::Ray);
-        let without = choose(Shadows::Auto, &lit, true, false);
-        assert!(without.technique == Shadows::None && without.warning, "{without:?}");
+        assert_eq!(choose(Shadows::Auto, &lit, true, false).technique, Shadows::Map);
+        assert_eq!(choose(Shadows::Auto, &lit, false, false).technique, Shadows::None);
         assert_eq!(choose(Shadows::Auto, &lit, false, true).technique, Shadows::None);
         assert_eq!(choose(Shadows::Ray, &lit, false, true).technique, Shadows::Ray);
         assert_eq!(choose(Shadows::Ray, &Lights::default(), true, true).technique, Shadows::None);
-        assert_eq!(choose_reference(Shadows::Map, &lit, true, true).technique, Shadows::Ray);
-        assert_eq!(choose_reference(Shadows::Map, &lit, true, false).technique, Shadows::Ray);
+        assert_eq!(choose_reference(Shadows::Map, &lit, true, true).technique, Shadows::Map);
+        assert_eq!(choose_reference(Shadows::Map, &lit, true, false).technique, Shadows::Map);
         assert_eq!(choose_reference(Shadows::None, &lit, true, true).technique, Shadows::None);
         assert_eq!(choose_reference(Shadows::Auto, &lit, true, true).technique, Shadows::Ray);
-        assert_eq!(choose_reference(Shadows::Auto, &lit, true, false).technique, Shadows::None);
+        assert_eq!(choose_reference(Shadows::Auto, &lit, true, false).technique, Shadows::Map);
     }
 }
