@@ -52,10 +52,12 @@ docs: build
 # shadows where Mesa 25's lavapipe (ray queries) can be installed (scripts/lavapipe-rt.sh), else without.
 images: build
 	mkdir -p docs/images
-	@if rt="$$(./scripts/lavapipe-rt.sh)"; then eval "$$rt"; else echo "make images: no ray queries: no shadows"; fi; \
+	@if rt="$$(./scripts/lavapipe-rt.sh)"; then eval "$$rt"; else echo "make images: no ray queries: shadow maps"; fi; \
 	for m in teapot.glb room.gltf overcast.glb sunset.glb; do \
 		$(SUNSHADE) render models/$$m -o docs/images/$${m%.*}.png --width 640 --height 480 || exit 1; \
 	done; \
+	$(SUNSHADE) render models/room.gltf -o /tmp/sunshade-room-irradiance.exr --width 320 --height 240 \
+		--quantity irradiance --false-color docs/images/room-irradiance.png -q && \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-sun.png --width 640 --height 300 \
 		--sun-elevation 35 --sun-azimuth 20 && \
 	$(SUNSHADE) render models/brdfs.glb -o docs/images/brdfs-disk.png --width 640 --height 300 \

@@ -21,6 +21,9 @@
 #define SHADOWS_NONE 0u
 #define SHADOWS_RAY 1u
 #define SHADOWS_MAP 2u
+// What the fragment shader writes (VARIANT_QUANTITY); values match gpu::layout.
+#define QUANTITY_RADIANCE 0u
+#define QUANTITY_IRRADIANCE 1u
 
 // The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
 // material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
@@ -32,6 +35,7 @@ layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EX
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
 layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 layout(constant_id = 5) const uint VARIANT_SURFACE = 0u; // SURFACE_* bits: what the material needs per pixel
+layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE or QUANTITY_IRRADIANCE
 
 // What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
 #define SURFACE_EVAL 1u

@@ -520,6 +520,63 @@ fn outputs_record_camera_lights_and_settings() {
     let reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap())).read_info().unwrap();
     let chunk = reader.info().uncompressed_latin1_text.iter().find(|t| t.keyword == "sunshadeSettings").unwrap();
     assert!(chunk.text.contains("\"renderer\":\"cpu reference\""), "{}", chunk.text);
+    // `--quantity irradiance`: the unit W/m2, the layer and the settings say so, on the GPU and the reference.
+    for command in ["render", "reference"] {
+        let o = sunshade(&[
+            command,
+            s(&input),
+            "-o",
+            s(&exr),
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--quantity",
+            "irradiance",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let meta = exr::meta::MetaData::read_from_file(&exr, false).unwrap();
+        let layer = &meta.headers[0].own_attributes;
+        assert_eq!(layer.layer_name.as_ref().map(|n| n.to_string()), Some("irradiance".to_string()));
+        let all: serde_json::Value = match layer.other.get(&exr::prelude::Text::from("sunshade")) {
+            Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+            other => panic!("sunshade attribute: {other:?}"),
+        };
+        assert!(all["quantity"].as_str().unwrap().starts_with("irradiance W/m2"), "{all}");
+        assert_eq!(all["sunshadeSettings"]["quantity"], "irradiance", "{all}");
+        assert!(sunshade::film::read_image(&exr).is_ok(), "an irradiance EXR reads back");
+    }
+    // --false-color: a PNG of the picture and its legend below; only a .png, refused before any work.
+    let fc = dir.path("e.png");
+    let o = sunshade(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&exr),
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--quantity",
+        "irradiance",
+        "--false-color",
+        s(&fc),
+        "--false-color-max",
+        "500",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let picture = image::open(&fc).unwrap().to_rgb8();
+    assert_eq!(picture.dimensions(), (320, 48 + sunshade::plot::false_color::LEGEND_HEIGHT));
+    let bad = dir.path("e.jpg");
+    let o = sunshade(&["render", s(&input), "-o", s(&exr), "--false-color", s(&bad)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--false-color") && !bad.exists(), "{}", stderr(&o));
+    // --tolerance bounds radiance: refused with irradiance, in one line, nothing written.
+    std::fs::remove_file(&exr).unwrap();
+    let o = sunshade(&["render", s(&input), "-o", s(&exr), "--quantity", "irradiance", "--tolerance", "1e-3"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--tolerance") && stderr(&o).lines().count() == 1, "{}", stderr(&o));
+    assert!(!exr.exists());
 }
 
 #[test]

@@ -259,11 +259,17 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
-    /// Shadows: `auto` (shadow rays where the device has ray queries, else none, with a warning; none where
-    /// nothing can occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk
-    /// lights, any device; the sky unoccluded). The reference casts rays for every technique but `none`.
+    /// Shadows: `auto` (shadow rays where the device has ray queries, else shadow maps; none where nothing can
+    /// occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk lights, any
+    /// device; the sky unoccluded, with a warning). The reference casts rays for every technique but `none`.
     #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
     pub shadows: Shadows,
+
+    /// What the pixels hold: `radiance` towards the camera [W/(m²·sr)], or `irradiance` [W/m²], the light
+    /// arriving at the surface point each pixel sees, per RGB channel, from every light's visible part (the
+    /// lecture's E(x, y); the material does not enter). Images record the quantity and its unit.
+    #[arg(long, default_value = "radiance", value_name = "radiance|irradiance")]
+    pub quantity: crate::shading::Quantity,
 
     /// Shadow rays per light and pixel for each light's visible fraction (a stratified grid over the light;
     /// rounded up to a square; 1: the light's centre alone, a hard shadow).
@@ -288,6 +294,13 @@ pub fn per_axis(samples: u32) -> u32 {
 impl SceneArgs {
     /// Refuses flags that mean nothing together.
     pub fn check(&self) -> Result<(), super::CliError> {
+        if self.tolerance.is_some() && self.quantity == crate::shading::Quantity::Irradiance {
+            return Err(super::CliError::Usage(
+                "--tolerance chooses models for radiance; with --quantity irradiance choose the sun model and \
+                 samples yourself (the irradiance's own formulas are exact; docs/accuracy.md)"
+                    .into(),
+            ));
+        }
         if self.sun_samples.is_some() && self.sun_model == SunModel::Delta {
             return Err(super::CliError::Usage("--sun-samples applies to --sun-model disk only".into()));
         }
@@ -322,6 +335,7 @@ impl SceneArgs {
                 shadow_samples_per_axis: per_axis(self.shadow_samples),
                 shadow_map_size: self.shadow_map_size,
                 shadow_map_filter: self.shadow_map_filter,
+                quantity: self.quantity,
             },
         }
     }
@@ -350,6 +364,16 @@ pub struct OutputArgs {
     /// covered pixels displays at 80% of white).
     #[arg(long, allow_hyphen_values = true, value_name = "EV|auto", help_heading = "Output")]
     pub exposure: Option<Exposure>,
+
+    /// Also write a false-colour PNG of the values (the Rec. 709 weighting of the channels, in the quantity's
+    /// unit) on the viridis scale, with a legend; the scale runs from 0 to the 99th percentile rounded up to
+    /// 1, 2 or 5 × 10ⁿ, or to --false-color-max.
+    #[arg(long, value_name = "PNG", help_heading = "Output")]
+    pub false_color: Option<PathBuf>,
+
+    /// The top of the false-colour scale, in the quantity's unit (values above it show in the top colour).
+    #[arg(long, value_name = "VALUE", value_parser = parse_positive, requires = "false_color", help_heading = "Output")]
+    pub false_color_max: Option<f64>,
 }
 
 impl OutputArgs {
@@ -357,6 +381,15 @@ impl OutputArgs {
     /// for a format that has none.
     pub fn check(&self) -> Result<(), super::CliError> {
         super::check_output_path(&self.output)?;
+        if let Some(f) = &self.false_color {
+            if ImageFormat::from_path(f) != Some(ImageFormat::Png) {
+                return Err(super::CliError::Usage(format!(
+                    "--false-color {}: a false-colour picture is a .png",
+                    f.display()
+                )));
+            }
+            super::check_output_path(f)?;
+        }
         if self.exposure.is_some() && ImageFormat::from_path(&self.output) != Some(ImageFormat::Png) {
             return Err(super::CliError::Usage(format!(
                 "--exposure applies to PNG output only ({} stores radiance unscaled)",
@@ -368,6 +401,20 @@ impl OutputArgs {
 
     pub fn exposure(&self) -> Exposure {
         self.exposure.unwrap_or(Exposure::Auto)
+    }
+
+    /// Writes the false-colour picture of `image` (values in `quantity`'s unit) where `--false-color` asks for one.
+    pub fn write_false_color(
+        &self,
+        image: &crate::film::Image,
+        quantity: crate::shading::Quantity,
+    ) -> Result<(), super::CliError> {
+        let Some(path) = &self.false_color else { return Ok(()) };
+        let max = self.false_color_max.unwrap_or_else(|| crate::plot::false_color::default_max(image));
+        let unit = format!("{} [{}]", quantity.name(), quantity.unit_ascii());
+        crate::plot::false_color::false_color(image, max, &unit)
+            .write_png(path)
+            .map_err(|e| super::CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))
     }
 }
 

@@ -109,7 +109,16 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
     let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
     let value: Value = serde_json::from_str(&text).map_err(|e| fail(format!("invalid JSON: {e}")))?;
     let jobs = value.as_array().ok_or_else(|| fail("the manifest must be a JSON array of jobs".into()))?;
-    Ok(jobs.iter().map(|job| RenderArgs::parse_list(&job_arguments(job)?)).collect())
+    Ok(jobs
+        .iter()
+        .map(|job| {
+            let args = RenderArgs::parse_list(&job_arguments(job)?)?;
+            if args.output.false_color.is_some() {
+                return Err("false-color: not written by batch jobs (render each with sunshade render)".to_string());
+            }
+            Ok(args)
+        })
+        .collect())
 }
 
 /// An image to write, and which job it is.

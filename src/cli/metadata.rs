@@ -50,6 +50,7 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
         "shadow_map_size": sh.shadow_map_size,
         "shadow_map_filter": match sh.shadow_map_filter { ShadowMapFilter::Pcss => "pcss", ShadowMapFilter::Nearest => "nearest" },
+        "quantity": sh.quantity.name(),
         "camera": { "eye": cam.eye.to_array(), "forward": cam.forward.to_array(), "up": cam.up.to_array(),
                     "orthographic": cam.is_orthographic() },
         "worldToNDC": "Vulkan clip space before the divide by w: x right, y down, depth in [0, 1]",
@@ -58,6 +59,11 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         text: vec![
             ("sunshadeLights".into(), lights.to_string()),
             ("sunshadeSettings".into(), quality.to_string()),
+            // What the pixel values are, in which unit (the image writer's default, radiance, replaced).
+            (
+                "quantity".into(),
+                format!("{} {} per linear RGB channel; A = coverage", sh.quantity.name(), sh.quantity.unit_ascii()),
+            ),
             ("sunshadeVersion".into(), env!("CARGO_PKG_VERSION").into()),
         ],
         matrices: vec![

@@ -101,6 +101,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     meta.text.extend(convergence);
     meta.text.extend(super::metadata::measured_materials(&scene));
     let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
+    a.output.write_false_color(&image, settings.shading.quantity)?;
     if a.verbose {
         eprintln!(
             "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",

@@ -250,6 +250,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     );
     meta.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
     let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
+    a.output.write_false_color(&job.image, job.settings.shading.quantity)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();

@@ -539,6 +539,32 @@ mod tests {
     }
 
     #[test]
+    fn an_excused_class_is_reported_apart_and_only_it() {
+        // Row 1 is 1% off (the class), pixel (0, 0) 50% off outside it.
+        let a = img(10, 10, |_, _| [1.0, 1.0, 1.0, 1.0]);
+        let b = img(10, 10, |x, y| match (x, y) {
+            (0, 0) => [1.5, 1.0, 1.0, 1.0],
+            (_, 1) => [1.01, 1.0, 1.0, 1.0],
+            _ => [1.0, 1.0, 1.0, 1.0],
+        });
+        let o = DiffOptions { fail_rel: Some(1e-3), fail_peak: None, hard_fail: Some(5e-3), ..Default::default() };
+        let row: Vec<bool> = (0..100).map(|k| k / 10 == 1).collect();
+        let (r, _) = diff_excusing(&a, &b, &o, Some((&row, "row 1"))).unwrap();
+        let e = r.excused.as_ref().unwrap();
+        assert_eq!((e.compared, e.over_tolerance), (10, 10), "{r:?}");
+        assert!((e.max_rel - 0.01 / 1.01).abs() < 1e-6, "{r:?}");
+        // The 50% pixel still fails; the class's pixels are in the metrics but not in the counts.
+        assert!(!r.pass && r.over_tolerance.total == 1 && r.hard_failures == 1, "{r:?}");
+        assert!(r.max_rel > 0.3 && r.text("a", "b").contains("10 pixels at row 1; 10 of them over tolerance"));
+        // With the 50% pixel in the class too, the comparison passes.
+        let both: Vec<bool> = (0..100).map(|k| k == 0 || k / 10 == 1).collect();
+        let (r, _) = diff_excusing(&a, &b, &o, Some((&both, "both"))).unwrap();
+        assert!(r.pass && r.json("a", "b")["excused"]["over_tolerance"] == 11, "{r:?}");
+        // Without a class the report has none.
+        assert!(diff(&a, &b, &o).unwrap().0.excused.is_none());
+    }
+
+    #[test]
     fn default_tolerance_allows_f32_rounding_of_the_peak_and_no_more() {
         // A pixel at 2% of the peak, 5u of the peak off: 1.5e-5 relative, within 8u of the peak.
         let u = 1.0 / (1u64 << 24) as f64;

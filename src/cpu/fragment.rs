@@ -17,7 +17,8 @@ use crate::shading::surface::{
 };
 use crate::shading::visibility::shadow_ray_origin;
 use crate::shading::{
-    radiance_out, radiance_out_visible, safe_normalize, Occlusion, ShadowedLights, Shadowing, SurfacePoint,
+    irradiance_visible, radiance_out, radiance_out_visible, safe_normalize, Occlusion, Quantity, ShadowedLights,
+    Shadowing, SurfacePoint,
 };
 
 /// The pixel's surface inputs ([`SurfaceSample`]): each set's texture coordinates at the pixel centre and at
@@ -95,7 +96,11 @@ pub(super) fn shade(
     }
     let emits = t.surface & SURFACE_EMISSION != 0;
     let add_emission = |r: [f64; 3]| if emits { [0, 1, 2].map(|c| r[c] + emission[c]) } else { r };
+    let irradiance = settings.shading.quantity == Quantity::Irradiance;
     let Some(occluders) = occluders else {
+        if irradiance {
+            return irradiance_visible(&point, &settings.lights, &settings.shading, None);
+        }
         return add_emission(radiance_out(&brdf, &point, &settings.lights, &settings.shading));
     };
     let shadow = Shadowing {
@@ -104,6 +109,9 @@ pub(super) fn shade(
         samples_per_axis: settings.shading.shadow_samples_per_axis,
         lights: ShadowedLights::of(settings.shading.shadows),
     };
+    if irradiance {
+        return irradiance_visible(&point, &settings.lights, &settings.shading, Some(&shadow));
+    }
     add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &settings.shading, Some(&shadow)))
 }
 

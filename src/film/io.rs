@@ -116,7 +116,11 @@ fn write_exr<W: Write + io::Seek>(image: &Image, w: &mut W, metadata: &Metadata)
         let p = pixels[y * width + x];
         (p[0], p[1], p[2], p[3])
     });
-    let mut attributes = LayerAttributes::named("radiance");
+    // The layer is named after the quantity the metadata gives (`quantity`: "irradiance W/m2 ..."), radiance by
+    // default.
+    let quantity = metadata.text.iter().find(|(k, _)| k == "quantity").map(|(_, v)| v.as_str());
+    let name = quantity.and_then(|q| q.split(' ').next()).unwrap_or("radiance");
+    let mut attributes = LayerAttributes::named(name);
     attributes.software_name = Some(Text::from(format!("sunshade {}", env!("CARGO_PKG_VERSION")).as_str()));
     // One custom attribute, `sunshade`: a JSON object of the quantity and every metadata text (JSON texts nested
     // as JSON). The exr crate keeps custom attributes in a HashMap, whose order changes from process to process;

@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::scene::texture::{Filter, MipFilter, Wrap};
 use crate::scene::{AlphaMode, Brdf, Lights, Material, Scene, TextureRef};
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, ShadingOptions, ShadowMapFilter, SunModel};
+use crate::shading::{DiskModel, Quantity, ShadingOptions, ShadowMapFilter, SunModel};
 use crate::visibility::shadow_map::{DiskMapFrame, SunMapFrame};
 
 pub const BRDF_LAMBERT: u32 = 0;
@@ -22,6 +22,9 @@ pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
+/// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
+pub const QUANTITY_RADIANCE: u32 = 0;
+pub const QUANTITY_IRRADIANCE: u32 = 1;
 /// Disk lights with a shadow map of their own (`MAX_DISK_MAPS` in the shaders).
 pub const MAX_DISK_MAPS: usize = crate::shading::MAPPED_DISKS;
 pub const WRAP_REPEAT: u32 = 0;
@@ -52,6 +55,8 @@ pub struct ShaderVariant {
     pub shadows: u32,
     /// `shading::surface::SURFACE_*` bits of the draw's material (0: untextured, opaque, not emissive).
     pub surface: u32,
+    /// `QUANTITY_RADIANCE` or `QUANTITY_IRRADIANCE`.
+    pub quantity: u32,
 }
 
 impl ShaderVariant {
@@ -68,12 +73,16 @@ impl ShaderVariant {
             (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
         };
         let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
-        Self { brdf, sun, disks, sky, shadows, surface }
+        let quantity = match shading.quantity {
+            Quantity::Radiance => QUANTITY_RADIANCE,
+            Quantity::Irradiance => QUANTITY_IRRADIANCE,
+        };
+        Self { brdf, sun, disks, sky, shadows, surface, quantity }
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 6] {
-        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface]
+    pub fn constants(&self) -> [u32; 7] {
+        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface, self.quantity]
     }
 }
 
@@ -398,6 +407,8 @@ mod tests {
             ("SHADOWS_NONE", SHADOWS_NONE),
             ("SHADOWS_RAY", SHADOWS_RAY),
             ("SHADOWS_MAP", SHADOWS_MAP),
+            ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
+            ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
             ("WRAP_REPEAT", WRAP_REPEAT),
             ("WRAP_MIRRORED_REPEAT", WRAP_MIRRORED_REPEAT),
             ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),

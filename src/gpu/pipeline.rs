@@ -205,7 +205,7 @@ impl ScenePipeline {
             return Ok(p);
         }
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
-        let variant = ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface };
+        let variant = ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface, quantity: 0 };
         // SAFETY: valid device, layout, modules and cache owned by self.
         let p = unsafe {
             create_pipeline(
@@ -271,7 +271,7 @@ unsafe fn create_pipeline(
     unsafe {
         // `depth_only`: a shadow map's pipeline, no colour attachment; its fragment stage (a null `fs`: none)
         // only discards.
-        let constants = variant.map_or([0; 6], |v| v.constants());
+        let constants = variant.map_or([0; 7], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();

@@ -3,6 +3,7 @@
 //! fonts or system libraries are needed, so a plot is the same on every machine.
 
 mod canvas;
+pub mod false_color;
 mod log_log;
 
 pub use canvas::{Canvas, Rgb};

@@ -9,12 +9,14 @@ pub mod brdf;
 pub mod brdf_fit;
 pub mod measured;
 pub mod quadrature;
+pub mod quantity;
 pub mod radiometry;
 mod shade;
 pub mod surface;
 pub mod texture_filter;
 pub mod visibility;
 
+pub use quantity::Quantity;
 pub use shade::{
     disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, lobe_about_z, lobe_width,
     normalized_lobe_integral, orthonormal_to, radiance_out, radiance_out_visible, safe_normalize, sky_lobe_integral,

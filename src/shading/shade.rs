@@ -75,6 +75,8 @@ pub struct ShadingOptions {
     pub shadow_map_size: u32,
     /// Its filter.
     pub shadow_map_filter: ShadowMapFilter,
+    /// What the pixels hold: radiance, or the irradiance at the surface.
+    pub quantity: super::Quantity,
 }
 
 impl Default for ShadingOptions {
@@ -88,6 +90,7 @@ impl Default for ShadingOptions {
             shadow_samples_per_axis: DEFAULT_SHADOW_SAMPLES_PER_AXIS,
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
             shadow_map_filter: ShadowMapFilter::Pcss,
+            quantity: super::Quantity::Radiance,
         }
     }
 }
