@@ -571,6 +571,26 @@ fn outputs_record_camera_lights_and_settings() {
     let o = sunshade(&["render", s(&input), "-o", s(&exr), "--false-color", s(&bad)]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--false-color") && !bad.exists(), "{}", stderr(&o));
+    // sum: two irradiance images add pixel by pixel (x + x = 2x exactly in f32), coverage kept; float images of
+    // one size only, refused in one line naming the file.
+    let (one, total) = (dir.path("one.exr"), dir.path("total.exr"));
+    std::fs::copy(&exr, &one).unwrap();
+    let o = sunshade(&["sum", s(&exr), s(&one), "-o", s(&total)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (x, t) = (sunshade::film::read_image(&exr).unwrap(), sunshade::film::read_image(&total).unwrap());
+    assert!(x.pixels().iter().any(|p| p[3] > 0.0 && p[0] > 0.0));
+    for (p, q) in x.pixels().iter().zip(t.pixels()) {
+        assert_eq!([2.0 * p[0], 2.0 * p[1], 2.0 * p[2], p[3]], *q);
+    }
+    let small = dir.path("small.exr");
+    let o = sunshade(&["render", s(&input), "-o", s(&small), "--width", "16", "--height", "16", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&total).unwrap();
+    let o = sunshade(&["sum", s(&exr), s(&small), "-o", s(&total)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("small.exr") && stderr(&o).lines().count() == 1 && !total.exists(), "{}", stderr(&o));
+    let o = sunshade(&["sum", s(&exr), s(&fc), "-o", s(&total)]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     // --tolerance bounds radiance: refused with irradiance, in one line, nothing written.
     std::fs::remove_file(&exr).unwrap();
     let o = sunshade(&["render", s(&input), "-o", s(&exr), "--quantity", "irradiance", "--tolerance", "1e-3"]);

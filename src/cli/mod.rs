@@ -20,6 +20,7 @@ mod reference;
 pub(crate) mod render;
 mod session;
 mod suite;
+mod sum;
 mod sweep;
 mod tabulate_brdf;
 
@@ -53,6 +54,8 @@ enum Command {
     /// Compare two images (.exr, .pfm, .png): coverage, errors, worst pixel; exit 1 when outside tolerance.
     #[command(allow_negative_numbers = true)]
     Diff(Box<diff::DiffCommand>),
+    /// Add float images pixel by pixel (f64 sums): e.g. the shards of an accumulation rendered apart.
+    Sum(sum::SumCommand),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
     /// Render many jobs of a JSON manifest in one process, on one device: scenes loaded and uploaded once while
@@ -181,6 +184,7 @@ pub fn main() -> ExitCode {
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", dir.display()))),
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
+        Command::Sum(a) => sum::run(&a),
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Albedo(a) => albedo::run(&a),
