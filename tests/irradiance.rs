@@ -6,37 +6,17 @@
 mod common;
 
 use common::CheckedRenderer;
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3};
 use sunshade::authoring::shapes::{quad, MeshData};
 use sunshade::cpu;
-use sunshade::scene::{Brdf, Camera, DiskLight, Lights, Material, Mesh, Projection, Scene, Sun};
+use sunshade::scene::{Brdf, Camera, DiskLight, Lights, Material, Projection, Scene, Sun};
 use sunshade::settings::RenderSettings;
 use sunshade::shading::{Quantity, ShadingOptions, Shadows};
 use sunshade::Image;
 
 fn scene(parts: &[MeshData], albedo: f32) -> Scene {
-    let meshes = parts
-        .iter()
-        .enumerate()
-        .map(|(i, m)| Mesh {
-            name: format!("part {i}"),
-            positions: m.positions.iter().map(|p| Vec3::from_array(*p)).collect(),
-            normals: m.normals.iter().map(|n| Vec3::from_array(*n)).collect(),
-            tangents: m
-                .normals
-                .iter()
-                .map(|n| {
-                    sunshade::scene::tangent::default_tangent(Vec3::from_array(*n).as_dvec3()).as_vec3().extend(1.0)
-                })
-                .collect::<Vec<Vec4>>(),
-            indices: m.indices.clone(),
-            material: 0,
-            ..Default::default()
-        })
-        .collect();
     // The albedo must not matter: irradiance is what arrives, whatever the surface reflects.
-    let material = Material::with_brdf("grey", Brdf::Lambert { albedo: [albedo; 3] });
-    Scene { meshes, materials: vec![material], ..Default::default() }
+    common::scene_of(parts, Material::with_brdf("grey", Brdf::Lambert { albedo: [albedo; 3] }))
 }
 
 fn irradiance_settings(w: u32, h: u32, camera: Camera, lights: Lights) -> RenderSettings {

@@ -9,11 +9,11 @@ mod common;
 use std::f64::consts::PI;
 
 use common::CheckedRenderer;
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3};
 use sunshade::authoring::shapes::{cube, icosphere, quad, MeshData};
 use sunshade::compare::{self, DiffOptions};
 use sunshade::cpu::{self, ReferenceOptions};
-use sunshade::scene::{Brdf, Camera, Lights, Material, Mesh, MetallicRoughness, Projection, Scene, Sun};
+use sunshade::scene::{Brdf, Camera, Lights, Material, MetallicRoughness, Projection, Scene, Sun};
 use sunshade::settings::RenderSettings;
 use sunshade::shading::quadrature::integrate_composite;
 use sunshade::shading::visibility::shadow_ray_origin;
@@ -42,26 +42,7 @@ fn placed(mesh: &MeshData, scale: f32, offset: Vec3) -> MeshData {
 }
 
 fn scene(parts: &[MeshData]) -> Scene {
-    let meshes = parts
-        .iter()
-        .enumerate()
-        .map(|(i, m)| Mesh {
-            name: format!("part {i}"),
-            positions: m.positions.iter().map(|p| Vec3::from_array(*p)).collect(),
-            normals: m.normals.iter().map(|n| Vec3::from_array(*n)).collect(),
-            tangents: m
-                .normals
-                .iter()
-                .map(|n| {
-                    sunshade::scene::tangent::default_tangent(Vec3::from_array(*n).as_dvec3()).as_vec3().extend(1.0)
-                })
-                .collect::<Vec<Vec4>>(),
-            indices: m.indices.clone(),
-            material: 0,
-            ..Default::default()
-        })
-        .collect();
-    Scene { meshes, materials: vec![material(false)], ..Default::default() }
+    common::scene_of(parts, material(false))
 }
 
 fn sun_lights(direction: DVec3, diameter_degrees: f64) -> Lights {

@@ -87,3 +87,28 @@ pub fn ray_query_renderer() -> Option<CheckedRenderer> {
     eprintln!("skipped: {name} has no ray queries (make test runs this on scripts/lavapipe-rt.sh's lavapipe)");
     None
 }
+
+/// A scene of these shapes, each a mesh of its own with default tangents, all of `material`.
+pub fn scene_of(parts: &[sunshade::authoring::shapes::MeshData], material: sunshade::scene::Material) -> Scene {
+    use glam::{Vec3, Vec4};
+    let meshes = parts
+        .iter()
+        .enumerate()
+        .map(|(i, m)| sunshade::scene::Mesh {
+            name: format!("part {i}"),
+            positions: m.positions.iter().map(|p| Vec3::from_array(*p)).collect(),
+            normals: m.normals.iter().map(|n| Vec3::from_array(*n)).collect(),
+            tangents: m
+                .normals
+                .iter()
+                .map(|n| {
+                    sunshade::scene::tangent::default_tangent(Vec3::from_array(*n).as_dvec3()).as_vec3().extend(1.0)
+                })
+                .collect::<Vec<Vec4>>(),
+            indices: m.indices.clone(),
+            material: 0,
+            ..Default::default()
+        })
+        .collect();
+    Scene { meshes, materials: vec![material], ..Default::default() }
+}
