@@ -261,7 +261,8 @@ pub struct SceneArgs {
 
     /// Shadows: `auto` (shadow rays where the device has ray queries, else shadow maps; none where nothing can
     /// occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk lights, any
-    /// device; the sky unoccluded, with a warning). The reference casts rays for every technique but `none`.
+    /// device; the sky unoccluded, with a warning). The reference casts rays for every technique but `none`
+    /// (for `map`, for the lights the maps shadow).
     #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
     pub shadows: Shadows,
 
