@@ -615,6 +615,22 @@ fn shadow_map_differences_lie_at_map_edges_and_the_rest_is_checked() {
     assert!(differing > 0, "the maps differ from the rays nowhere: the test tests nothing");
 }
 
+#[test]
+fn the_testing_api_checks_auto_against_the_model_the_device_used() {
+    // `auto` is shadow maps on a device without ray queries: the reference resolves it the same way, and its
+    // rays then leave the sky unoccluded as the maps do, so the overcast scene (a sky its geometry occludes)
+    // passes `testing::check_against_reference` unchanged; with ray queries both cast rays everywhere.
+    let mut gpu = CheckedRenderer::new();
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    for name in ["overcast.glb", "room.gltf"] {
+        let job = sunshade::testing::job(dir.join(name), &["--width", "64", "--height", "48"]).unwrap();
+        let image = gpu.render_job(&job).unwrap();
+        let options = gpu.reference_options();
+        sunshade::testing::check_against_reference(&job, &image, &options, &DiffOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
 /// A floor (z = 0, 4 m square) and, 1 m above its left part, an alpha-masked square whose 2 × 2 texture
 /// (NEAREST) is opaque in two opposite quarters and cut away in the others; a delta sun from (−1, 0, 1), so the
 /// mask's shadow falls 1 m to the right of it, on the floor the orthographic camera looks down at.

@@ -42,7 +42,8 @@ pub(super) fn covers(scene: &Scene, settings: &RenderSettings, t: &Prepared, x: 
     alpha_covers(material, base_color(material, &scene.textures, &s)[3])
 }
 
-/// Radiance at the point of triangle `t` with barycentrics `w`.
+/// Radiance (or irradiance, as the settings' quantity says) at the point of triangle `t` with barycentrics `w`;
+/// `shadow_rays`: the occluders and the lights they shadow (`None`: every light unoccluded).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn shade(
     scene: &Scene,
@@ -51,7 +52,7 @@ pub(super) fn shade(
     (x, y): (u32, u32),
     w: [f64; 3],
     viewer: glam::Vec4,
-    occluders: Option<&dyn Occlusion>,
+    shadow_rays: Option<(&dyn Occlusion, ShadowedLights)>,
 ) -> [f64; 3] {
     let mut a = [0.0f64; ATTRIBUTES];
     for (k, slot) in a.iter_mut().enumerate() {
@@ -97,7 +98,7 @@ pub(super) fn shade(
     let emits = t.surface & SURFACE_EMISSION != 0;
     let add_emission = |r: [f64; 3]| if emits { [0, 1, 2].map(|c| r[c] + emission[c]) } else { r };
     let irradiance = settings.shading.quantity == Quantity::Irradiance;
-    let Some(occluders) = occluders else {
+    let Some((occluders, lights)) = shadow_rays else {
         if irradiance {
             return irradiance_visible(&point, &settings.lights, &settings.shading, None);
         }
@@ -107,7 +108,7 @@ pub(super) fn shade(
         origin: shadow_origin(t, w, position, normal),
         occluders,
         samples_per_axis: settings.shading.shadow_samples_per_axis,
-        lights: ShadowedLights::of(settings.shading.shadows),
+        lights,
     };
     if irradiance {
         return irradiance_visible(&point, &settings.lights, &settings.shading, Some(&shadow));

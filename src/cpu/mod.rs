@@ -42,7 +42,7 @@ use crate::film::Image;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{discontinuity_margin as surface_discontinuity, surface_flags, SURFACE_ALPHA_MASK};
-use crate::shading::{Occlusion, Shadows};
+use crate::shading::{Occlusion, ShadowedLights, Shadows};
 use crate::visibility::ShadowChoice;
 
 /// How the reference mirrors the device.
@@ -143,11 +143,23 @@ pub fn shadow_choice_where(
     crate::visibility::choose_reference(requested, &settings.lights, can_occlude, options.device_ray_queries)
 }
 
-/// The occluders the render's shadow rays test ([`shadow_choice`]), or `None` where every light is unoccluded.
-fn occluders_for<'a>(scene: &'a Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Option<Occluders<'a>> {
+/// The reference's shadow rays for a render: the occluders they test and the lights they shadow, both from
+/// [`shadow_choice`]'s technique (every light for rays; for maps, the lights with a map, as the GPU shadows them,
+/// also where `auto` resolved to maps).
+struct ShadowRays<'a> {
+    occluders: Occluders<'a>,
+    lights: ShadowedLights,
+}
+
+/// The render's [`ShadowRays`], or `None` where every light is unoccluded.
+fn occluders_for<'a>(
+    scene: &'a Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+) -> Option<ShadowRays<'a>> {
     match shadow_choice(scene, settings, options).technique {
         Shadows::None => None,
-        _ => Some(Occluders::new(scene)),
+        technique => Some(ShadowRays { occluders: Occluders::new(scene), lights: ShadowedLights::of(technique) }),
     }
 }
 
@@ -163,10 +175,12 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
 fn plain_shader<'a>(
     scene: &'a Scene,
     settings: &'a RenderSettings,
-    occluders: Option<&'a Occluders<'_>>,
+    rays: Option<&'a ShadowRays<'_>>,
 ) -> impl Fn(&Prepared, (u32, u32), [f64; 3]) -> ([f64; 3], bool) + Sync + 'a {
     let viewer = settings.viewer();
-    move |t, xy, w| (shade(scene, settings, t, xy, w, viewer, occluders.map(|o| o as &dyn Occlusion)), false)
+    move |t, xy, w| {
+        (shade(scene, settings, t, xy, w, viewer, rays.map(|r| (&r.occluders as &dyn Occlusion, r.lights))), false)
+    }
 }
 
 /// [`render`] for the pixels flagged in `selected` only (row-major, one flag a pixel); every other pixel is left
@@ -211,9 +225,10 @@ pub fn render_with_fragile_pixels(
     render_inner(scene, settings, options, None, &|t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
         let mut flagged = false;
         let radiance = match &occluders {
-            Some(bvh) => {
-                let rec = Recording { occluders: bvh, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
-                let r = shade(scene, settings, t, (x, y), w, viewer, Some(&rec));
+            Some(rays) => {
+                let rec =
+                    Recording { occluders: &rays.occluders, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
+                let r = shade(scene, settings, t, (x, y), w, viewer, Some((&rec, rays.lights)));
                 flagged = rec.fragile.load(std::sync::atomic::Ordering::Relaxed);
                 r
             }
@@ -239,17 +254,17 @@ pub fn render_with_map_edges(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let occluders = occluders_for(scene, settings, options);
-    let mapped = shadow_choice(scene, settings, options).technique == Shadows::Map;
+    let rays = occluders_for(scene, settings, options);
     let reach = map_edges::MapReach::new(scene, settings);
     let viewer = settings.viewer();
     render_inner(scene, settings, options, None, &|t: &Prepared, xy: (u32, u32), w: [f64; 3]| {
-        let o = occluders.as_ref();
-        let radiance = shade(scene, settings, t, xy, w, viewer, o.map(|o| o as &dyn Occlusion));
-        let edge = match o {
-            Some(o) if mapped => {
+        let cast = rays.as_ref().map(|r| (&r.occluders as &dyn Occlusion, r.lights));
+        let radiance = shade(scene, settings, t, xy, w, viewer, cast);
+        let edge = match &rays {
+            // Mapped lights: the render's technique is `map` (asked, or `auto` without ray queries).
+            Some(r) if r.lights == ShadowedLights::MAPPED => {
                 let f = ray_frame(t, w);
-                reach.is_edge(o, f.origin, f.face, f.position, f.normal)
+                reach.is_edge(&r.occluders, f.origin, f.face, f.position, f.normal)
             }
             _ => false,
         };

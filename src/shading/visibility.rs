@@ -153,8 +153,8 @@ impl ShadowedLights {
     /// The lights a shadow-map render shadows.
     pub const MAPPED: Self = Self { sun: true, disks: MAPPED_DISKS, sky: false };
 
-    /// The lights technique `shadows` shadows (`None` and `Auto` have no rays to cast: every light, for a caller
-    /// that casts them anyway).
+    /// The lights a render with technique `shadows` shadows: the mapped ones for `map`, every light otherwise (a
+    /// resolved technique: `auto` must be resolved first, since it may mean maps).
     pub fn of(shadows: Shadows) -> Self {
         if shadows == Shadows::Map {
             Self::MAPPED
