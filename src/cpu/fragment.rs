@@ -54,15 +54,8 @@ pub(super) fn shade(
     viewer: glam::Vec4,
     shadow_rays: Option<(&dyn Occlusion, ShadowedLights)>,
 ) -> [f64; 3] {
-    let mut a = [0.0f64; ATTRIBUTES];
-    for (k, slot) in a.iter_mut().enumerate() {
-        *slot = w[0] * t.attributes[0][k] + w[1] * t.attributes[1][k] + w[2] * t.attributes[2][k];
-    }
-    let position = DVec3::new(a[0], a[1], a[2]);
-    let mut normal = safe_normalize(DVec3::new(a[3], a[4], a[5]));
-    if t.flip_normal {
-        normal = -normal;
-    }
+    let a = interpolated(t, w);
+    let (position, normal) = position_and_normal(t, &a);
     // Surface frame: the interpolated tangent made orthogonal to the normal; bitangent w (n × t).
     let tangent = orthonormal_tangent(DVec3::new(a[6], a[7], a[8]), normal);
     let handedness = if a[9] < 0.0 { -1.0 } else { 1.0 };
@@ -141,14 +134,20 @@ pub(super) struct RayFrame {
     pub face: DVec3,
 }
 
+/// Triangle `t`'s vertex attributes at barycentrics `w`, interpolated in f64.
+fn interpolated(t: &Prepared, w: [f64; 3]) -> [f64; ATTRIBUTES] {
+    std::array::from_fn(|k| w[0] * t.attributes[0][k] + w[1] * t.attributes[1][k] + w[2] * t.attributes[2][k])
+}
+
+/// The point [m] and its unit normal on the side being shaded, from interpolated attributes `a` of triangle `t`.
+fn position_and_normal(t: &Prepared, a: &[f64; ATTRIBUTES]) -> (DVec3, DVec3) {
+    let normal = safe_normalize(DVec3::new(a[3], a[4], a[5]));
+    (DVec3::new(a[0], a[1], a[2]), if t.flip_normal { -normal } else { normal })
+}
+
 /// The [`RayFrame`] of the point with barycentrics `w` of triangle `t`, as [`shade`] computes it.
 pub(super) fn ray_frame(t: &Prepared, w: [f64; 3]) -> RayFrame {
-    let at = |k: usize| w[0] * t.attributes[0][k] + w[1] * t.attributes[1][k] + w[2] * t.attributes[2][k];
-    let position = DVec3::new(at(0), at(1), at(2));
-    let mut normal = safe_normalize(DVec3::new(at(3), at(4), at(5)));
-    if t.flip_normal {
-        normal = -normal;
-    }
+    let (position, normal) = position_and_normal(t, &interpolated(t, w));
     let p = corners(t);
     let face = safe_normalize((p[1] - p[0]).cross(p[2] - p[0]));
     let face = if face.dot(normal) < 0.0 { -face } else { face };
