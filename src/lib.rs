@@ -14,6 +14,7 @@ pub mod authoring;
 pub mod cli;
 pub mod compare;
 pub mod cpu;
+pub mod daylight;
 pub mod film;
 pub mod gpu;
 pub mod plot;

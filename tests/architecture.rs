@@ -41,6 +41,9 @@ fn modules_depend_one_way() {
     // Speed against error knows the reference and the comparison; GPU timings come from the command line.
     assert_free_of("src/accuracy", &["ash::", "gltf::", "crate::gpu", "crate::cli"]);
     assert_free_of("src/plot", &["ash::", "gltf::", "crate::gpu", "crate::cpu", "crate::scene", "crate::cli"]);
+    // Daylight is astronomy and a clear-sky model: numbers that the settings turn into lights.
+    let renderers = ["crate::gpu", "crate::cpu", "crate::shading", "crate::compare", "crate::cli"];
+    assert_free_of("src/daylight", &[&["ash::", "gltf::", "crate::scene"][..], &renderers[..]].concat());
 }
 
 /// Names of the functions defined in a GLSL file (a return type, a name, an opening parenthesis at line start).
