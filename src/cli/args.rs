@@ -5,6 +5,8 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::DVec3;
 
+use super::daylight::{DaylightArgs, DaylightAt};
+use super::quantity::RequestedQuantity;
 use crate::film::{Exposure, ImageFormat};
 use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
@@ -268,9 +270,14 @@ pub struct SceneArgs {
 
     /// What the pixels hold: `radiance` towards the camera [W/(m²·sr)], or `irradiance` [W/m²], the light
     /// arriving at the surface point each pixel sees, per RGB channel, from every light's visible part (the
-    /// lecture's E(x, y); the material does not enter). Images record the quantity and its unit.
-    #[arg(long, default_value = "radiance", value_name = "radiance|irradiance")]
-    pub quantity: crate::shading::Quantity,
+    /// lecture's E(x, y); the material does not enter); accumulated over --from/--to/--step: `irradiation`
+    /// [Wh/m²], the sum of the irradiance of each step's midpoint times its length, or `sun-hours` [h], the
+    /// hours whose direct sun on the surface reaches --sun-hours-threshold. Images record the quantity and its unit.
+    #[arg(long, default_value = "radiance", value_name = "radiance|irradiance|irradiation|sun-hours")]
+    pub quantity: RequestedQuantity,
+
+    #[command(flatten)]
+    pub daylight: DaylightArgs,
 
     /// Shadow rays per light and pixel for each light's visible fraction (a stratified grid over the light;
     /// rounded up to a square; 1: the light's centre alone, a hard shadow).
@@ -295,9 +302,21 @@ pub fn per_axis(samples: u32) -> u32 {
 impl SceneArgs {
     /// Refuses flags that mean nothing together.
     pub fn check(&self) -> Result<(), super::CliError> {
-        if self.tolerance.is_some() && self.quantity == crate::shading::Quantity::Irradiance {
+        self.daylight.check().map_err(super::CliError::Usage)?;
+        let accumulating = self.daylight.from.is_some();
+        if self.quantity.is_accumulated() != accumulating {
+            return Err(super::CliError::Usage(if accumulating {
+                "--from/--to/--step accumulate: give --quantity irradiation or sun-hours".into()
+            } else {
+                format!(
+                    "--quantity {} accumulates over time: give --from, --to, --step and --location",
+                    self.quantity.name()
+                )
+            }));
+        }
+        if self.tolerance.is_some() && self.quantity != RequestedQuantity::Radiance {
             return Err(super::CliError::Usage(
-                "--tolerance chooses models for radiance; with --quantity irradiance choose the sun model and \
+                "--tolerance chooses models for radiance; with other quantities choose the sun model and \
                  samples yourself (the irradiance's own formulas are exact; docs/accuracy.md)"
                     .into(),
             ));
@@ -323,10 +342,32 @@ impl SceneArgs {
     }
 
     pub fn light_options(&self) -> LightOptions {
+        self.light_options_at(self.daylight.at_time().as_ref())
+    }
+
+    /// The light options with the sun and clear sky of `daylight` (the flags' own where they give them): the sun's
+    /// direction from its position; its `E⊥` the clear sky's direct normal irradiance unless --sun-irradiance or
+    /// --sun-radiance; the sky the clear sky's uniform equivalent unless --sky-radiance. A sun below the horizon
+    /// sends no direct light whatever the flags say.
+    pub fn light_options_at(&self, daylight: Option<&DaylightAt>) -> LightOptions {
+        let mut sun = self.sun_options();
+        let mut sky = self.sky_radiance;
+        if let Some(d) = daylight {
+            sun.direction = Some(d.direction);
+            if !d.position.is_up() {
+                sun.irradiance = Some(0.0);
+                sun.radiance = None;
+            } else if sun.irradiance.is_none() && sun.radiance.is_none() {
+                sun.irradiance = Some(d.clear_sky.dni);
+            }
+            if sky.is_none() {
+                sky = Some([d.clear_sky.sky_radiance(); 3]);
+            }
+        }
         LightOptions {
-            sun: self.sun_options(),
+            sun,
             disks: self.disk_lights.clone(),
-            sky: self.sky_radiance,
+            sky,
             shading: ShadingOptions {
                 sun: self.sun_model,
                 disk: self.disk_model,
@@ -336,7 +377,7 @@ impl SceneArgs {
                 shadow_samples_per_axis: per_axis(self.shadow_samples),
                 shadow_map_size: self.shadow_map_size,
                 shadow_map_filter: self.shadow_map_filter,
-                quantity: self.quantity,
+                quantity: self.quantity.frame(),
             },
         }
     }
@@ -408,7 +449,7 @@ impl OutputArgs {
     pub fn write_false_color(
         &self,
         image: &crate::film::Image,
-        quantity: crate::shading::Quantity,
+        quantity: RequestedQuantity,
     ) -> Result<(), super::CliError> {
         let Some(path) = &self.false_color else { return Ok(()) };
         let max = self.false_color_max.unwrap_or_else(|| crate::plot::false_color::default_max(image));

@@ -113,6 +113,13 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
         .iter()
         .map(|job| {
             let args = RenderArgs::parse_list(&job_arguments(job)?)?;
+            if args.scene.quantity.is_accumulated() {
+                return Err(format!(
+                    "quantity {}: not accumulated by batch jobs (render it with sunshade render, which runs its \
+                     instants in one process)",
+                    args.scene.quantity.name()
+                ));
+            }
             if args.output.false_color.is_some() {
                 return Err("false-color: not written by batch jobs (render each with sunshade render)".to_string());
             }

@@ -99,3 +99,9 @@ pub fn sun_model_line(settings: &RenderSettings) -> String {
         (true, SunModel::Disk) => format!("sun: disk, {}² samples", settings.shading.sun_samples_per_axis),
     }
 }
+
+/// `sunshadeDaylight`: where the sun of `--time` stood and the clear sky it gave, when the render has one.
+pub fn daylight(a: &super::args::SceneArgs) -> Option<(String, String)> {
+    let d = a.daylight.at_time()?;
+    Some(("sunshadeDaylight".into(), d.json(a.daylight.north, a.daylight.linke_turbidity).to_string()))
+}

@@ -3,6 +3,7 @@
 //! Exit codes: 0 success, 1 failure, 2 usage error. Every error is one line on stderr that names the file or the
 //! flag at fault.
 
+mod accumulate;
 mod albedo;
 mod args;
 mod batch;
@@ -11,11 +12,13 @@ mod bench_measured;
 mod bench_pareto;
 mod bench_shadows;
 mod bench_textures;
+mod daylight;
 mod diff;
 mod fit_brdf;
 mod generated;
 mod info;
 mod metadata;
+mod quantity;
 mod reference;
 pub(crate) mod render;
 mod session;
@@ -56,6 +59,10 @@ enum Command {
     Diff(Box<diff::DiffCommand>),
     /// Add float images pixel by pixel (f64 sums): e.g. the shards of an accumulation rendered apart.
     Sum(sum::SumCommand),
+    /// Where the sun is at a time and place (NREL SPA): zenith, azimuth (clockwise from north), elevation, its
+    /// direction in scene axes, whether it is up, and the clear sky's irradiances.
+    #[command(allow_negative_numbers = true)]
+    Sun(daylight::SunCommand),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
     /// Render many jobs of a JSON manifest in one process, on one device: scenes loaded and uploaded once while
@@ -185,6 +192,7 @@ pub fn main() -> ExitCode {
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Sum(a) => sum::run(&a),
+        Command::Sun(a) => daylight::run_sun(&a),
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Albedo(a) => albedo::run(&a),
@@ -256,6 +264,9 @@ pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliErr
 
 /// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
 pub(crate) fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
+    if let Some(w) = a.daylight.at_time().and_then(|d| d.below_horizon_warning()) {
+        warn_once(&w);
+    }
     settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options())
         .map_err(|e| CliError::Usage(e.to_string()))
 }

@@ -73,6 +73,9 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     a.output.check()?;
     a.scene.check()?;
     cpu::check_size(a.scene.width, a.scene.height, a.max_pixels).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
+    if a.scene.quantity.is_accumulated() {
+        return run_accumulation(a, started);
+    }
     let (scene, mut settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
     let options = a.reference.options();
@@ -100,8 +103,9 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     };
     meta.text.extend(convergence);
     meta.text.extend(super::metadata::measured_materials(&scene));
+    meta.text.extend(super::metadata::daylight(&a.scene));
     let ev = write_image_with(&image, &a.output.output, a.output.exposure(), &meta)?;
-    a.output.write_false_color(&image, settings.shading.quantity)?;
+    a.output.write_false_color(&image, a.scene.quantity)?;
     if a.verbose {
         eprintln!(
             "sunshade: CPU reference, {} threads, {} triangles, {}x{} pixels, {} covered",
@@ -147,4 +151,30 @@ fn converged_image(
         "last_change": c.last_change,
     });
     (c.image, ("sunshadeConverged".into(), record.to_string()))
+}
+
+/// `--quantity irradiation|sun-hours` on the CPU: each step a reference frame (its shadows as `render` resolves
+/// them on this machine's reference), summed as `render` sums them.
+fn run_accumulation(a: &ReferenceCommand, started: Instant) -> Result<(), CliError> {
+    if a.converged || a.scene.tolerance.is_some() {
+        return Err(CliError::Usage("an accumulation takes neither --converged nor --tolerance".into()));
+    }
+    let (scene, load_time) = super::load_only(&a.scene)?;
+    let options = a.reference.options();
+    let scene_can_occlude = crate::visibility::can_occlude(&scene);
+    let done = super::accumulate::accumulate(&scene, &a.scene, |settings| {
+        let mut settings = settings.clone();
+        settings.shading.shadows = cpu::shadow_choice_where(scene_can_occlude, &settings, &options).technique;
+        Ok(cpu::render(&scene, &settings, &options))
+    })?;
+    let meta = done.metadata(&a.scene, "cpu reference");
+    let ev = write_image_with(&done.image, &a.output.output, a.output.exposure(), &meta)?;
+    a.output.write_false_color(&done.image, a.scene.quantity)?;
+    warn_if_nothing_covered(&done.image, &a.scene.scene);
+    if a.verbose {
+        done.print();
+        print_exposure(ev);
+        print_phases(&[("load", load_time), ("frames", done.frames)], started.elapsed());
+    }
+    Ok(())
 }

@@ -110,6 +110,12 @@ pub struct Rendered {
 /// settings resolved, then the device, the upload (once per scene and renderer) and the frame.
 pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, CliError> {
     a.check()?;
+    if a.scene.quantity.is_accumulated() {
+        return Err(CliError::Usage(format!(
+            "--quantity {} accumulates many frames: render it alone with sunshade render",
+            a.scene.quantity.name()
+        )));
+    }
     let (scene, load) = session.load(&a.scene)?;
     let settings = resolve_settings(session.scene_ref(scene), &a.scene)?;
     let renderer = session.renderer(a.device.clone(), a.interpolation)?;
@@ -236,6 +242,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let started = Instant::now();
     super::set_quiet(a.quiet);
     let mut session = Session::new(cache_dir(a.no_cache));
+    if a.scene.quantity.is_accumulated() {
+        return run_accumulation(&mut session, a, started);
+    }
     let job = render_job(&mut session, a)?;
     let t_cache = Instant::now();
     for w in session.save_pipeline_caches() {
@@ -249,8 +258,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         &job.prediction,
     );
     meta.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
+    meta.text.extend(super::metadata::daylight(&a.scene));
     let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
-    a.output.write_false_color(&job.image, job.settings.shading.quantity)?;
+    a.output.write_false_color(&job.image, a.scene.quantity)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();
@@ -299,6 +309,52 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     }
     if a.check {
         check_job(&mut session, a, &job, a.verbose)?;
+    }
+    Ok(())
+}
+
+/// `--quantity irradiation|sun-hours`: every step of the interval rendered on one renderer (the scene loaded and
+/// uploaded once, the pipelines created at the first step), summed, written once.
+fn run_accumulation(session: &mut Session, a: &RenderArgs, started: Instant) -> Result<(), CliError> {
+    a.check()?;
+    if a.check {
+        return Err(CliError::Usage(
+            "--check compares one frame: check an instant (--time) of the accumulation instead".into(),
+        ));
+    }
+    let (scene, load) = session.load(&a.scene)?;
+    let renderer = session.renderer(a.device.clone(), a.interpolation)?;
+    session.renderer_mut(renderer).check_size(a.scene.width, a.scene.height)?;
+    let upload = session.upload(scene, renderer)?;
+    let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
+    let mut pipelines = std::time::Duration::ZERO;
+    let mut warned = false;
+    let done = super::accumulate::accumulate(scene_data, &a.scene, |settings| {
+        let choice = r.shadow_choice(gpu_scene, settings)?;
+        if choice.warning && !warned {
+            super::warn_once(&format!("shadows: {}", choice.reason));
+            warned = true;
+        }
+        let mut settings = settings.clone();
+        settings.shading.shadows = choice.technique;
+        let (image, timings) = r.render(gpu_scene, &settings)?;
+        pipelines += timings.pipelines;
+        Ok(image)
+    })?;
+    for w in session.save_pipeline_caches() {
+        super::warn(&format!("pipeline cache not saved: {w}"));
+    }
+    let meta = done.metadata(&a.scene, &session.renderer_description(renderer));
+    let ev = write_image_with(&done.image, &a.output.output, a.output.exposure(), &meta)?;
+    a.output.write_false_color(&done.image, a.scene.quantity)?;
+    warn_if_nothing_covered(&done.image, &a.scene.scene);
+    if a.verbose {
+        done.print();
+        print_exposure(ev);
+        print_phases(
+            &[("load", load), ("upload", upload), ("pipelines", pipelines), ("frames", done.frames)],
+            started.elapsed(),
+        );
     }
     Ok(())
 }

@@ -1,0 +1,60 @@
+//! What `--quantity` asks for: a quantity one frame renders (radiance, irradiance), or one accumulated over many
+//! instants from irradiance frames (irradiation, sun-hours).
+
+use crate::shading::Quantity;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RequestedQuantity {
+    #[default]
+    Radiance,
+    Irradiance,
+    /// `H = Σ E(tᵢ) Δtᵢ` [Wh/m²] over the steps of `--from/--to/--step`.
+    Irradiation,
+    /// Hours in which the direct sun on the surface reaches `--sun-hours-threshold` [h].
+    SunHours,
+}
+
+impl RequestedQuantity {
+    /// The quantity each rendered frame holds.
+    pub fn frame(self) -> Quantity {
+        match self {
+            RequestedQuantity::Radiance => Quantity::Radiance,
+            _ => Quantity::Irradiance,
+        }
+    }
+
+    /// Whether it sums frames over time.
+    pub fn is_accumulated(self) -> bool {
+        matches!(self, RequestedQuantity::Irradiation | RequestedQuantity::SunHours)
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RequestedQuantity::Irradiation => "irradiation",
+            RequestedQuantity::SunHours => "sun-hours",
+            q => q.frame().name(),
+        }
+    }
+
+    /// The unit in ASCII, as image files record it.
+    pub fn unit_ascii(self) -> &'static str {
+        match self {
+            RequestedQuantity::Irradiation => "Wh/m2",
+            RequestedQuantity::SunHours => "h",
+            q => q.frame().unit_ascii(),
+        }
+    }
+}
+
+impl std::str::FromStr for RequestedQuantity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "radiance" => Ok(RequestedQuantity::Radiance),
+            "irradiance" => Ok(RequestedQuantity::Irradiance),
+            "irradiation" => Ok(RequestedQuantity::Irradiation),
+            "sun-hours" => Ok(RequestedQuantity::SunHours),
+            _ => Err(format!("'{s}' is not a quantity (radiance, irradiance, irradiation, sun-hours)")),
+        }
+    }
+}
