@@ -250,6 +250,21 @@ fn shards_add_up_to_the_whole() {
         // Each shard is rounded to f32 once, and their sum once more: a few ulps apart at most.
         assert!((p[0] - q[0]).abs() <= 4.0 * f32::EPSILON * p[0], "{p:?} {q:?}");
     }
+    // diff reads the quantity the files record: its errors in Wh/m²; a radiance image is not compared with it.
+    let o = sunshade(&["diff", s(&whole), s(&total)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(report.contains("max abs error") && report.contains("Wh/m²") && !report.contains("sr)"), "{report}");
+    let radiance = dir.path("radiance.exr");
+    let o = sunshade(&[&["render", s(&roof), "-o", s(&radiance), "-q"][..], &VIEW_DOWN].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    for command in ["diff", "sum"] {
+        let mixed = dir.path("mixed.exr");
+        let o = sunshade(&[command, s(&whole), s(&radiance), "-o", s(&mixed)]);
+        assert_eq!(o.status.code(), Some(2), "{command}: {}", stderr(&o));
+        assert!(stderr(&o).contains("holds irradiation") && stderr(&o).contains("holds radiance"), "{}", stderr(&o));
+        assert!(!mixed.exists());
+    }
 }
 
 #[test]
@@ -290,6 +305,16 @@ fn time_and_place_set_the_sun_and_a_night_is_dark_with_a_warning() {
     assert!(o.status.success(), "{}", stderr(&o));
     let worst = worst_relative(&covered(&sunshade::film::read_image(&out).unwrap(), 500), ghi);
     assert!(worst <= 1e-5, "noon: {worst:e} against GHI {ghi}");
+    // The image records where the sun stood and what the clear sky gave.
+    let meta = exr::meta::MetaData::read_from_file(&out, false).unwrap();
+    let all: serde_json::Value = match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
+    };
+    let recorded = &all["sunshadeDaylight"];
+    assert_eq!(recorded["time"], "2026-06-21T11:30:00Z", "{all}");
+    assert!((recorded["zenith_deg"].as_f64().unwrap() - p.zenith_deg).abs() < 1e-12, "{all}");
+    assert!((recorded["clear_sky"]["ghi_w_m2"].as_f64().unwrap() - ghi).abs() < 1e-9 * ghi, "{all}");
     // `sunshade sun --json`: the fields the issue names, and the direction in scene axes (north −Z).
     let o = sunshade(&["sun", "--time", "2026-06-21T13:30:00+02:00", "--location", PLACE, "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -122,8 +122,22 @@ pub struct DiffCommand {
 /// How a comparison is reported: text, or JSON with these extra members (`render --check --json` adds the
 /// render's predicted error).
 pub enum ReportFormat {
-    Text,
+    /// Text, absolute errors in this unit.
+    Text(String),
     Json(serde_json::Map<String, serde_json::Value>),
+}
+
+impl ReportFormat {
+    /// Text or (`json`) JSON with `extra` members, absolute errors in `unit` (JSON member `unit`).
+    pub fn new(json: bool, unit: &str, extra: Vec<(String, serde_json::Value)>) -> Self {
+        if json {
+            let mut map: serde_json::Map<String, serde_json::Value> = extra.into_iter().collect();
+            map.insert("unit".into(), serde_json::json!(unit));
+            ReportFormat::Json(map)
+        } else {
+            ReportFormat::Text(unit.to_string())
+        }
+    }
 }
 
 pub fn compare_and_report(
@@ -151,7 +165,7 @@ pub fn compare_and_report(
             }
             println!("{}", serde_json::to_string_pretty(&json).expect("serialisable"));
         }
-        ReportFormat::Text => print!("{}", report.text(names.0, names.1)),
+        ReportFormat::Text(unit) => print!("{}", report.text_in(names.0, names.1, &unit)),
     }
     Ok(report)
 }
@@ -180,6 +194,22 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
             return Err(CliError::Usage(format!("{}: the difference image is float (use .exr or .pfm)", o.display())));
         }
     }
+    // The quantities the files record: two different ones are not compared; the report's unit is theirs.
+    let (qa, qb) = (crate::film::read_quantity(&a.a), crate::film::read_quantity(&a.b));
+    if let (Some((na, _)), Some((nb, _))) = (&qa, &qb) {
+        if na != nb {
+            return Err(CliError::Usage(format!(
+                "{} holds {na} and {} holds {nb}: compare images of one quantity",
+                a.a.display(),
+                a.b.display()
+            )));
+        }
+    }
+    let unit = match qa.or(qb) {
+        _ if fa == ImageFormat::Png => "(8-bit sRGB codes)".to_string(),
+        Some((_, unit)) => super::quantity::pretty_unit(&unit),
+        None => "W/(m²·sr)".to_string(), // a PFM records nothing: radiance, sunshade's default quantity
+    };
     let read = |p: &PathBuf| read_image(p).map_err(|e| CliError::Usage(e.to_string()));
     let (mut ia, mut ib) = (read(&a.a)?, read(&a.b)?);
     if fa == ImageFormat::Pfm || fb == ImageFormat::Pfm {
@@ -198,7 +228,7 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
         crate::film::write_image(&d, o, crate::film::Exposure::Ev(0.0))?;
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
-    let format = if a.json { ReportFormat::Json(Default::default()) } else { ReportFormat::Text };
+    let format = ReportFormat::new(a.json, &unit, Vec::new());
     let report = compare_and_report(
         &ia,
         &ib,

@@ -46,6 +46,11 @@ impl RequestedQuantity {
     }
 }
 
+/// An ASCII unit as files record it, as people read it: `W/(m2 sr)` → `W/(m²·sr)`, `Wh/m2` → `Wh/m²`.
+pub fn pretty_unit(ascii: &str) -> String {
+    ascii.replace("m2 sr", "m²·sr").replace("m2", "m²")
+}
+
 impl std::str::FromStr for RequestedQuantity {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {

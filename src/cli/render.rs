@@ -191,11 +191,8 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     }
     // The JSON also carries the render's predicted error against the truth (the comparison is against the
     // reference with the same models).
-    let format = if a.json {
-        ReportFormat::Json([("predicted_error".to_string(), job.prediction.json())].into_iter().collect())
-    } else {
-        ReportFormat::Text
-    };
+    let unit = job.settings.shading.quantity.unit();
+    let format = ReportFormat::new(a.json, unit, vec![("predicted_error".to_string(), job.prediction.json())]);
     let report = compare_and_report(
         &job.image,
         &reference,

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
-use crate::film::{read_image, write_image, Exposure, Image, ImageFormat};
+use crate::film::{read_image, write_image_with, Exposure, Image, ImageFormat, Metadata};
 
 #[derive(Args, Debug)]
 pub struct SumCommand {
@@ -65,6 +65,23 @@ pub fn run(a: &SumCommand) -> Result<(), CliError> {
         }
         images.push(image);
     }
-    write_image(&sum(&images), &a.output, Exposure::Ev(0.0))?;
+    // The sum holds what its inputs hold: one quantity, recorded in the output (refused when they differ).
+    let quantities: Vec<Option<(String, String)>> = a.inputs.iter().map(|p| crate::film::read_quantity(p)).collect();
+    if let Some(i) = quantities.iter().position(|q| q.is_some() && *q != quantities[0]) {
+        let name = |q: &Option<(String, String)>| q.as_ref().map_or("no recorded quantity".into(), |q| q.0.clone());
+        return Err(CliError::Usage(format!(
+            "{} holds {} and {} holds {}: sum adds images of one quantity",
+            a.inputs[i].display(),
+            name(&quantities[i]),
+            a.inputs[0].display(),
+            name(&quantities[0])
+        )));
+    }
+    let mut metadata = Metadata::default();
+    if let Some((name, unit)) = &quantities[0] {
+        let text = format!("{name} {unit} per linear RGB channel; A = coverage");
+        metadata.text.push(("quantity".into(), text));
+    }
+    write_image_with(&sum(&images), &a.output, Exposure::Ev(0.0), &metadata)?;
     Ok(())
 }

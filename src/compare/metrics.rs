@@ -363,8 +363,13 @@ impl DiffReport {
         self.over_tolerance_pixels.iter().filter(|&&(x, y)| mask.get((y * width + x) as usize) == Some(&true)).count()
     }
 
-    /// A short human-readable report.
+    /// A short human-readable report, errors in W/(m²·sr) (radiance, the default quantity).
     pub fn text(&self, name_a: &str, name_b: &str) -> String {
+        self.text_in(name_a, name_b, "W/(m²·sr)")
+    }
+
+    /// A short human-readable report, absolute errors in `unit` (the images' quantity's).
+    pub fn text_in(&self, name_a: &str, name_b: &str, unit: &str) -> String {
         let mut s = String::new();
         let o = &self.options;
         let parts: Vec<String> = [
@@ -386,12 +391,12 @@ impl DiffReport {
             self.options.fail_coverage
         );
         s += &format!("compared (covered in both): {}\n", self.compared);
-        s += &format!("max abs error: {:.3e} W/(m²·sr)\n", self.max_abs);
+        s += &format!("max abs error: {:.3e} {unit}\n", self.max_abs);
         s += &format!(
-            "max rel error: {:.3e} (interior {:.3e}; floor {:.3e} W/(m²·sr))\n",
+            "max rel error: {:.3e} (interior {:.3e}; floor {:.3e} {unit})\n",
             self.max_rel, self.max_rel_interior, self.floor
         );
-        s += &format!("RMSE: {:.3e} W/(m²·sr), PSNR: {:.1} dB (peak {:.4e})\n", self.rmse, self.psnr_db, self.peak);
+        s += &format!("RMSE: {:.3e} {unit}, PSNR: {:.1} dB (peak {:.4e})\n", self.rmse, self.psnr_db, self.peak);
         s += &format!(
             "over tolerance ({tol}): {} (edge {}, interior {}; allowed {})\n",
             self.over_tolerance.total, self.over_tolerance.edge, self.over_tolerance.interior, self.allowed_over

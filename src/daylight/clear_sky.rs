@@ -8,8 +8,8 @@
 //! radiance `L_sky = DHI/π`, the radiance of a uniform sky that puts the model's diffuse horizontal irradiance
 //! on a horizontal plane (`∫ L cos θ dΩ = π L` over the upper hemisphere). A real clear sky is not uniform (its
 //! brightness gathers around the sun and at the horizon, Perez et al. 1993), so on tilted and shaded surfaces the
-//! sky's share is an approximation; and sunshade's sky lights every surface over its own horizon (a vertical wall
-//! gets `π L/2` from the sky, where outdoors half of that comes from the ground).
+//! sky's share is an approximation; and sunshade's sky is the upper hemisphere only, so a vertical wall gets
+//! `π L/2` from it and nothing from the ground (whose reflected light is not modelled).
 
 /// The total solar irradiance at 1 AU [W/m²] (Kopp & Lean 2011: 1360.8 ± 0.5).
 pub const SOLAR_CONSTANT_W_M2: f64 = 1360.8;

@@ -219,6 +219,33 @@ pub fn read_image(path: &Path) -> Result<Image, ImageIoError> {
 }
 
 /// PFM: header `PF\n<w> <h>\n-1.0\n` (negative scale = little-endian), then RGB rows from the bottom up.
+/// What a sunshade image holds, as its metadata records it: `(quantity, unit)` in ASCII, e.g.
+/// `("irradiation", "Wh/m2")`, from the EXR's `sunshade` attribute or the PNG's `quantity` text; `None` for a PFM
+/// (no metadata) or a file sunshade did not write. Reads only the header (EXR) or the text chunks (PNG).
+pub fn read_quantity(path: &Path) -> Option<(String, String)> {
+    let text = match ImageFormat::from_path(path)? {
+        ImageFormat::Pfm => return None,
+        ImageFormat::Exr => {
+            let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+            let header = meta.headers.first()?;
+            let value = header.own_attributes.other.get(&exr::prelude::Text::from("sunshade"))?;
+            let exr::meta::attribute::AttributeValue::Text(t) = value else { return None };
+            let all: serde_json::Value = serde_json::from_str(&t.to_string()).ok()?;
+            all.get("quantity")?.as_str()?.to_string()
+        }
+        ImageFormat::Png => {
+            let file = std::fs::File::open(path).ok()?;
+            let reader = png::Decoder::new(io::BufReader::new(file)).read_info().ok()?;
+            let chunk = reader.info().uncompressed_latin1_text.iter().find(|t| t.keyword == "quantity")?;
+            chunk.text.clone()
+        }
+    };
+    // "NAME UNIT per linear RGB channel; ..."; the unit may hold a space ("W/(m2 sr)"): up to " per ".
+    let head = text.split(" per ").next()?;
+    let (name, unit) = head.split_once(' ')?;
+    Some((name.to_string(), unit.to_string()))
+}
+
 fn write_pfm(image: &Image, w: &mut impl Write) -> io::Result<()> {
     write!(w, "PF\n{} {}\n-1.0\n", image.width(), image.height())?;
     let width = image.width() as usize;

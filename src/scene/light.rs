@@ -43,8 +43,9 @@ pub struct DiskLight {
 pub struct Lights {
     pub sun: Option<Sun>,
     pub disks: Vec<DiskLight>,
-    /// Overcast sky: uniform radiance [W/(m²·sr)] over the whole sphere of directions, per channel (no
-    /// occlusion: every surface sees the whole sky above its horizon).
+    /// Overcast sky: uniform radiance [W/(m²·sr)] per channel over the directions above the horizontal (the
+    /// upper hemisphere), `E = π L0 (1 + cos t)/2` on a surface tilted by t and unshadowed; the scene occludes it
+    /// where shadows are cast by rays (shadow maps leave it unoccluded).
     pub sky: Option<[f32; 3]>,
 }
 
