@@ -74,12 +74,12 @@ pub fn accumulate(
     a: &SceneArgs,
     mut frame: impl FnMut(&RenderSettings) -> Result<Image, CliError>,
 ) -> Result<Accumulated, CliError> {
-    let d = &a.daylight;
-    let (Some(from), Some(to), Some(step_s)) = (d.from, d.to, d.step) else {
+    let (d, acc) = (&a.daylight, &a.accumulation);
+    let (Some(from), Some(to), Some(step_s)) = (acc.from, acc.to, acc.step) else {
         return Err(CliError::Usage("an accumulation needs --from, --to and --step".into()));
     };
     let all = steps(from, to, step_s);
-    let mine = shard_of(all.len(), d.shard);
+    let mine = shard_of(all.len(), acc.shard);
     let sun_hours = a.quantity == RequestedQuantity::SunHours;
     let (width, height) = (a.width, a.height);
     let pixels = width as usize * height as usize;
@@ -121,7 +121,7 @@ pub fn accumulate(
         let image = frame(&settings)?;
         frames += t.elapsed();
         let t = Clock::now();
-        add_step(&mut sum, &image, step.hours, sun_hours.then_some(d.sun_hours_threshold));
+        add_step(&mut sum, &image, step.hours, sun_hours.then_some(acc.sun_hours_threshold));
         if coverage.is_none() {
             coverage = Some(image.pixels().iter().map(|p| p[3]).collect());
         }
@@ -188,15 +188,15 @@ fn add_step(sum: &mut [[f64; 3]], image: &Image, hours: f64, threshold: Option<f
 impl Accumulated {
     /// The record of the accumulation for the file's metadata (`sunshadeAccumulation`).
     pub fn json(&self, a: &SceneArgs) -> serde_json::Value {
-        let d = &a.daylight;
+        let (d, acc) = (&a.daylight, &a.accumulation);
         serde_json::json!({
             "quantity": a.quantity.name(),
             "unit": a.quantity.unit_ascii(),
-            "from": d.from.map(|t| t.to_string()),
-            "to": d.to.map(|t| t.to_string()),
-            "step_s": d.step,
+            "from": acc.from.map(|t| t.to_string()),
+            "to": acc.to.map(|t| t.to_string()),
+            "step_s": acc.step,
             "rule": "midpoint of each step, weighted by its length; steps with the sun down add nothing",
-            "shard": d.shard.map(|(k, n)| format!("{k}/{n}")),
+            "shard": acc.shard.map(|(k, n)| format!("{k}/{n}")),
             "steps_total": self.steps_total,
             "steps_in_shard": self.steps_in_shard,
             "steps_rendered": self.steps_rendered,
@@ -206,7 +206,7 @@ impl Accumulated {
             "north_deg": d.north,
             "refraction": !d.no_refraction,
             "linke_turbidity": d.linke_turbidity,
-            "sun_hours_threshold_w_m2": (a.quantity == RequestedQuantity::SunHours).then_some(d.sun_hours_threshold),
+            "sun_hours_threshold_w_m2": (a.quantity == RequestedQuantity::SunHours).then_some(acc.sun_hours_threshold),
         })
     }
 

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::DVec3;
 
-use super::daylight::{DaylightArgs, DaylightAt};
+use super::daylight::{AccumulationArgs, DaylightArgs, DaylightAt};
 use super::quantity::RequestedQuantity;
 use crate::film::{Exposure, ImageFormat};
 use crate::scene::light::MAX_DISK_EXTENT_M;
@@ -279,6 +279,9 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub daylight: DaylightArgs,
 
+    #[command(flatten)]
+    pub accumulation: AccumulationArgs,
+
     /// Shadow rays per light and pixel for each light's visible fraction (a stratified grid over the light;
     /// rounded up to a square; 1: the light's centre alone, a hard shadow).
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_SAMPLES_PER_AXIS * DEFAULT_SHADOW_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=4096))]
@@ -303,7 +306,8 @@ impl SceneArgs {
     /// Refuses flags that mean nothing together.
     pub fn check(&self) -> Result<(), super::CliError> {
         self.daylight.check().map_err(super::CliError::Usage)?;
-        let accumulating = self.daylight.from.is_some();
+        self.accumulation.check().map_err(super::CliError::Usage)?;
+        let accumulating = self.accumulation.from.is_some();
         if self.quantity.is_accumulated() != accumulating {
             return Err(super::CliError::Usage(if accumulating {
                 "--from/--to/--step accumulate: give --quantity irradiation or sun-hours".into()

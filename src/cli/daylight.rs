@@ -1,7 +1,8 @@
 //! The daylight flags: `--time`, `--location` and the scene's orientation give the sun's direction (the NREL
 //! Solar Position Algorithm); the Ineichen–Perez clear sky gives its `E⊥` and the sky's radiance unless
 //! `--sun-irradiance`/`--sun-radiance` or `--sky-radiance` say otherwise. `--from/--to/--step` set the instants of
-//! an accumulation (`--quantity irradiation|sun-hours`). Also `sunshade sun`, which prints where the sun is.
+//! an accumulation (`--quantity irradiation|sun-hours`, [`AccumulationArgs`]). Also `sunshade sun`, which prints
+//! where the sun is.
 
 use clap::Args;
 use glam::DVec3;
@@ -105,7 +106,11 @@ pub struct DaylightArgs {
     #[arg(help_heading = "Daylight", long, default_value_t = DEFAULT_LINKE_TURBIDITY, value_parser = parse_finite,
           value_name = "TL")]
     pub linke_turbidity: f64,
+}
 
+/// The flags of an accumulation over time (`--quantity irradiation|sun-hours`).
+#[derive(Args, Clone, Debug, Default)]
+pub struct AccumulationArgs {
     /// Start of an accumulation (--quantity irradiation or sun-hours), ISO 8601 like --time.
     #[arg(help_heading = "Accumulation", long, value_parser = parse_instant, value_name = "ISO8601",
           requires_all = ["to", "step", "location"], conflicts_with_all = ["sun_dir", "sun_elevation", "sun_azimuth"])]
@@ -128,6 +133,21 @@ pub struct DaylightArgs {
     /// WMO's threshold of sunshine, here on the surface, through its shadows).
     #[arg(help_heading = "Accumulation", long, default_value_t = 120.0, value_parser = parse_finite, value_name = "W/M2")]
     pub sun_hours_threshold: f64,
+}
+
+impl AccumulationArgs {
+    /// Refuses values outside what an accumulation takes.
+    pub fn check(&self) -> Result<(), String> {
+        if self.sun_hours_threshold < 0.0 {
+            return Err("--sun-hours-threshold must be non-negative".into());
+        }
+        if let (Some(from), Some(to)) = (self.from, self.to) {
+            if to <= from {
+                return Err(format!("--to {to} is not after --from {from}"));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The sun and sky of one instant at one place.
@@ -166,14 +186,6 @@ impl DaylightArgs {
         }
         if !(1.0..=10.0).contains(&self.linke_turbidity) {
             return Err(format!("--linke-turbidity {}: the model holds for 1..10", self.linke_turbidity));
-        }
-        if self.sun_hours_threshold < 0.0 {
-            return Err("--sun-hours-threshold must be non-negative".into());
-        }
-        if let (Some(from), Some(to)) = (self.from, self.to) {
-            if to <= from {
-                return Err(format!("--to {to} is not after --from {from}"));
-            }
         }
         Ok(())
     }
