@@ -342,6 +342,8 @@ fn daylight_flags_that_mean_nothing_are_refused_in_one_line() {
         (&["--time", "2026-06-21T12:00Z", "--location", PLACE, "--sun-dir", "0,1,0"][..], "--sun-dir"),
         (&["--location", "95,0", "--time", "2026-06-21T12:00Z"][..], "latitude"),
         (&["--quantity", "irradiation"][..], "--from"),
+        (&["--time", "2026-06-21T12:00Z", "--location", PLACE, "--linke-turbidity", "20"][..], "--linke-turbidity"),
+        (&["--time", "2026-06-21T12:00Z", "--location", PLACE, "--pressure", "5"][..], "--pressure"),
         (
             &["--location", PLACE, "--from", "2026-06-21T00:00Z", "--to", "2026-06-22T00:00Z", "--step", "1h"][..],
             "irradiation or sun-hours",
@@ -375,6 +377,21 @@ fn daylight_flags_that_mean_nothing_are_refused_in_one_line() {
                 "irradiation",
             ][..],
             "duration",
+        ),
+        (
+            &[
+                "--location",
+                PLACE,
+                "--from",
+                "2000-01-01T00:00Z",
+                "--to",
+                "2900-01-01T00:00Z",
+                "--step",
+                "1s",
+                "--quantity",
+                "irradiation",
+            ][..],
+            "at most",
         ),
     ] {
         let o = sunshade(&[&base[..], extra].concat());

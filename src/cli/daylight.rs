@@ -108,6 +108,10 @@ pub struct DaylightArgs {
     pub linke_turbidity: f64,
 }
 
+/// The most steps an accumulation takes (a year in 1-minute steps is 525 600): the list of steps is held in
+/// memory.
+pub const MAX_STEPS: usize = 10_000_000;
+
 /// The flags of an accumulation over time (`--quantity irradiation|sun-hours`).
 #[derive(Args, Clone, Debug, Default)]
 pub struct AccumulationArgs {
@@ -144,6 +148,14 @@ impl AccumulationArgs {
         if let (Some(from), Some(to)) = (self.from, self.to) {
             if to <= from {
                 return Err(format!("--to {to} is not after --from {from}"));
+            }
+            if let Some(step) = self.step {
+                let steps = to.seconds_since(from) / step;
+                if steps > MAX_STEPS as f64 {
+                    return Err(format!(
+                        "--from {from} --to {to} in steps of {step} s makes {steps:.3e} steps; at most {MAX_STEPS}"
+                    ));
+                }
             }
         }
         Ok(())

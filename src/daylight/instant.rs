@@ -113,9 +113,6 @@ impl Instant {
         }
         let month = digits(mo, "month")?;
         let day = digits(d, "day")?;
-        if !YEARS.contains(&year) {
-            return Err(bad("the year is outside -2000..6000, where the solar position algorithm holds"));
-        }
         if !(1..=12).contains(&month) {
             return Err(bad("the month is not 1..12"));
         }
@@ -157,7 +154,12 @@ impl Instant {
             return Err(bad("the time of day is out of range"));
         }
         let local = Self::from_utc(year, month, day, hour, minute, f64::from(whole) + fraction);
-        Ok(Self { seconds: local.seconds - offset_s, nanos: local.nanos })
+        let utc = Self { seconds: local.seconds - offset_s, nanos: local.nanos };
+        // The range holds for the instant in UT (an offset or 24:00 may carry it over a year's end).
+        if !YEARS.contains(&utc.civil().0) {
+            return Err(bad("the year (in UT) is outside -2000..6000, where the solar position algorithm holds"));
+        }
+        Ok(utc)
     }
 
     /// This instant plus `seconds` (may be negative and fractional).
@@ -185,9 +187,14 @@ impl Instant {
         2_451_545.0 + self.days_since_j2000()
     }
 
+    /// The UT calendar date `(year, month, day)`.
+    pub fn civil(self) -> (i64, u32, u32) {
+        civil_from_days((self.seconds + UNIX_TO_J2000_S).div_euclid(86_400))
+    }
+
     /// Year as a decimal, `year + (month − 0.5)/12` (the argument of the ΔT polynomials).
     pub fn decimal_year(self) -> f64 {
-        let (year, month, _) = civil_from_days((self.seconds + UNIX_TO_J2000_S).div_euclid(86_400));
+        let (year, month, _) = self.civil();
         year as f64 + (f64::from(month) - 0.5) / 12.0
     }
 }
@@ -198,7 +205,9 @@ impl fmt::Display for Instant {
         let unix = self.seconds + UNIX_TO_J2000_S;
         let (y, mo, d) = civil_from_days(unix.div_euclid(86_400));
         let s = unix.rem_euclid(86_400);
-        write!(f, "{y:04}-{mo:02}-{d:02}T{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)?;
+        // ISO 8601's expanded years: a sign and at least four digits (`-0627`, not `-627`).
+        let sign = if y < 0 { "-" } else { "" };
+        write!(f, "{sign}{:04}-{mo:02}-{d:02}T{:02}:{:02}:{:02}", y.abs(), s / 3600, s / 60 % 60, s % 60)?;
         if self.nanos != 0 {
             let frac = format!("{:09}", self.nanos);
             write!(f, ".{}", frac.trim_end_matches('0'))?;
@@ -247,6 +256,8 @@ mod tests {
             ("2026-06-21T25:00Z", "out of range"),
             ("2026-06-21", "no 'T'"),
             ("7000-01-01T00:00Z", "-2000..6000"),
+            ("6000-12-31T23:00-05:00", "-2000..6000"),
+            ("999999999-01-01T00:00Z", "-2000..6000"),
             ("2026-06-21T12:00+19:00", "offset"),
             ("26-06-21T12:00Z", "four digits"),
             ("2026-06-xxT12:00Z", "not a number"),
@@ -255,5 +266,52 @@ mod tests {
             assert!(e.contains(why) && e.contains(text), "{text}: {e}");
         }
         assert!(Instant::parse("2024-02-29T12:00Z").is_ok());
+    }
+
+    /// A small xorshift generator: the fuzz cases are the same on every run.
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    #[test]
+    fn every_instant_round_trips_through_its_text() {
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let span =
+            Instant::from_utc(6000, 12, 31, 23, 59, 59.0).seconds - Instant::from_utc(-2000, 1, 1, 0, 0, 0.0).seconds;
+        let first = Instant::from_utc(-2000, 1, 1, 0, 0, 0.0).seconds;
+        for _ in 0..20_000 {
+            let t = Instant { seconds: first + (xorshift(&mut rng) % span as u64) as i64, nanos: 0 };
+            assert_eq!(Instant::parse(&t.to_string()).unwrap(), t, "{t}");
+        }
+    }
+
+    #[test]
+    fn mutated_times_never_panic_and_errors_name_the_text() {
+        let seeds = ["2026-06-21T12:00:00+02:00", "2003-10-17 12:30:30.5-07:00", "-0500-03-01T00:00Z"];
+        let alphabet = b"0123456789:-+TZ. ,x";
+        let mut rng = 0x1234_5678_9abc_def1u64;
+        for k in 0..30_000 {
+            let mut text: Vec<u8> = seeds[k % seeds.len()].bytes().collect();
+            for _ in 0..1 + xorshift(&mut rng) % 3 {
+                let at = (xorshift(&mut rng) as usize) % (text.len() + 1);
+                let c = alphabet[(xorshift(&mut rng) as usize) % alphabet.len()];
+                match xorshift(&mut rng) % 3 {
+                    0 if at < text.len() => text[at] = c,
+                    1 if at < text.len() => {
+                        text.remove(at);
+                    }
+                    _ => text.insert(at, c),
+                }
+            }
+            let text = String::from_utf8(text).expect("ASCII");
+            match Instant::parse(&text) {
+                // A time it takes is one it can write and read back.
+                Ok(t) => assert_eq!(Instant::parse(&t.to_string()).unwrap(), t, "{text}"),
+                Err(e) => assert!(e.0.contains(&text), "{text}: {e}"),
+            }
+        }
     }
 }
