@@ -49,6 +49,27 @@ fn sun_at(t: Instant) -> sunshade::daylight::SolarPosition {
     solar_position(t, &ZURICH, &options)
 }
 
+/// The clear sky's global horizontal irradiance [W/m²] at Zurich at `t`, as the CLI's defaults give it.
+fn clear_sky_ghi(t: Instant) -> f64 {
+    let p = sun_at(t);
+    let inputs = ClearSkyInputs {
+        linke_turbidity: 3.0,
+        elevation_m: ZURICH.elevation_m,
+        pressure_mbar: Atmosphere::standard(ZURICH.elevation_m).pressure_mbar,
+        distance_au: p.distance_au,
+    };
+    ineichen_perez(p.zenith_deg, &inputs).ghi
+}
+
+/// The `sunshade` JSON attribute of an EXR sunshade wrote.
+fn exr_record(path: &Path) -> serde_json::Value {
+    let meta = exr::meta::MetaData::read_from_file(path, false).unwrap();
+    match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
+        other => panic!("sunshade attribute: {other:?}"),
+    }
+}
+
 /// Midpoints and lengths [h] of `[from, to)` in steps of `step_h` hours; asserts that no midpoint's sun sits
 /// within 0.3° of the horizon, where the disk sun is partly below a horizontal roof and `E⊥ cos θ` is not exact.
 fn midpoints(from: &str, to: &str, step_h: f64) -> Vec<(Instant, f64)> {
@@ -121,10 +142,7 @@ fn a_roof_over_a_day_is_the_sum_of_the_suns_normal_irradiance_times_the_cosine()
         let meta = exr::meta::MetaData::read_from_file(&out, false).unwrap();
         let layer = &meta.headers[0].own_attributes;
         assert_eq!(layer.layer_name.as_ref().map(|n| n.to_string()), Some("irradiation".to_string()));
-        let all: serde_json::Value = match layer.other.get(&exr::prelude::Text::from("sunshade")) {
-            Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
-            other => panic!("sunshade attribute: {other:?}"),
-        };
+        let all = exr_record(&out);
         assert!(all["quantity"].as_str().unwrap().starts_with("irradiation Wh/m2"), "{all}");
         assert_eq!(all["sunshadeAccumulation"]["steps_total"], 24, "{all}");
     }
@@ -137,19 +155,7 @@ fn a_roof_under_the_clear_sky_gathers_its_global_horizontal_irradiation() {
     let dir = TempDir::new("roof-clear");
     let roof = dir.write("roof.glb", &plane(Vec3::Z, Vec3::X, Vec3::ZERO));
     let (from, to) = ("2026-06-15T00:10:00+02:00", "2026-06-16T00:10:00+02:00");
-    let truth: f64 = midpoints(from, to, 2.0)
-        .iter()
-        .map(|&(t, hours)| {
-            let p = sun_at(t);
-            let inputs = ClearSkyInputs {
-                linke_turbidity: 3.0,
-                elevation_m: ZURICH.elevation_m,
-                pressure_mbar: Atmosphere::standard(ZURICH.elevation_m).pressure_mbar,
-                distance_au: p.distance_au,
-            };
-            ineichen_perez(p.zenith_deg, &inputs).ghi * hours
-        })
-        .sum();
+    let truth: f64 = midpoints(from, to, 2.0).iter().map(|&(t, hours)| clear_sky_ghi(t) * hours).sum();
     let out = dir.path("clear.exr");
     let o = sunshade(
         &[
@@ -286,14 +292,7 @@ fn time_and_place_set_the_sun_and_a_night_is_dark_with_a_warning() {
     assert!(image.pixels().iter().all(|p| p[0] == 0.0 && p[1] == 0.0 && p[2] == 0.0));
     // At noon the roof is lit by the sun and sky of the clear-sky model: irradiance = GHI.
     let noon = Instant::parse("2026-06-21T13:30:00+02:00").unwrap();
-    let p = sun_at(noon);
-    let inputs = ClearSkyInputs {
-        linke_turbidity: 3.0,
-        elevation_m: ZURICH.elevation_m,
-        pressure_mbar: Atmosphere::standard(ZURICH.elevation_m).pressure_mbar,
-        distance_au: p.distance_au,
-    };
-    let ghi = ineichen_perez(p.zenith_deg, &inputs).ghi;
+    let (p, ghi) = (sun_at(noon), clear_sky_ghi(noon));
     let o = sunshade(
         &[
             &["render", s(&roof), "-o", s(&out), "--time", "2026-06-21T13:30:00+02:00", "--location", PLACE][..],
@@ -306,11 +305,7 @@ fn time_and_place_set_the_sun_and_a_night_is_dark_with_a_warning() {
     let worst = worst_relative(&covered(&sunshade::film::read_image(&out).unwrap(), 500), ghi);
     assert!(worst <= 1e-5, "noon: {worst:e} against GHI {ghi}");
     // The image records where the sun stood and what the clear sky gave.
-    let meta = exr::meta::MetaData::read_from_file(&out, false).unwrap();
-    let all: serde_json::Value = match meta.headers[0].own_attributes.other.get(&exr::prelude::Text::from("sunshade")) {
-        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string()).unwrap(),
-        other => panic!("sunshade attribute: {other:?}"),
-    };
+    let all = exr_record(&out);
     let recorded = &all["sunshadeDaylight"];
     assert_eq!(recorded["time"], "2026-06-21T11:30:00Z", "{all}");
     assert!((recorded["zenith_deg"].as_f64().unwrap() - p.zenith_deg).abs() < 1e-12, "{all}");

@@ -223,6 +223,28 @@ impl Accumulated {
         meta
     }
 
+    /// Writes the image (with its record) and the false colour if asked; with `verbose`, prints what was rendered,
+    /// the exposure and `phases`.
+    pub fn finish(
+        &self,
+        a: &SceneArgs,
+        output: &super::args::OutputArgs,
+        renderer: &str,
+        verbose: Option<(&[(&str, Duration)], Clock)>,
+    ) -> Result<(), CliError> {
+        let meta = self.metadata(a, renderer);
+        let ev = crate::film::write_image_with(&self.image, &output.output, output.exposure(), &meta)?;
+        output.write_false_color(&self.image, a.quantity)?;
+        super::warn_if_nothing_covered(&self.image, &a.scene);
+        if let Some((phases, started)) = verbose {
+            self.print();
+            super::print_exposure(ev);
+            let frames = [("frames", self.frames)];
+            super::print_phases(&[phases, &frames[..]].concat(), started.elapsed());
+        }
+        Ok(())
+    }
+
     /// `-v`: what was rendered and what it cost.
     pub fn print(&self) {
         eprintln!(

@@ -167,14 +167,6 @@ fn run_accumulation(a: &ReferenceCommand, started: Instant) -> Result<(), CliErr
         settings.shading.shadows = cpu::shadow_choice_where(scene_can_occlude, &settings, &options).technique;
         Ok(cpu::render(&scene, &settings, &options))
     })?;
-    let meta = done.metadata(&a.scene, "cpu reference");
-    let ev = write_image_with(&done.image, &a.output.output, a.output.exposure(), &meta)?;
-    a.output.write_false_color(&done.image, a.scene.quantity)?;
-    warn_if_nothing_covered(&done.image, &a.scene.scene);
-    if a.verbose {
-        done.print();
-        print_exposure(ev);
-        print_phases(&[("load", load_time), ("frames", done.frames)], started.elapsed());
-    }
-    Ok(())
+    let phases = [("load", load_time)];
+    done.finish(&a.scene, &a.output, "cpu reference", a.verbose.then_some((&phases[..], started)))
 }

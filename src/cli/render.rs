@@ -341,17 +341,11 @@ fn run_accumulation(session: &mut Session, a: &RenderArgs, started: Instant) -> 
     for w in session.save_pipeline_caches() {
         super::warn(&format!("pipeline cache not saved: {w}"));
     }
-    let meta = done.metadata(&a.scene, &session.renderer_description(renderer));
-    let ev = write_image_with(&done.image, &a.output.output, a.output.exposure(), &meta)?;
-    a.output.write_false_color(&done.image, a.scene.quantity)?;
-    warn_if_nothing_covered(&done.image, &a.scene.scene);
-    if a.verbose {
-        done.print();
-        print_exposure(ev);
-        print_phases(
-            &[("load", load), ("upload", upload), ("pipelines", pipelines), ("frames", done.frames)],
-            started.elapsed(),
-        );
-    }
-    Ok(())
+    let phases = [("load", load), ("upload", upload), ("pipelines", pipelines)];
+    done.finish(
+        &a.scene,
+        &a.output,
+        &session.renderer_description(renderer),
+        a.verbose.then_some((&phases[..], started)),
+    )
 }
