@@ -7,6 +7,7 @@ mod common;
 
 use common::CheckedRenderer;
 use glam::{DVec3, Vec3};
+use sunshade::accuracy::predicted;
 use sunshade::authoring::shapes::{quad, MeshData};
 use sunshade::cpu;
 use sunshade::scene::{Brdf, Camera, DiskLight, Lights, Material, Projection, Scene, Sun};
@@ -99,8 +100,22 @@ fn the_floor_under_a_disk_skylight_is_the_view_factor_everywhere() {
             let (worst, n) = worst_relative(&image, &s, exact);
             eprintln!("disk skylight, albedo {albedo}, {name}: {n} pixels, max relative error {worst:.2e}");
             assert!(n == 96 * 96 && worst <= 1e-5, "{name}: max relative error {worst:e} over {n} pixels");
+            // The predicted bound covers the measurement, with nothing left unbounded.
+            let renderer = match name {
+                "gpu" => predicted::Renderer::Gpu { exact_interpolation: true },
+                _ => predicted::Renderer::Reference,
+            };
+            let p = predicted::predict(&sc, &s, renderer, false);
+            assert!(p.unbounded.is_empty() && worst <= p.max_relative.max(1e-6), "{name}: {}", p.line());
         }
     }
+    // Irradiance has no lobes: a specular material changes neither the image nor the prediction.
+    let shiny = common::scene_of(
+        std::slice::from_ref(&floor),
+        Material::with_brdf("shiny", Brdf::Phong { kd: [0.2; 3], ks: [0.5; 3], exponent: 5000.0 }),
+    );
+    let p = predicted::predict(&shiny, &s, predicted::Renderer::Gpu { exact_interpolation: true }, false);
+    assert!(p.unbounded.is_empty() && p.max_relative <= 1e-5, "{}", p.line());
 }
 
 #[test]

@@ -6,11 +6,12 @@
 //! in [`Prediction::unbounded`] instead of being silently left out: disk lights and the sky on specular surfaces
 //! (their lobe grids; on Lambertian ones their closed forms are exact, and the small-source estimate unbounded),
 //! penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and shadows turned
-//! off in a scene that can shadow itself (there the error is up to 100%).
+//! off in a scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes:
+//! its lights' closed forms are exact ([`predict_irradiance`]).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, ShadingOptions, Shadows, SunModel};
+use crate::shading::{DiskModel, Quantity, ShadingOptions, Shadows, SunModel};
 
 use super::bounds::{
     horizon_bound, horizon_error, peak_lower_bound, sharpest_brdf, sun_delta_bound, sun_grid_bound,
@@ -185,6 +186,9 @@ pub fn predict_with_peak(
     can_occlude: bool,
     rendered: Option<f64>,
 ) -> Prediction {
+    if settings.shading.quantity == Quantity::Irradiance {
+        return predict_irradiance(settings, renderer, can_occlude);
+    }
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let lights = &settings.lights;
     let shading = &settings.shading;
@@ -233,6 +237,40 @@ pub fn predict_with_peak(
             p.unbounded.push("the sky (its lobe grid)".into());
         }
     }
+    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude);
+    p
+}
+
+/// The prediction of an irradiance image: no material enters, so no lobe grid; each light's irradiance is its
+/// closed form (the disk sun's, partly set disk included; an exact disk light's projected solid angle; the sky's
+/// `π L (1 + cos t)/2`), exact but for the arithmetic. Left unbounded: the delta sun where its disk would
+/// straddle a surface's horizon (absolute error up to `(2/(3π)) r E⊥`, which no floor relates to the image's
+/// peak without knowing it), the small-source estimate, and occlusion as for radiance.
+fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude: bool) -> Prediction {
+    let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
+    let (lights, shading) = (&settings.lights, &settings.shading);
+    if lights.sun.is_some() {
+        match shading.sun {
+            SunModel::Disk => p.terms.push(("irradiance of the disk sun (closed form):".into(), 0.0)),
+            SunModel::Delta => p.unbounded.push("the delta sun near surfaces' horizons".into()),
+        }
+    }
+    if !lights.disks.is_empty() {
+        match shading.disk {
+            DiskModel::Exact => p.terms.push(("irradiance of the disk lights (exact):".into(), 0.0)),
+            DiskModel::SmallSource => p.unbounded.push("the disk lights' small-source estimate".into()),
+        }
+    }
+    if lights.sky.is_some() {
+        p.terms.push(("irradiance of the sky (closed form):".into(), 0.0));
+    }
+    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude);
+    p
+}
+
+/// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, and what no bound
+/// covers), and the renderer's arithmetic and interpolation.
+fn occlusion_and_arithmetic(p: &mut Prediction, shading: &ShadingOptions, renderer: Renderer, can_occlude: bool) {
     if can_occlude {
         match shading.shadows {
             Shadows::None => {
@@ -250,7 +288,6 @@ pub fn predict_with_peak(
             p.unbounded.push("f32 or device interpolation".into());
         }
     }
-    p
 }
 
 /// `--tolerance`: the cheapest sun model for `scene` whose predicted error (with the GPU's arithmetic on the
