@@ -100,7 +100,7 @@ pub fn accumulate(
     for &k in &mine {
         let step = all[k];
         hours_in_shard += step.hours;
-        let at = d.at(step.midpoint).expect("--location is required with --from");
+        let Some(at) = d.at(step.midpoint) else { return Err(no_location()) };
         bar.inc(1);
         if !at.position.is_up() {
             continue;
@@ -135,7 +135,7 @@ pub fn accumulate(
     let first_settings = match first_settings {
         Some(s) => s,
         None => {
-            let at = d.at(from).expect("--location is required with --from");
+            let Some(at) = d.at(from) else { return Err(no_location()) };
             let mut lights = a.light_options_at(Some(&at));
             lights.sun.irradiance = Some(0.0);
             lights.sky = Some([0.0; 3]);
@@ -161,6 +161,10 @@ pub fn accumulate(
         frames,
         accumulating,
     })
+}
+
+fn no_location() -> CliError {
+    CliError::Usage("an accumulation needs --location".into())
 }
 
 /// Adds one step: `E·Δt` per channel (irradiation), or `Δt` on every channel where the direct irradiance
