@@ -81,6 +81,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         ProgressStyle::with_template("{spinner} {elapsed} {pos} settings measured: {msg}").expect("template"),
     );
     let mut charts = Vec::new();
+    let mut costs = Vec::new();
     for path in &scenes {
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let scene = scene::load_with_options(path, &LoadOptions::default())?;
@@ -152,6 +153,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             );
         }
         out += "\n";
+        costs.push((name.clone(), exactness_cost(&rows)));
         for (metric, fronts, value) in [
             ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),
             ("p99 relative error", &front_p99, |e: &ImageError| e.p99),
@@ -176,6 +178,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         bar.suspend(|| eprintln!("sunshade bench: {name} done ({} settings)", rows.len()));
     }
     bar.finish_and_clear();
+    out += &exactness_table(&costs);
     if let Some(plot) = &a.plot {
         write_plot(plot, &charts)?;
     }
@@ -185,6 +188,58 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         eprintln!("sunshade bench: updated {}", doc.display());
     }
     Ok(())
+}
+
+/// The tolerances of "what exactness costs".
+const COST_TOLERANCES: [f64; 3] = [1e-2, 1e-3, 1e-4];
+
+/// For one scene: the default setting's frame time and max error (row 1 of the sweep), and for each of
+/// [`COST_TOLERANCES`] the fastest measured setting whose max relative error meets it (its row number and frame
+/// time), or `None` where no setting does.
+struct ExactnessCost {
+    default_ms: f64,
+    default_max_rel: f64,
+    fastest: [Option<(usize, f64)>; 3],
+}
+
+fn exactness_cost(rows: &[Row]) -> ExactnessCost {
+    let fastest = COST_TOLERANCES.map(|t| {
+        rows.iter()
+            .enumerate()
+            .filter(|(_, r)| r.error.max_rel <= t)
+            .min_by(|a, b| a.1.frame_ms.total_cmp(&b.1.frame_ms))
+            .map(|(i, r)| (i + 1, r.frame_ms))
+    });
+    ExactnessCost { default_ms: rows[0].frame_ms, default_max_rel: rows[0].error.max_rel, fastest }
+}
+
+/// "What exactness costs", every scene: the default settings' frame against the fastest setting that still meets
+/// each tolerance (measured against the converged reference, from the tables above).
+fn exactness_table(costs: &[(String, ExactnessCost)]) -> String {
+    let mut out = String::from(
+        "**What exactness costs** (from the tables above): the default settings (row 1) against the fastest \
+         setting whose max relative error meets each tolerance; `default / fastest` is how much the default's \
+         accuracy costs over what that tolerance needs (1.00×: the default is itself the fastest meeting it; \
+         below 1: the default does not meet it and the fastest setting that does is slower; — where no \
+         setting meets it).\n\n\
+         | scene | default [ms] | default max rel | fastest ≤ 1e-2: row, [ms], default / fastest | fastest ≤ 1e-3 | fastest ≤ 1e-4 |\n\
+         |---|---:|---:|---|---|---|\n",
+    );
+    for (name, c) in costs {
+        let cells: Vec<String> = c
+            .fastest
+            .iter()
+            .map(|f| match f {
+                Some((row, ms)) => format!("#{row}, {ms:.2}, {:.2}×", c.default_ms / ms),
+                None => "—".into(),
+            })
+            .collect();
+        out += &format!(
+            "| {name} | {:.2} | {:.2e} | {} | {} | {} |\n",
+            c.default_ms, c.default_max_rel, cells[0], cells[1], cells[2]
+        );
+    }
+    out + "\n"
 }
 
 /// The charts in one PNG, two a row (each scene's max and p99 side by side).
@@ -197,4 +252,32 @@ fn write_plot(path: &Path, charts: &[LogLogChart]) -> Result<(), CliError> {
     canvas.write_png(path).map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
     eprintln!("sunshade bench: wrote {}", path.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(frame_ms: f64, max_rel: f64) -> Row {
+        let error = ImageError { max_rel, p99: max_rel, rmse: 0.0, over: [0; 3], compared: 1, coverage_mismatches: 0 };
+        Row { label: String::new(), frame_ms, spread_ms: 0.0, error, predicted: (0.0, false) }
+    }
+
+    #[test]
+    fn exactness_cost_takes_the_fastest_setting_meeting_each_tolerance() {
+        // Row 1 the default (40 ms, 2e-4); a fast rough one, a middle one, a slow exact one.
+        let rows = [row(40.0, 2e-4), row(5.0, 5e-3), row(10.0, 8e-4), row(80.0, 1e-6)];
+        let c = exactness_cost(&rows);
+        assert_eq!((c.default_ms, c.default_max_rel), (40.0, 2e-4));
+        assert_eq!(c.fastest, [Some((2, 5.0)), Some((3, 10.0)), Some((4, 80.0))]);
+        let table = exactness_table(&[("x.glb".into(), c)]);
+        assert!(
+            table.contains("| x.glb | 40.00 | 2.00e-4 | #2, 5.00, 8.00× | #3, 10.00, 4.00× | #4, 80.00, 0.50× |"),
+            "{table}"
+        );
+        // Nothing meets 1e-4: a dash, not a number.
+        let c = exactness_cost(&[row(40.0, 2e-3)]);
+        assert_eq!(c.fastest, [Some((1, 40.0)), None, None]);
+        assert!(exactness_table(&[("y.glb".into(), c)]).contains("| — | — |"));
+    }
 }
