@@ -105,15 +105,12 @@ pub fn accumulate(
         if !at.position.is_up() {
             continue;
         }
-        let mut lights = a.light_options_at(Some(&at));
-        if sun_hours {
-            // Direct sun only, at its own E⊥: the threshold is on the direct irradiance of the surface.
-            lights.disks.clear();
-            lights.sky = None;
-        }
+        let lights = a.light_options_at(Some(&at));
         let mut settings = settings::resolve_with(scene, width, height, &a.camera_options(), &lights)
             .map_err(|e| CliError::Usage(e.to_string()))?;
         if sun_hours {
+            // Direct sun only, at its own E⊥: the threshold is on the direct irradiance of the surface (the
+            // scene's own disks and sky, which resolving adds, removed too).
             settings.lights.disks.clear();
             settings.lights.sky = None;
         }
@@ -178,7 +175,7 @@ fn add_step(sum: &mut [[f64; 3]], image: &Image, hours: f64, threshold: Option<f
                 }
             }
             Some(t) => {
-                let e = 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+                let e = crate::plot::false_color::pixel_value(*p);
                 if p[3] > 0.0 && e >= t && e > 0.0 {
                     for v in acc.iter_mut() {
                         *v += hours;

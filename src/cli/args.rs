@@ -345,10 +345,6 @@ impl SceneArgs {
         CameraOptions { camera: self.camera, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
     }
 
-    pub fn light_options(&self) -> LightOptions {
-        self.light_options_at(self.daylight.at_time().as_ref())
-    }
-
     /// The light options with the sun and clear sky of `daylight` (the flags' own where they give them): the sun's
     /// direction from its position; its `E⊥` the clear sky's direct normal irradiance unless --sun-irradiance or
     /// --sun-radiance; the sky the clear sky's uniform equivalent unless --sky-radiance. A sun below the horizon

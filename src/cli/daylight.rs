@@ -286,7 +286,7 @@ pub struct SunCommand {
 pub fn run_sun(a: &SunCommand) -> Result<(), super::CliError> {
     let d = &a.daylight;
     d.check().map_err(super::CliError::Usage)?;
-    let (Some(_), Some(at)) = (d.time, d.at_time()) else {
+    let Some(at) = d.at_time() else {
         return Err(super::CliError::Usage("sunshade sun needs --time and --location".into()));
     };
     if a.json {

@@ -264,10 +264,11 @@ pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliErr
 
 /// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
 pub(crate) fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
-    if let Some(w) = a.daylight.at_time().and_then(|d| d.below_horizon_warning()) {
+    let daylight = a.daylight.at_time();
+    if let Some(w) = daylight.as_ref().and_then(|d| d.below_horizon_warning()) {
         warn_once(&w);
     }
-    settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options())
+    settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options_at(daylight.as_ref()))
         .map_err(|e| CliError::Usage(e.to_string()))
 }
 

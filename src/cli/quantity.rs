@@ -54,12 +54,10 @@ pub fn pretty_unit(ascii: &str) -> String {
 impl std::str::FromStr for RequestedQuantity {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "radiance" => Ok(RequestedQuantity::Radiance),
-            "irradiance" => Ok(RequestedQuantity::Irradiance),
-            "irradiation" => Ok(RequestedQuantity::Irradiation),
-            "sun-hours" => Ok(RequestedQuantity::SunHours),
-            _ => Err(format!("'{s}' is not a quantity (radiance, irradiance, irradiation, sun-hours)")),
-        }
+        let all = [Self::Radiance, Self::Irradiance, Self::Irradiation, Self::SunHours];
+        all.into_iter().find(|q| q.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|q| q.name()).collect();
+            format!("'{s}' is not a quantity ({})", names.join(", "))
+        })
     }
 }

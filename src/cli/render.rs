@@ -325,12 +325,10 @@ fn run_accumulation(session: &mut Session, a: &RenderArgs, started: Instant) -> 
     let upload = session.upload(scene, renderer)?;
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let mut pipelines = std::time::Duration::ZERO;
-    let mut warned = false;
     let done = super::accumulate::accumulate(scene_data, &a.scene, |settings| {
         let choice = r.shadow_choice(gpu_scene, settings)?;
-        if choice.warning && !warned {
+        if choice.warning {
             super::warn_once(&format!("shadows: {}", choice.reason));
-            warned = true;
         }
         let mut settings = settings.clone();
         settings.shading.shadows = choice.technique;

@@ -39,14 +39,3 @@ impl Quantity {
         }
     }
 }
-
-impl std::str::FromStr for Quantity {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "radiance" => Ok(Quantity::Radiance),
-            "irradiance" => Ok(Quantity::Irradiance),
-            _ => Err(format!("'{s}' is not a quantity (radiance, irradiance)")),
-        }
-    }
-}
