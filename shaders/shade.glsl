@@ -281,9 +281,10 @@ float measured_sampling_alpha(float lobe_width) {
     return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
 }
 
-// integral of lobe (n.w)+ over the hemisphere (the sky, per unit radiance): a stratified grid through the lobe's
-// inverse CDF, each sample weighted by lobe/pdf (see the Rust).
-vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+// integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
+// lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
+// (see the Rust).
+vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
     vec3 n = p.normal;
     vec3 v = p.to_viewer;
     uint kind = VARIANT_BRDF;
@@ -302,7 +303,7 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                 float e = m.ks.w;
                 vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
                 float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
-                if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
                     sum += value;
                 }
             } else if (kind == BRDF_BLINN_PHONG) {
@@ -312,7 +313,7 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                 if (vh > 0.0) {
                     vec3 omega = 2.0 * vh * h - v;
                     float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
-                    if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
                         sum += value;
                     }
                 }
@@ -330,7 +331,7 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                 if (vh > 0.0) {
                     vec3 omega = 2.0 * vh * h - v;
                     float value = max(dot(n, omega), 0.0) / (vh * cos_d);
-                    if (!(value > 0.0) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
                         sum += value;
                     }
                 }
@@ -346,7 +347,7 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
                     vec3 omega = 2.0 * vh * h - v;
                     float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
                     vec3 value = specular_lobe_rgb(m, p, omega) * weight;
-                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || visible_along(p.shadow_origin, omega)) {
+                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
                         sum += value;
                     }
                 }
@@ -354,6 +355,94 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
         }
     }
     return sum / (k * k);
+}
+
+// Which lune of the hemisphere the horizontal splits off (see sky_lune.rs).
+const uint LUNE_BELOW = 0u;
+const uint LUNE_ABOVE = 1u;
+
+// How far the sky's lobe integral is taken over the upper lune directly rather than as the hemisphere's less the
+// lower lune's: 0 with the lobe's peak (the mirror of the viewer) above the horizontal by more than a quarter of
+// its width (at most 1 rad), 1 below by more than that, linear between, scaled by the tilt from up over that
+// quarter width (at most 1; see sky_lune.rs).
+float sky_lune_blend(MaterialGpu m, Frame p) {
+    vec3 n = p.normal;
+    vec3 r = mirror(p.to_viewer, n);
+    float quarter = 0.25 * min(lobe_width(m), 1.0);
+    float tilt = atan2_accurate(length(vec3(0.0, 1.0, 0.0) - n.y * n), n.y);
+    // A measured table takes the upper lune wherever the surface is tilted (see the Rust).
+    float below = VARIANT_BRDF == BRDF_MEASURED ? 1.0 : clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0);
+    return below * min(tilt / quarter, 1.0);
+}
+
+// integral of lobe (n.w)+ over one lune of the hemisphere (LUNE_BELOW or LUNE_ABOVE the horizontal), per unit
+// radiance: a midpoint grid in lune coordinates w = cos(lambda) (cos(psi) n + sin(psi) b) + sin(lambda) e, graded
+// about the lobe's peak; the upper lune's samples cast shadow rays where `shadowed` (see sky_lune.rs).
+vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool shadowed) {
+    vec3 n = p.normal;
+    vec3 across = vec3(0.0, 1.0, 0.0) - n.y * n;
+    float sin_t = length(across);
+    float tilt = atan2_accurate(sin_t, n.y);
+    float psi_lo = lune == LUNE_BELOW ? -0.5 * PI : tilt - 0.5 * PI;
+    float psi_hi = lune == LUNE_BELOW ? tilt - 0.5 * PI : 0.5 * PI;
+    if (!(psi_hi > psi_lo) || VARIANT_BRDF == BRDF_LAMBERT) {
+        return vec3(0.0);
+    }
+    vec3 b = sin_t > 0.0 ? across / sin_t : orthonormal_to(n);
+    vec3 e = cross(n, b);
+    vec3 r = mirror(p.to_viewer, n);
+    float psi_r = atan2_accurate(dot(r, b), dot(r, n));
+    float rn = dot(r, n);
+    float rb = dot(r, b);
+    float lambda_r = atan2_accurate(dot(r, e), sqrt(rn * rn + rb * rb));
+    float cos_lambda_r = cos(lambda_r);
+    float outside = max(max(psi_r - psi_hi, psi_lo - psi_r), 0.0) * cos_lambda_r;
+    float width = lobe_width(m);
+    float w = outside > 0.0 ? width * width / (width + outside) : width;
+    float psi_c = clamp(psi_r, psi_lo, psi_hi);
+    float width_psi = min(w / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
+    float width_lambda = min(w, 16.0 * PI);
+    vec2 psi_ends = sinh_warp_ends(psi_lo, psi_hi, psi_c, width_psi);
+    vec2 lambda_ends = sinh_warp_ends(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
+    float blend_psi = uniform_blend(width_psi, psi_hi - psi_lo);
+    float blend_lambda = uniform_blend(width_lambda, PI);
+    float k = float(per_axis);
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < per_axis; ++i) {
+        float u = (float(i) + 0.5) / k;
+        vec2 pw = blended_point(psi_lo, psi_hi, sinh_warp(psi_lo, psi_hi, psi_c, width_psi, psi_ends, u), blend_psi, u);
+        float sp = sin(pw.x);
+        float cp = cos(pw.x);
+        for (uint j = 0u; j < per_axis; ++j) {
+            float ul = (float(j) + 0.5) / k;
+            vec2 lw = blended_point(-0.5 * PI, 0.5 * PI,
+                sinh_warp(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda, lambda_ends, ul), blend_lambda, ul);
+            float sl = sin(lw.x);
+            float cl = cos(lw.x);
+            vec3 omega = cl * (cp * n + sp * b) + sl * e;
+            float weight = cl * cl * max(cp, 0.0) * pw.y * lw.y;
+            vec3 value = specular_lobe_rgb(m, p, omega) * weight;
+            if (lune == LUNE_BELOW || !any(greaterThan(value, vec3(0.0))) || !shadowed
+                || visible_along(p.shadow_origin, omega)) {
+                sum += value;
+            }
+        }
+    }
+    return sum / (k * k);
+}
+
+// integral of lobe (n.w)+ over the sky (the hemisphere above the horizontal, per unit radiance): the hemisphere's
+// inverse-CDF grid less the lower lune while the lobe's peak is above the horizontal, the upper lune's own grid
+// once it is below, a blend between; at least 0 (see the Rust).
+vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+    float s = sky_lune_blend(m, p);
+    vec3 direct = s > 0.0 ? sky_lobe_in_lune(m, p, per_axis, LUNE_ABOVE, shadowed) : vec3(0.0);
+    vec3 by_difference = vec3(0.0);
+    if (s < 1.0) {
+        by_difference = max(sky_lobe_hemisphere_grid(m, p, per_axis, shadowed)
+            - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false), vec3(0.0));
+    }
+    return (1.0 - s) * by_difference + s * direct;
 }
 
 // Outgoing radiance [W/(m^2 sr)] per channel from the visible part of each light. `p.normal` is unit (or 0) on

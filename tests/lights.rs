@@ -389,6 +389,55 @@ fn overcast_sky_on_tilted_planes_and_a_sphere() {
     assert!(checked[..4].iter().all(|&c| c >= 100) && checked[4] >= 500, "checked pixels per surface: {checked:?}");
 }
 
+/// The sky is the upper hemisphere for the specular lobes too: a glossy wall (Phong e = 100, a lobe that
+/// integrates to 1 at normal view) seen head on by an orthographic camera has its mirror direction on the
+/// horizontal, so half of its lobe sees the sky and half the ground: `L = kd/π · π L0/2 + ks L0 / 2`, on both
+/// renderers. (Before the lobes knew the horizontal, the specular part was the whole `ks L0`.) The lobe's grid is
+/// the default 16²; 1e-3 covers its error there (the analytic half is checked to 1e-3 at 64² in the unit tests).
+#[test]
+fn a_glossy_wall_sees_the_sky_with_half_of_its_lobe() {
+    let dir = TempDir::new("sky-wall");
+    let l0 = 100.0f32;
+    let (kd, ks) = (0.3f64, 0.6f64);
+    let mut b = GltfBuilder::new();
+    let m = b.add_material(
+        "glossy",
+        [0.5; 3],
+        false,
+        Some(json!({ "sunshade": { "brdf": "phong", "kd": [kd, kd, kd], "ks": [ks, ks, ks], "exponent": 100.0 } })),
+    );
+    // A wall in the XY plane facing +Z.
+    let wall = quad(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
+    let mesh = b.add_mesh("wall", &[wall.primitive(Some(m))]);
+    let node = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[node], Some(json!({ "sunshade": { "sky_radiance": l0 } })));
+    let scene = load(&dir.write("wall.glb", &b));
+    let camera = Camera::looking(
+        DVec3::new(0.0, 0.0, 10.0),
+        -DVec3::Z,
+        DVec3::Y,
+        Projection::Orthographic { ymag: 1.5, znear: 1.0, zfar: 20.0 },
+    )
+    .unwrap();
+    let s = RenderSettings::new(48, 48, camera, scene.lights.clone());
+    let mut gpu = CheckedRenderer::new();
+    let want = kd / PI * (PI * l0 as f64 * 0.5) + ks * l0 as f64 * 0.5;
+    let mut checked = 0;
+    for (who, img) in both(&mut gpu, &scene, &s) {
+        for y in 0..s.height {
+            for x in 0..s.width {
+                let got = img.get(x, y);
+                if got[3] == 0.0 {
+                    continue;
+                }
+                checked += 1;
+                assert!(rel(got[0] as f64, want) <= 1e-3, "{who} ({x},{y}): {} vs {want}", got[0]);
+            }
+        }
+    }
+    assert!(checked > 1000, "{checked} pixels checked");
+}
+
 #[test]
 fn the_setting_sun_dims_continuously_and_monotonically() {
     let dir = TempDir::new("sunset");

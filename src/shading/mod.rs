@@ -12,6 +12,7 @@ pub mod quadrature;
 pub mod quantity;
 pub mod radiometry;
 mod shade;
+pub mod sky_lune;
 pub mod surface;
 pub mod texture_filter;
 pub mod visibility;

@@ -1,0 +1,246 @@
+//! The sky below the horizontal: the part of a surface's hemisphere that is not sky.
+//!
+//! The sky is uniform over the upper hemisphere (`ω·up > 0`, up = +Y), so a surface tilted by `t` from up sees
+//! it through the **upper lune** `{n·ω > 0, ω·up > 0}` of dihedral angle `π − t`: its irradiance is
+//! `π L (1 + cos t)/2` (`radiometry::sky_irradiance`). The lobe integral is sampled through each lobe's own
+//! inverse CDF over the whole hemisphere about n (`shade::sky_lobe_integral_visible`), which cannot clip at the
+//! horizontal without an indicator that jumps inside the grid's cells (a sample flipping between the GPU and the
+//! reference would move a pixel by its whole weight). So the integral over the **lower lune**
+//! `L⁻ = {n·ω > 0, ω·up < 0}` is computed here on a grid whose edges are the lune's own, and subtracted.
+//!
+//! **Lune coordinates.** With `b` the unit component of up across n (`up = cos t n + sin t b`) and `e = n × b`,
+//! `ω = cos λ (cos ψ n + sin ψ b) + sin λ e` maps the rectangle `ψ ∈ (−π/2, t − π/2)`, `λ ∈ (−π/2, π/2)` onto
+//! `L⁻` exactly (`n·ω = cos λ cos ψ > 0`, `ω·up = cos λ cos(ψ − t) < 0`), with `dω = cos λ dψ dλ`. The integrand
+//! `lobe(ω) cos²λ cos ψ` is smooth on the closed rectangle (it vanishes at the surface's horizon ψ = −π/2 and at
+//! the poles λ = ±π/2), so the midpoint rule keeps its 1/k² convergence. As for disk lights
+//! (`shade::segment_lobe_integral`) the grid is graded by `sinh_warp` about the lobe's peak (the mirror direction
+//! of the viewer) with the lobe's width, and blends into the uniform grid for wide lobes; everything is
+//! continuous in the inputs, so no sample switches on or off between the renderers.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use glam::DVec3;
+
+use super::brdf::mirror;
+use super::shade::{
+    blended_point, lobe_width, orthonormal_to, sinh_warp, sinh_warp_ends, specular_lobe_rgb, uniform_blend,
+    SurfacePoint,
+};
+use super::visibility::Shadowing;
+use crate::scene::Brdf;
+
+/// Which of the two lunes a surface's hemisphere is split into by the horizontal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lune {
+    /// `{n·ω > 0, ω·up < 0}`: not sky.
+    Below,
+    /// `{n·ω > 0, ω·up > 0}`: the sky's part of the hemisphere.
+    Above,
+}
+
+/// How far the sky's lobe integral is taken directly over the upper lune rather than as the hemisphere's less
+/// the lower lune's: 0 while the lobe's peak (the mirror direction of the viewer) is above the horizontal by more
+/// than a quarter of the lobe's width w (at most 1 rad), 1 once it is below by more than that, linear between, so
+/// the result is continuous in the inputs. Above, the lower lune holds only the lobe's tail and the difference
+/// keeps the inverse-CDF grid's accuracy; below, the difference would be a small remainder of two nearly equal
+/// sums, each sum's error amplified by their ratio, so the upper lune's own grid (which holds the tail) is taken.
+/// Measured with a blend over a whole width instead of a quarter: on a grazing view of a measured table whose
+/// peak was 0.9 of a width below (weight 0.03 on the difference), the sky moved by 1.6e-4 for a 2e-7 turn of the
+/// viewer (f32's rounding), from 1e-6 in each sum. The blend reads only the geometry: one that read the sums' ratio
+/// moved with their rounding (3e-5 between the renderers on brdfs.glb's undersides).
+///
+/// It is scaled by the surface's tilt from up over that quarter width (at most 1): a surface tilted less has a
+/// lower lune too thin to hold much of the lobe, and one facing straight up has none, so floors keep the
+/// hemisphere's grid alone (their images are those of the grid before the lobes knew the horizontal).
+pub fn sky_lune_blend(brdf: &Brdf, p: &SurfacePoint) -> f64 {
+    let n = p.normal;
+    let r = mirror(p.to_viewer, n);
+    let quarter = 0.25 * lobe_width(brdf).min(1.0);
+    let tilt = (DVec3::Y - n.y * n).length().atan2(n.y);
+    // A measured table takes the upper lune wherever the surface is tilted (see `sky_lobe_integral_visible`).
+    let below = if matches!(brdf, Brdf::Measured { .. }) { 1.0 } else { (0.5 - r.y / (2.0 * quarter)).clamp(0.0, 1.0) };
+    below * (tilt / quarter).min(1.0)
+}
+
+/// `∫ lobe(ω) (n·ω)+ dω` over one lune of the surface's hemisphere (`Below` or `Above` the horizontal), per unit
+/// radiance, per channel: a `per_axis²` midpoint grid in lune coordinates graded about the lobe's peak (see the
+/// module's text), each sample of the upper lune casting its shadow ray along ω where `shadow` is given (the lower
+/// lune is not sky and casts none). 0 for a Lambertian BRDF, and for the lower lune of a surface facing up.
+pub fn sky_lobe_in_lune(
+    brdf: &Brdf,
+    p: &SurfacePoint,
+    per_axis: u32,
+    lune: Lune,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
+    let n = p.normal;
+    // up = cos t n + sin t b. sin t as the length of up's part across n: `sqrt(1 − cos²t)` would cancel for
+    // surfaces nearly facing up, whose thin lune is then placed by a wrong t.
+    let across = DVec3::Y - n.y * n;
+    let sin_t = across.length();
+    let tilt = sin_t.atan2(n.y);
+    let (psi_lo, psi_hi) = match lune {
+        Lune::Below => (-FRAC_PI_2, tilt - FRAC_PI_2),
+        Lune::Above => (tilt - FRAC_PI_2, FRAC_PI_2),
+    };
+    // (A NaN normal compares unordered: nothing.)
+    if psi_hi.partial_cmp(&psi_lo) != Some(std::cmp::Ordering::Greater) || matches!(brdf, Brdf::Lambert { .. }) {
+        return [0.0; 3];
+    }
+    let b = if sin_t > 0.0 { across / sin_t } else { orthonormal_to(n) };
+    let e = n.cross(b);
+    // The lobe's peak in lune coordinates, its width in each (|dω/dψ| = cos λ, |dω/dλ| = 1). A peak outside the
+    // lune leaves only its tail there, falling off from the lune's edge over width²/(width + distance): crowd the
+    // grid at the edge, that narrow (as for disk lights).
+    let r = mirror(p.to_viewer, n);
+    let psi_r = r.dot(b).atan2(r.dot(n));
+    let lambda_r = r.dot(e).atan2((r.dot(n).powi(2) + r.dot(b).powi(2)).sqrt());
+    let cos_lambda_r = lambda_r.cos();
+    let outside = (psi_r - psi_hi).max(psi_lo - psi_r).max(0.0) * cos_lambda_r;
+    let width = lobe_width(brdf);
+    let w = if outside > 0.0 { width * width / (width + outside) } else { width };
+    let psi_c = psi_r.clamp(psi_lo, psi_hi);
+    let width_psi = (w / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
+    let width_lambda = w.min(16.0 * PI);
+    let psi_ends = sinh_warp_ends(psi_lo, psi_hi, psi_c, width_psi);
+    let lambda_ends = sinh_warp_ends(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
+    let (blend_psi, blend_lambda) = (uniform_blend(width_psi, psi_hi - psi_lo), uniform_blend(width_lambda, PI));
+    let k = per_axis as f64;
+    let mut sum = [0.0; 3];
+    for i in 0..per_axis {
+        let u = (i as f64 + 0.5) / k;
+        let (psi, d_psi) =
+            blended_point(psi_lo, psi_hi, sinh_warp(psi_lo, psi_hi, psi_c, width_psi, psi_ends, u), blend_psi, u);
+        let (sp, cp) = psi.sin_cos();
+        for j in 0..per_axis {
+            let u = (j as f64 + 0.5) / k;
+            let (lambda, d_lambda) = blended_point(
+                -FRAC_PI_2,
+                FRAC_PI_2,
+                sinh_warp(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda, lambda_ends, u),
+                blend_lambda,
+                u,
+            );
+            let (sl, cl) = lambda.sin_cos();
+            let omega = cl * (cp * n + sp * b) + sl * e;
+            // (n·ω) dω = cos λ cos ψ · cos λ dψ dλ; cos ψ ≥ 0 on the hemisphere.
+            let weight = cl * cl * cp.max(0.0) * d_psi * d_lambda;
+            let lobe = specular_lobe_rgb(brdf, p, omega).map(|l| l * weight);
+            // A sample of the sky that contributes casts its shadow ray.
+            if lune == Lune::Below || !lobe.iter().any(|&x| x > 0.0) || shadow.is_none_or(|s| s.visible_along(omega)) {
+                for (s, l) in sum.iter_mut().zip(lobe) {
+                    *s += l;
+                }
+            }
+        }
+    }
+    sum.map(|s| s / (k * k))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::shade::sky_lobe_integral;
+
+    fn point(normal: DVec3, to_viewer: DVec3) -> SurfacePoint {
+        let tangent = crate::scene::tangent::default_tangent(normal);
+        SurfacePoint { position: DVec3::ZERO, normal, tangent, bitangent: normal.cross(tangent), to_viewer }
+    }
+
+    /// A lune's integral by brute force: a fine uniform grid in (θ, φ) about n, the indicator of ω·up's sign.
+    fn brute_force(brdf: &Brdf, p: &SurfacePoint, lune: Lune) -> f64 {
+        let n = p.normal;
+        let t = orthonormal_to(n);
+        let b = n.cross(t);
+        let (nt, np) = (1500, 3000);
+        let mut s = 0.0;
+        for i in 0..nt {
+            let th = (i as f64 + 0.5) / nt as f64 * FRAC_PI_2;
+            for j in 0..np {
+                let ph = (j as f64 + 0.5) / np as f64 * 2.0 * PI;
+                let w = th.cos() * n + th.sin() * (ph.cos() * t + ph.sin() * b);
+                if (w.y < 0.0) == (lune == Lune::Below) {
+                    s += specular_lobe_rgb(brdf, p, w)[0] * th.cos() * th.sin();
+                }
+            }
+        }
+        s * (FRAC_PI_2 / nt as f64) * (2.0 * PI / np as f64)
+    }
+
+    #[test]
+    fn nothing_is_below_the_horizon_of_a_surface_facing_up() {
+        let phong = Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 10.0 };
+        let p = point(DVec3::Y, DVec3::new(0.6, 0.8, 0.0));
+        assert_eq!(sky_lobe_in_lune(&phong, &p, 16, Lune::Below, None), [0.0; 3]);
+    }
+
+    #[test]
+    fn a_vertical_wall_seen_head_on_loses_half_its_lobe() {
+        // n horizontal, the viewer along n: the lobe and the cosine are symmetric about the horizontal plane, so
+        // the lower lune holds exactly half of the hemisphere's integral (1 for these normalised lobes).
+        let n = DVec3::X;
+        let p = point(n, n);
+        // A lobe of e = 1e6 (0.06° wide) with its peak on the lune's edge needs 32² (16²: 2.2e-2; 32²: 1.5e-4).
+        for (brdf, k) in [
+            (Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 100.0 }, 16),
+            (Brdf::BlinnPhong { kd: [0.0; 3], ks: [1.0; 3], exponent: 100.0 }, 16),
+            (Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 1e6 }, 32),
+        ] {
+            // The whole hemisphere's integral: the same configuration on a floor, where nothing is below.
+            let whole = sky_lobe_integral(&brdf, &point(DVec3::Y, DVec3::Y), 256);
+            let lower = sky_lobe_in_lune(&brdf, &p, k, Lune::Below, None)[0];
+            assert!((lower - 0.5 * whole).abs() < 2e-3 * whole, "{brdf:?}: {lower} of {whole}");
+            // And the sky's share is the other half.
+            let sky = sky_lobe_integral(&brdf, &p, k.max(64));
+            assert!((sky - 0.5 * whole).abs() < 2e-3 * whole, "{brdf:?}: the sky's {sky} of {whole}");
+        }
+    }
+
+    #[test]
+    fn the_lune_grid_converges_to_the_brute_force_integral() {
+        // Tilted surfaces, viewers on either side of the horizontal mirror, wide and narrow lobes.
+        let cases = [
+            (DVec3::new(1.0, 0.3, 0.0), DVec3::new(0.5, -0.2, 0.4)),
+            (DVec3::new(0.2, -1.0, 0.3), DVec3::new(0.4, -0.5, 0.1)),
+            (DVec3::new(0.0, 0.5, 1.0), DVec3::new(0.3, 0.1, 1.0)),
+        ];
+        for brdf in [
+            Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 1.0 },
+            Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 30.0 },
+            Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.3, alpha_y: 0.3 },
+        ] {
+            for (n, v) in cases {
+                let p = point(n.normalize(), v.normalize());
+                let want = brute_force(&brdf, &p, Lune::Below);
+                let got = sky_lobe_in_lune(&brdf, &p, 64, Lune::Below, None)[0];
+                assert!((got - want).abs() < 1e-3 * want.max(1e-3), "{brdf:?} {n} {v}: {got} vs {want}");
+                let coarse = sky_lobe_in_lune(&brdf, &p, 16, Lune::Below, None)[0];
+                assert!((coarse - want).abs() < 2e-2 * want.max(1e-3), "{brdf:?} {n} {v}: 16²: {coarse} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_sky_integral_converges_to_the_upper_lune_whichever_way_the_surface_faces() {
+        // Facing up, sideways and down; peaks above, on and below the horizontal (the blend's three regimes).
+        let cases = [
+            (DVec3::new(0.3, 1.0, 0.0), DVec3::new(-0.9, 0.5, 0.1)),
+            (DVec3::new(1.0, 0.0, 0.2), DVec3::new(1.0, 0.05, 0.0)),
+            (DVec3::new(1.0, -0.4, 0.0), DVec3::new(0.6, 0.3, 0.3)),
+            (DVec3::new(0.1, -1.0, 0.2), DVec3::new(0.3, -0.6, 0.0)),
+        ];
+        for brdf in [
+            Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 30.0 },
+            Brdf::BlinnPhong { kd: [0.0; 3], ks: [1.0; 3], exponent: 30.0 },
+            Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.3, alpha_y: 0.3 },
+        ] {
+            for (n, v) in cases {
+                let p = point(n.normalize(), v.normalize());
+                assert!(p.normal.dot(p.to_viewer) > 0.0);
+                let want = brute_force(&brdf, &p, Lune::Above);
+                let got = sky_lobe_integral(&brdf, &p, 64);
+                assert!((got - want).abs() < 2e-3 * want.max(1e-2), "{brdf:?} {n} {v}: {got} vs {want}");
+            }
+        }
+    }
+}
