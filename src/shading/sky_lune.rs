@@ -1,21 +1,26 @@
-//! The sky below the horizontal: the part of a surface's hemisphere that is not sky.
+//! The two lunes the horizontal cuts a surface's hemisphere into: the sky's part and the rest.
 //!
 //! The sky is uniform over the upper hemisphere (`ω·up > 0`, up = +Y), so a surface tilted by `t` from up sees
 //! it through the **upper lune** `{n·ω > 0, ω·up > 0}` of dihedral angle `π − t`: its irradiance is
 //! `π L (1 + cos t)/2` (`radiometry::sky_irradiance`). The lobe integral is sampled through each lobe's own
-//! inverse CDF over the whole hemisphere about n (`shade::sky_lobe_integral_visible`), which cannot clip at the
-//! horizontal without an indicator that jumps inside the grid's cells (a sample flipping between the GPU and the
-//! reference would move a pixel by its whole weight). So the integral over the **lower lune**
-//! `L⁻ = {n·ω > 0, ω·up < 0}` is computed here on a grid whose edges are the lune's own, and subtracted.
+//! inverse CDF over the whole hemisphere about n (`shade::sky_lobe_hemisphere_grid`), which cannot clip at the
+//! horizontal without an indicator that jumps inside the grid's cells (first-order convergence, and a sample
+//! within rounding of the horizontal counted by one renderer and not the other moves a pixel by its whole
+//! weight). So `shade::sky_lobe_integral_visible` subtracts the **lower lune**'s integral, computed here on a grid
+//! whose edges are the lune's own, while the lobe's peak is above the horizontal, and takes the upper lune's
+//! integral from its own grid once the peak is below ([`sky_lune_blend`]).
 //!
 //! **Lune coordinates.** With `b` the unit component of up across n (`up = cos t n + sin t b`) and `e = n × b`,
 //! `ω = cos λ (cos ψ n + sin ψ b) + sin λ e` maps the rectangle `ψ ∈ (−π/2, t − π/2)`, `λ ∈ (−π/2, π/2)` onto
-//! `L⁻` exactly (`n·ω = cos λ cos ψ > 0`, `ω·up = cos λ cos(ψ − t) < 0`), with `dω = cos λ dψ dλ`. The integrand
-//! `lobe(ω) cos²λ cos ψ` is smooth on the closed rectangle (it vanishes at the surface's horizon ψ = −π/2 and at
-//! the poles λ = ±π/2), so the midpoint rule keeps its 1/k² convergence. As for disk lights
-//! (`shade::segment_lobe_integral`) the grid is graded by `sinh_warp` about the lobe's peak (the mirror direction
-//! of the viewer) with the lobe's width, and blends into the uniform grid for wide lobes; everything is
-//! continuous in the inputs, so no sample switches on or off between the renderers.
+//! the lower lune exactly (`n·ω = cos λ cos ψ > 0`, `ω·up = cos λ cos(ψ − t) < 0`), and `ψ ∈ (t − π/2, π/2)` onto
+//! the upper one, with `dω = cos λ dψ dλ`. The integrand `lobe(ω) cos²λ cos ψ` is smooth on the closed rectangle
+//! (it vanishes at the surface's horizon ψ = ±π/2 and at the poles λ = ±π/2), so the midpoint rule keeps its
+//! 1/k² convergence once the grid resolves the lobe (measured: Phong e = 100 with its peak on the lune's edge,
+//! 4.6e-5 at 16², 4e-10 at 32²). As for disk lights (`shade::segment_lobe_integral`) the grid is graded by
+//! `sinh_warp` about the lobe's peak (the mirror direction of the viewer) with the lobe's width, and blends into
+//! the uniform grid for wide lobes; everything is continuous in the inputs, so no sample switches on or off
+//! between the renderers. Precision: the tilt is `atan2(|up − (n·up) n|, n·up)`, not `acos(n·up)`, which loses
+//! half its digits for surfaces nearly facing up (whose thin lune it places).
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
