@@ -371,6 +371,27 @@ fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
     assert_eq!(checked, 7);
 }
 
+#[test]
+fn gpu_ray_queries_agree_with_the_reference_on_glossy_spheres_under_the_sky() {
+    // brdfs.glb's glossy spheres on their floor under an overcast sky alone, every sky sample casting its ray
+    // (the lobe grids over the hemisphere and over the lunes the horizontal cuts it into, shading::sky_lune):
+    // against the f64 reference, to the tolerance of `render --check`.
+    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let scene = common::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/brdfs.glb"));
+    let lights = sunshade::scene::Lights { sky: Some([300.0; 3]), ..Default::default() };
+    let mut s =
+        sunshade::settings::resolve(&scene, 96, 72, &Default::default(), &sunshade::settings::SunOptions::default())
+            .unwrap();
+    s.lights = lights;
+    s.shading.shadows = Shadows::Ray;
+    s.shading.samples_per_axis = 8;
+    let g = gpu.render(&scene, &s);
+    let c = cpu::render(&scene, &s, &gpu.reference_options());
+    let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+    assert!(report.pass, "{}", report.text("gpu", "reference"));
+    assert!(report.compared > 2000, "{} pixels compared", report.compared);
+}
+
 /// Settings for the shadow map with a map of `size` texels.
 fn map_settings(s: &RenderSettings, size: u32) -> RenderSettings {
     let mut s = s.clone();
