@@ -228,6 +228,60 @@ impl ScenePipeline {
         self.ray_query_module != vk::ShaderModule::null()
     }
 
+    /// Creates the pipelines of `variants` that do not exist yet, several at once (a thread each, at most as many
+    /// as the machine has cores): a driver compiles a pipeline on the thread that asks for it (lavapipe: LLVM, a
+    /// few hundred milliseconds a variant), and the pipeline cache is internally synchronized. The pipelines are
+    /// those [`Self::variant`] would create one by one; variants it would refuse are left to it.
+    pub fn prepare_variants(&mut self, variants: &[ShaderVariant]) -> Result<(), GpuError> {
+        let mut missing: Vec<ShaderVariant> = Vec::new();
+        for &v in variants {
+            let refused = v.shadows == SHADOWS_RAY && !self.has_ray_queries();
+            if !refused && !self.variants.contains_key(&v) && !missing.contains(&v) {
+                missing.push(v);
+            }
+        }
+        if missing.len() < 2 {
+            return Ok(());
+        }
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
+        let (d, layout, with_normals) = (&self.dev.device, self.layout, self.with_normals);
+        let (vertex, fragment, ray_query) = (self.vertex_module, self.fragment_module, self.ray_query_module);
+        let mut first_error = None;
+        for chunk in missing.chunks(threads) {
+            let created: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = chunk
+                    .iter()
+                    .map(|&variant| {
+                        let fs = if variant.shadows == SHADOWS_RAY { ray_query } else { fragment };
+                        // SAFETY: valid device, layout, modules and cache, owned by self and alive for the scope;
+                        // vkCreateGraphicsPipelines may be called from several threads at once.
+                        scope.spawn(move || unsafe {
+                            create_pipeline(d, cache, layout, (vertex, fs), with_normals, Some(variant), false)
+                        })
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| {
+                        h.join().unwrap_or_else(|_| Err(GpuError::ShaderCompile("pipeline creation panicked".into())))
+                    })
+                    .collect()
+            });
+            // Every pipeline made is kept (and destroyed with the others), whatever failed beside it.
+            for (&variant, result) in chunk.iter().zip(created) {
+                match result {
+                    Ok(p) => {
+                        self.variants.insert(variant, p);
+                        self.unsaved = true;
+                    }
+                    Err(e) => first_error = first_error.or(Some(e)),
+                }
+            }
+        }
+        first_error.map_or(Ok(()), Err)
+    }
+
     /// The pipeline of a variant, created on first use. Returns it and whether it was created now.
     pub fn variant(&mut self, variant: ShaderVariant) -> Result<(vk::Pipeline, bool), GpuError> {
         if let Some(&p) = self.variants.get(&variant) {

@@ -504,9 +504,14 @@ impl Renderer {
         };
         // The pipeline variant of each draw, created now if this is its first frame.
         let t_pipelines = Instant::now();
+        let variants: Vec<ShaderVariant> = scene
+            .draws
+            .iter()
+            .map(|draw| ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &settings.shading, shadows))
+            .collect();
+        self.pipeline.prepare_variants(&variants)?;
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
-        for draw in &scene.draws {
-            let variant = ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &settings.shading, shadows);
+        for variant in variants {
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
