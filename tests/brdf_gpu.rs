@@ -118,6 +118,33 @@ fn brdf_chart_gpu_against_reference() {
     assert!(failures.is_empty(), "over tolerance: {failures:?}");
 }
 
+/// The chart's spheres under an overcast sky alone: the sky's lobe grids over the hemisphere and over the lunes
+/// the horizontal cuts it into (`shading::sky_lune`), every lobe from Phong e = 1 to 1e6 and the anisotropic
+/// Ward, GPU against the reference to the chart's tolerances.
+#[test]
+fn brdf_chart_under_the_sky_gpu_against_reference() {
+    let dir = TempDir::new("chart-sky");
+    let mut gpu = CheckedRenderer::new();
+    let mut failures = Vec::new();
+    for material in chart::brdf_chart() {
+        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
+        let name = &material.name;
+        let tolerance = lobe_tolerance(&material.extras);
+        let lights = Lights { sky: Some([100.0; 3]), ..Default::default() };
+        let s = RenderSettings::new(128, 128, scene.cameras[0].1, lights);
+        let g = gpu.render(&scene, &s);
+        let c = cpu::render(&scene, &s, &gpu.reference_options());
+        assert!(g.pixels().iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "{name}: non-finite pixel");
+        let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
+        assert!(report.covered_b > 8_000, "{name}: only {} pixels covered", report.covered_b);
+        println!("{name:24} sky: max rel {:.2e} (tolerance {tolerance:.1e})", report.max_rel_interior);
+        if report.max_rel_interior > tolerance {
+            failures.push(format!("{name}: {:.3e} > {tolerance:.3e}", report.max_rel_interior));
+        }
+    }
+    assert!(failures.is_empty(), "over tolerance: {failures:?}");
+}
+
 /// A square facing the viewer, the sun straight behind the viewer (l = v = n): every pixel reflects the lobe's
 /// peak, `ks ρ_peak E⊥ + kd E⊥/π` with `ρ_peak = (e + 2)/(2π)` (Phong) or the Blinn-Phong normalization, about
 /// 1.1e8 (Phong) and 2.8e7 (Blinn-Phong) W/(m²·sr) at e = 1e6: far above f16's 65504, and exact in the f32
