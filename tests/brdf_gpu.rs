@@ -80,15 +80,23 @@ fn sun(direction: DVec3, irradiance: f32) -> Sun {
     }
 }
 
+/// The BRDF chart's spheres, written into `dir` and loaded: each material's name, scene and GPU tolerance.
+fn chart_spheres(dir: &TempDir) -> Vec<(String, Scene, f64)> {
+    chart::brdf_chart()
+        .into_iter()
+        .map(|material| {
+            let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
+            (material.name.clone(), scene, lobe_tolerance(&material.extras))
+        })
+        .collect()
+}
+
 #[test]
 fn brdf_chart_gpu_against_reference() {
     let dir = TempDir::new("chart");
     let mut gpu = CheckedRenderer::new();
     let mut failures = Vec::new();
-    for material in chart::brdf_chart() {
-        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
-        let name = &material.name;
-        let tolerance = lobe_tolerance(&material.extras);
+    for (name, scene, tolerance) in chart_spheres(&dir) {
         let mut worst = 0.0f64;
         let mut peak = 0.0f64;
         for degrees in chart::SUN_FROM_VIEW_DEGREES {
@@ -126,10 +134,7 @@ fn brdf_chart_under_the_sky_gpu_against_reference() {
     let dir = TempDir::new("chart-sky");
     let mut gpu = CheckedRenderer::new();
     let mut failures = Vec::new();
-    for material in chart::brdf_chart() {
-        let scene = common::load(&dir.write(&chart::file_name(&material), &chart::sphere_scene(&material)));
-        let name = &material.name;
-        let tolerance = lobe_tolerance(&material.extras);
+    for (name, scene, tolerance) in chart_spheres(&dir) {
         let lights = Lights { sky: Some([100.0; 3]), ..Default::default() };
         let s = RenderSettings::new(128, 128, scene.cameras[0].1, lights);
         let g = gpu.render(&scene, &s);
