@@ -230,18 +230,20 @@ impl ScenePipeline {
 
     /// Creates the pipelines of `variants` that do not exist yet, several at once (a thread each, at most as many
     /// as the machine has cores): a driver compiles a pipeline on the thread that asks for it (lavapipe: LLVM, a
-    /// few hundred milliseconds a variant), and the pipeline cache is internally synchronized. The pipelines are
-    /// those [`Self::variant`] would create one by one; variants it would refuse are left to it.
+    /// few hundred milliseconds a variant), and the pipeline cache is internally synchronized. A variant with
+    /// shadow rays on a device without ray queries is refused.
     pub fn prepare_variants(&mut self, variants: &[ShaderVariant]) -> Result<(), GpuError> {
         let mut missing: Vec<ShaderVariant> = Vec::new();
         for &v in variants {
-            let refused = v.shadows == SHADOWS_RAY && !self.has_ray_queries();
-            if !refused && !self.variants.contains_key(&v) && !missing.contains(&v) {
+            if v.shadows == SHADOWS_RAY && !self.has_ray_queries() {
+                return Err(GpuError::Unsupported(format!(
+                    "{} has no ray queries for shadow rays",
+                    self.dev.info.name
+                )));
+            }
+            if !self.variants.contains_key(&v) && !missing.contains(&v) {
                 missing.push(v);
             }
-        }
-        if missing.len() < 2 {
-            return Ok(());
         }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
@@ -282,33 +284,18 @@ impl ScenePipeline {
         first_error.map_or(Ok(()), Err)
     }
 
-    /// The pipeline of a variant, created on first use. Returns it and whether it was created now.
+    /// The pipeline of a variant, created on first use ([`Self::prepare_variants`]). Returns it and whether it was
+    /// created now.
     pub fn variant(&mut self, variant: ShaderVariant) -> Result<(vk::Pipeline, bool), GpuError> {
-        if let Some(&p) = self.variants.get(&variant) {
-            return Ok((p, false));
-        }
-        if variant.shadows == SHADOWS_RAY && !self.has_ray_queries() {
-            return Err(GpuError::Unsupported(format!("{} has no ray queries for shadow rays", self.dev.info.name)));
-        }
-        let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
-        // SAFETY: valid device, layout, modules and cache owned by self.
-        let p = unsafe {
-            create_pipeline(
-                &self.dev.device,
-                cache,
-                self.layout,
-                (
-                    self.vertex_module,
-                    if variant.shadows == SHADOWS_RAY { self.ray_query_module } else { self.fragment_module },
-                ),
-                self.with_normals,
-                Some(variant),
-                false,
-            )?
-        };
-        self.variants.insert(variant, p);
-        self.unsaved = true;
-        Ok((p, true))
+        let created = !self.variants.contains_key(&variant);
+        self.prepare_variants(&[variant])?;
+        // prepare_variants made it or returned its error.
+        let p = self
+            .variants
+            .get(&variant)
+            .copied()
+            .ok_or(GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result: vk::Result::ERROR_UNKNOWN })?;
+        Ok((p, created))
     }
 }
 
