@@ -167,6 +167,27 @@ vec2 sinh_warp_ends(float a, float b, float c, float w) {
     return vec2(asinh_accurate((a - c) / w), asinh_accurate((b - c) / w));
 }
 
+// One axis of a graded grid: [a, b] graded about c with width w, with its warp's ends and its blend towards the
+// uniform grid over the span, computed once per grid (see the Rust).
+struct GradedAxis {
+    float a;
+    float b;
+    float c;
+    float w;
+    vec2 ends;
+    float blend;
+};
+
+// The graded axis on [a, b] about c with width w.
+GradedAxis graded_axis(float a, float b, float c, float w) {
+    return GradedAxis(a, b, c, w, sinh_warp_ends(a, b, c, w), uniform_blend(w, b - a));
+}
+
+// The axis' point (x, dx/du) for u in (0, 1): the graded point moved towards the uniform one by the blend.
+vec2 graded_point(GradedAxis g, float u) {
+    return blended_point(g.a, g.b, sinh_warp(g.a, g.b, g.c, g.w, g.ends, u), g.blend, u);
+}
+
 // The grid's sums over a disk, per unit radiance (see the Rust): the lobe's per channel over the visible samples,
 // the cosine's over all, and how uniform the grid was.
 struct SegmentSums {
@@ -234,18 +255,14 @@ SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d
     float k = float(per_axis);
     vec3 sum = vec3(0.0);
     float projected = 0.0;
-    vec2 beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
-    vec2 s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
-    float blend_beta = uniform_blend(width_beta, alpha);
-    float blend_s = uniform_blend(width_s, 2.0);
+    GradedAxis beta_axis = graded_axis(0.0, alpha, beta_c, width_beta);
+    GradedAxis s_axis = graded_axis(-1.0, 1.0, s_c, width_s);
     for (uint i = 0u; i < per_axis; ++i) {
-        float ub = (float(i) + 0.5) / k;
-        vec2 bw = blended_point(0.0, alpha, sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, ub), blend_beta, ub);
+        vec2 bw = graded_point(beta_axis, (float(i) + 0.5) / k);
         float sb = sin(bw.x);
         float cb = cos(bw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            float us = (float(j) + 0.5) / k;
-            vec2 sw = blended_point(-1.0, 1.0, sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, us), blend_s, us);
+            vec2 sw = graded_point(s_axis, (float(j) + 0.5) / k);
             vec3 y = q + radius * cb * w + radius * sb * sw.x * v;
             float dist2 = dot(y, y);
             float dist = sqrt(dist2);
@@ -262,7 +279,7 @@ SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d
             }
         }
     }
-    return SegmentSums(sum / (k * k), projected / (k * k), min(blend_beta, blend_s));
+    return SegmentSums(sum / (k * k), projected / (k * k), min(beta_axis.blend, s_axis.blend));
 }
 
 // A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
@@ -361,6 +378,13 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
 const uint LUNE_BELOW = 0u;
 const uint LUNE_ABOVE = 1u;
 
+// Up's part across the normal n (xyz: up - (n.up) n = sin(t) b) and the surface's tilt t from up (w), by atan2 of
+// that part's length and n.up (see the Rust).
+vec4 up_across(vec3 n) {
+    vec3 across = vec3(0.0, 1.0, 0.0) - n.y * n;
+    return vec4(across, atan2_accurate(length(across), n.y));
+}
+
 // How far the sky's lobe integral is taken over the upper lune directly rather than as the hemisphere's less the
 // lower lune's: 0 with the lobe's peak (the mirror of the viewer) above the horizontal by more than a quarter of
 // its width (at most 1 rad), 1 below by more than that, linear between, scaled by the tilt from up over that
@@ -369,7 +393,7 @@ float sky_lune_blend(MaterialGpu m, Frame p) {
     vec3 n = p.normal;
     vec3 r = mirror(p.to_viewer, n);
     float quarter = 0.25 * min(lobe_width(m), 1.0);
-    float tilt = atan2_accurate(length(vec3(0.0, 1.0, 0.0) - n.y * n), n.y);
+    float tilt = up_across(n).w;
     // A measured table takes the upper lune wherever the surface is tilted (see the Rust).
     float below = VARIANT_BRDF == BRDF_MEASURED ? 1.0 : clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0);
     return below * min(tilt / quarter, 1.0);
@@ -380,9 +404,10 @@ float sky_lune_blend(MaterialGpu m, Frame p) {
 // about the lobe's peak; the upper lune's samples cast shadow rays where `shadowed` (see sky_lune.rs).
 vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool shadowed) {
     vec3 n = p.normal;
-    vec3 across = vec3(0.0, 1.0, 0.0) - n.y * n;
+    vec4 up = up_across(n);
+    vec3 across = up.xyz;
     float sin_t = length(across);
-    float tilt = atan2_accurate(sin_t, n.y);
+    float tilt = up.w;
     float psi_lo = lune == LUNE_BELOW ? -0.5 * PI : tilt - 0.5 * PI;
     float psi_hi = lune == LUNE_BELOW ? tilt - 0.5 * PI : 0.5 * PI;
     if (!(psi_hi > psi_lo) || VARIANT_BRDF == BRDF_LAMBERT) {
@@ -402,21 +427,16 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     float psi_c = clamp(psi_r, psi_lo, psi_hi);
     float width_psi = min(w / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
     float width_lambda = min(w, 16.0 * PI);
-    vec2 psi_ends = sinh_warp_ends(psi_lo, psi_hi, psi_c, width_psi);
-    vec2 lambda_ends = sinh_warp_ends(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
-    float blend_psi = uniform_blend(width_psi, psi_hi - psi_lo);
-    float blend_lambda = uniform_blend(width_lambda, PI);
+    GradedAxis psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
+    GradedAxis lambda_axis = graded_axis(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
     float k = float(per_axis);
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < per_axis; ++i) {
-        float u = (float(i) + 0.5) / k;
-        vec2 pw = blended_point(psi_lo, psi_hi, sinh_warp(psi_lo, psi_hi, psi_c, width_psi, psi_ends, u), blend_psi, u);
+        vec2 pw = graded_point(psi_axis, (float(i) + 0.5) / k);
         float sp = sin(pw.x);
         float cp = cos(pw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            float ul = (float(j) + 0.5) / k;
-            vec2 lw = blended_point(-0.5 * PI, 0.5 * PI,
-                sinh_warp(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda, lambda_ends, ul), blend_lambda, ul);
+            vec2 lw = graded_point(lambda_axis, (float(j) + 0.5) / k);
             float sl = sin(lw.x);
             float cl = cos(lw.x);
             vec3 omega = cl * (cp * n + sp * b) + sl * e;

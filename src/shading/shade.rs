@@ -319,6 +319,29 @@ pub fn blended_point(a: f64, b: f64, (x, dx): (f64, f64), lambda: f64, u: f64) -
     (x + lambda * ((a + u * (b - a)) - x), dx + lambda * ((b - a) - dx))
 }
 
+/// One axis of a graded grid: `[a, b]` graded about c with width w ([`sinh_warp`]), with its warp's ends and its
+/// blend towards the uniform grid over the span, computed once per grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GradedAxis {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub w: f64,
+    pub ends: (f64, f64),
+    pub blend: f64,
+}
+
+/// The graded axis on `[a, b]` about c with width w: [`sinh_warp_ends`] and [`uniform_blend`] over `b − a`.
+pub fn graded_axis(a: f64, b: f64, c: f64, w: f64) -> GradedAxis {
+    GradedAxis { a, b, c, w, ends: sinh_warp_ends(a, b, c, w), blend: uniform_blend(w, b - a) }
+}
+
+/// The axis' point `(x, dx/du)` for `u ∈ (0, 1)`: the graded point moved towards the uniform one by the blend
+/// ([`sinh_warp`], [`blended_point`]).
+pub fn graded_point(g: &GradedAxis, u: f64) -> (f64, f64) {
+    blended_point(g.a, g.b, sinh_warp(g.a, g.b, g.c, g.w, g.ends, u), g.blend, u)
+}
+
 /// The ends of [`sinh_warp`]'s z range for the grid on `[a, b]` graded about c with width w:
 /// `(asinh((a − c)/w), asinh((b − c)/w))`.
 pub fn sinh_warp_ends(a: f64, b: f64, c: f64, w: f64) -> (f64, f64) {
@@ -463,17 +486,14 @@ pub fn segment_lobe_integral_visible(
     let width_s = (footprint / (radius * sbc).max(1e-30)).min(32.0);
     let k = per_axis as f64;
     let (mut sum, mut projected) = ([0.0; 3], 0.0);
-    let beta_ends = sinh_warp_ends(0.0, alpha, beta_c, width_beta);
-    let s_ends = sinh_warp_ends(-1.0, 1.0, s_c, width_s);
-    let (blend_beta, blend_s) = (uniform_blend(width_beta, alpha), uniform_blend(width_s, 2.0));
+    let (beta_axis, s_axis) = (graded_axis(0.0, alpha, beta_c, width_beta), graded_axis(-1.0, 1.0, s_c, width_s));
     for i in 0..per_axis {
         let u = (i as f64 + 0.5) / k;
-        let (beta, d_beta) =
-            blended_point(0.0, alpha, sinh_warp(0.0, alpha, beta_c, width_beta, beta_ends, u), blend_beta, u);
+        let (beta, d_beta) = graded_point(&beta_axis, u);
         let (sb, cb) = beta.sin_cos();
         for j in 0..per_axis {
             let u = (j as f64 + 0.5) / k;
-            let (s, d_s) = blended_point(-1.0, 1.0, sinh_warp(-1.0, 1.0, s_c, width_s, s_ends, u), blend_s, u);
+            let (s, d_s) = graded_point(&s_axis, u);
             let y = q + radius * cb * w + radius * sb * s * v;
             let dist2 = y.length_squared();
             let dist = dist2.sqrt();
@@ -491,7 +511,11 @@ pub fn segment_lobe_integral_visible(
             }
         }
     }
-    SegmentSums { lobe: sum.map(|s| s / (k * k)), projected: projected / (k * k), uniformity: blend_beta.min(blend_s) }
+    SegmentSums {
+        lobe: sum.map(|s| s / (k * k)),
+        projected: projected / (k * k),
+        uniformity: beta_axis.blend.min(s_axis.blend),
+    }
 }
 
 /// `exp(x) − 1` without cancellation for small x (Kahan's trick: exact where `exp` and `ln` are accurate).

@@ -27,10 +27,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::brdf::mirror;
-use super::shade::{
-    blended_point, lobe_width, orthonormal_to, sinh_warp, sinh_warp_ends, specular_lobe_rgb, uniform_blend,
-    SurfacePoint,
-};
+use super::shade::{graded_axis, graded_point, lobe_width, orthonormal_to, specular_lobe_rgb, SurfacePoint};
 use super::visibility::Shadowing;
 use crate::scene::Brdf;
 
@@ -41,6 +38,14 @@ pub enum Lune {
     Below,
     /// `{n·ω > 0, ω·up > 0}`: the sky's part of the hemisphere.
     Above,
+}
+
+/// Up's part across the normal n (`up − (n·up) n = sin t b`, b the unit uphill direction) and the surface's tilt t
+/// from up [rad]. `sin t` is that part's length and t its `atan2` with `n·up`: `acos(n·up)` or `sqrt(1 − cos²t)`
+/// would cancel for surfaces nearly facing up, whose thin lune t then places wrongly.
+pub fn up_across(n: DVec3) -> (DVec3, f64) {
+    let across = DVec3::Y - n.y * n;
+    (across, across.length().atan2(n.y))
 }
 
 /// How far the sky's lobe integral is taken directly over the upper lune rather than as the hemisphere's less
@@ -61,7 +66,7 @@ pub fn sky_lune_blend(brdf: &Brdf, p: &SurfacePoint) -> f64 {
     let n = p.normal;
     let r = mirror(p.to_viewer, n);
     let quarter = 0.25 * lobe_width(brdf).min(1.0);
-    let tilt = (DVec3::Y - n.y * n).length().atan2(n.y);
+    let (_, tilt) = up_across(n);
     // A measured table takes the upper lune wherever the surface is tilted (see `sky_lobe_integral_visible`).
     let below = if matches!(brdf, Brdf::Measured { .. }) { 1.0 } else { (0.5 - r.y / (2.0 * quarter)).clamp(0.0, 1.0) };
     below * (tilt / quarter).min(1.0)
@@ -79,11 +84,8 @@ pub fn sky_lobe_in_lune(
     shadow: Option<&Shadowing>,
 ) -> [f64; 3] {
     let n = p.normal;
-    // up = cos t n + sin t b. sin t as the length of up's part across n: `sqrt(1 − cos²t)` would cancel for
-    // surfaces nearly facing up, whose thin lune is then placed by a wrong t.
-    let across = DVec3::Y - n.y * n;
+    let (across, tilt) = up_across(n);
     let sin_t = across.length();
-    let tilt = sin_t.atan2(n.y);
     let (psi_lo, psi_hi) = match lune {
         Lune::Below => (-FRAC_PI_2, tilt - FRAC_PI_2),
         Lune::Above => (tilt - FRAC_PI_2, FRAC_PI_2),
@@ -107,25 +109,15 @@ pub fn sky_lobe_in_lune(
     let psi_c = psi_r.clamp(psi_lo, psi_hi);
     let width_psi = (w / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
     let width_lambda = w.min(16.0 * PI);
-    let psi_ends = sinh_warp_ends(psi_lo, psi_hi, psi_c, width_psi);
-    let lambda_ends = sinh_warp_ends(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
-    let (blend_psi, blend_lambda) = (uniform_blend(width_psi, psi_hi - psi_lo), uniform_blend(width_lambda, PI));
+    let psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
+    let lambda_axis = graded_axis(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
     let k = per_axis as f64;
     let mut sum = [0.0; 3];
     for i in 0..per_axis {
-        let u = (i as f64 + 0.5) / k;
-        let (psi, d_psi) =
-            blended_point(psi_lo, psi_hi, sinh_warp(psi_lo, psi_hi, psi_c, width_psi, psi_ends, u), blend_psi, u);
+        let (psi, d_psi) = graded_point(&psi_axis, (i as f64 + 0.5) / k);
         let (sp, cp) = psi.sin_cos();
         for j in 0..per_axis {
-            let u = (j as f64 + 0.5) / k;
-            let (lambda, d_lambda) = blended_point(
-                -FRAC_PI_2,
-                FRAC_PI_2,
-                sinh_warp(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda, lambda_ends, u),
-                blend_lambda,
-                u,
-            );
+            let (lambda, d_lambda) = graded_point(&lambda_axis, (j as f64 + 0.5) / k);
             let (sl, cl) = lambda.sin_cos();
             let omega = cl * (cp * n + sp * b) + sl * e;
             // (n·ω) dω = cos λ cos ψ · cos λ dψ dλ; cos ψ ≥ 0 on the hemisphere.
