@@ -8,7 +8,10 @@
 //! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
 //! - [`bounds`]: the sun models' error bounds, derived next to the code;
 //! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models;
-//! - [`trial`]: `--tolerance` on the reference, with the delta sun tried first where its own image's peak decides.
+//! - [`refinement`]: the lobe grids' error under disk lights and the sky estimated from a ladder of grids
+//!   (Richardson extrapolation with the observed order, Roache's GCI), where no bound is derived;
+//! - [`trial`]: `--tolerance` on any renderer, with the delta sun tried first where its own image's peak decides,
+//!   and the lobe grids' ladder where they need it.
 //!
 //! This module knows the reference renderer and the comparison, never Vulkan: GPU timings come from the caller.
 
@@ -17,4 +20,5 @@ pub mod converged;
 pub mod error;
 pub mod pareto;
 pub mod predicted;
+pub mod refinement;
 pub mod trial;

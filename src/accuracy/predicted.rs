@@ -2,9 +2,11 @@
 //! cheapest sun model whose bound meets a tolerance.
 //!
 //! What is bounded so far: the sun (delta or disk, its grid) over every material of the scene, the sharpest
-//! lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. What is not, and is named
-//! in [`Prediction::unbounded`] instead of being silently left out: disk lights and the sky on specular surfaces
-//! (their lobe grids; on Lambertian ones their closed forms are exact, and the small-source estimate unbounded),
+//! lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather than bounded,
+//! where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular surfaces
+//! ([`super::refinement`]). What is not, and is named in [`Prediction::unbounded`] instead of being silently left
+//! out: disk lights and the sky on specular surfaces without that study (on Lambertian ones their closed forms are
+//! exact, and the small-source estimate unbounded),
 //! penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and shadows turned
 //! off in a scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes:
 //! its lights' closed forms are exact ([`predict_irradiance`]).
@@ -12,6 +14,8 @@
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, Quantity, ShadingOptions, Shadows, SunModel};
+
+use super::refinement::LobeEstimate;
 
 use super::bounds::{
     horizon_bound, horizon_error, peak_lower_bound, sharpest_brdf, sun_delta_bound, sun_grid_bound,
@@ -84,6 +88,12 @@ fn brdf_name(brdf: &Brdf) -> String {
         Brdf::Ward { alpha_x, alpha_y, .. } => format!("Ward αx={alpha_x} αy={alpha_y}"),
         Brdf::Measured { ref table, .. } => format!("measured {}", table.name),
     }
+}
+
+/// Whether `--tolerance` must estimate the lobe grids by refinement ([`super::trial`]): disk lights or the sky
+/// over a scene with specular (or measured) materials.
+pub fn lobes_need_study(scene: &Scene, settings: &RenderSettings) -> bool {
+    (!settings.lights.disks.is_empty() || settings.lights.sky.is_some()) && !only_lambertian(scene)
 }
 
 /// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
@@ -174,17 +184,20 @@ fn sun_bound(brdf: &Brdf, shading: &ShadingOptions, r: f64, horizon: f64, angles
 /// The predicted error of rendering `scene` with `settings` (whose shadow technique is the one used) on
 /// `renderer`; `can_occlude`: whether something in the scene can occlude a light.
 pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can_occlude: bool) -> Prediction {
-    predict_with_peak(scene, settings, renderer, can_occlude, None)
+    predict_with_peak(scene, settings, renderer, can_occlude, None, None)
 }
 
 /// [`predict`], where a delta sun's render is known to peak at `rendered` [W/(m²·sr)] (its own image's peak): the
 /// horizon term is then taken against that peak ([`horizon_terms`]) instead of the material's own response.
+/// `lobes`: the refinement's estimate of the lobe grids under disk lights and the sky where one was made
+/// ([`super::refinement`]); it adds to the sun's term (both err at the same pixels).
 pub fn predict_with_peak(
     scene: &Scene,
     settings: &RenderSettings,
     renderer: Renderer,
     can_occlude: bool,
     rendered: Option<f64>,
+    lobes: Option<&LobeEstimate>,
 ) -> Prediction {
     if settings.shading.quantity == Quantity::Irradiance {
         return predict_irradiance(settings, renderer, can_occlude);
@@ -224,18 +237,26 @@ pub fn predict_with_peak(
     }
     let lambertian = only_lambertian(scene);
     if !lights.disks.is_empty() {
-        match (lambertian, shading.disk) {
-            (true, DiskModel::Exact) => p.terms.push(("disk lights, exact, on Lambertian surfaces:".into(), 0.0)),
-            (true, DiskModel::SmallSource) => p.unbounded.push("the disk lights' small-source estimate".into()),
-            (false, _) => p.unbounded.push("the disk lights (their lobe grids)".into()),
+        match (lambertian, shading.disk, lobes) {
+            (true, DiskModel::Exact, _) => p.terms.push(("disk lights, exact, on Lambertian surfaces:".into(), 0.0)),
+            (true, DiskModel::SmallSource, _) => p.unbounded.push("the disk lights' small-source estimate".into()),
+            (false, DiskModel::Exact, None) => p.unbounded.push("the disk lights (their lobe grids)".into()),
+            (false, DiskModel::Exact, Some(_)) => {}
+            (false, DiskModel::SmallSource, _) => {
+                p.unbounded.push("the disk lights (their lobe grids and the small-source estimate)".into())
+            }
         }
     }
     if lights.sky.is_some() {
-        if lambertian {
-            p.terms.push(("the sky on Lambertian surfaces:".into(), 0.0));
-        } else {
-            p.unbounded.push("the sky (its lobe grid)".into());
+        match (lambertian, lobes) {
+            (true, _) => p.terms.push(("the sky on Lambertian surfaces:".into(), 0.0)),
+            (false, None) => p.unbounded.push("the sky (its lobe grid)".into()),
+            (false, Some(_)) => {}
         }
+    }
+    if let Some(estimate) = lobes.filter(|_| !lambertian) {
+        p.terms.push((estimate.term(), estimate.gci));
+        p.max_relative += estimate.gci;
     }
     occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude);
     p
@@ -343,17 +364,34 @@ pub fn choose_for_tolerance_with_peak(
     delta_peak: Option<f64>,
 ) -> Result<ShadingOptions, String> {
     let lights = &settings.lights;
+    if lobes_need_study(scene, settings) && !has_measured(scene) {
+        return Err(format!(
+            "--tolerance {tolerance:e}: under disk lights and the sky only Lambertian surfaces have a derived bound \
+             (their closed forms), and this scene has {} and specular materials: their lobe grids are estimated by \
+             refinement, which renders the image several times (`render --tolerance` and `reference --tolerance` do; \
+             docs/accuracy.md, \"Error bounds\")",
+            if lights.sky.is_some() { "a sky" } else { "disk lights" }
+        ));
+    }
+    choose_sun_within(scene, settings, renderer, can_occlude, tolerance, delta_peak)
+}
+
+/// [`choose_for_tolerance_with_peak`] but for the lobe grids under disk lights and the sky on specular surfaces,
+/// which the caller estimates by refinement ([`super::trial`]): the sun's models for `tolerance`, and what the
+/// other techniques refuse.
+pub(crate) fn choose_sun_within(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    tolerance: f64,
+    delta_peak: Option<f64>,
+) -> Result<ShadingOptions, String> {
+    let lights = &settings.lights;
     if has_measured(scene) {
         return Err(format!(
             "--tolerance {tolerance:e}: measured BRDFs have no derived error bound (docs/measured.md measures their \
              lookup and grids)"
-        ));
-    }
-    if (!lights.disks.is_empty() || lights.sky.is_some()) && !only_lambertian(scene) {
-        return Err(format!(
-            "--tolerance {tolerance:e}: under disk lights and the sky only Lambertian surfaces have a bound (their \
-             closed forms), and this scene has {} and specular materials (docs/accuracy.md, \"Error bounds\")",
-            if lights.sky.is_some() { "a sky" } else { "disk lights" }
         ));
     }
     if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude {
@@ -432,7 +470,7 @@ pub fn choose_and_predict(
             choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, delta_peak)?;
     }
     let peak = delta_peak.filter(|_| settings.shading.sun == SunModel::Delta);
-    Ok(predict_with_peak(scene, settings, renderer, can_occlude, peak))
+    Ok(predict_with_peak(scene, settings, renderer, can_occlude, peak, None))
 }
 
 /// Whether `choose_and_predict` should be given a delta render's peak: `--tolerance` asked, and

@@ -2,12 +2,19 @@
 //! from meeting the tolerance against the floor-based bound (`predicted::delta_worth_trying`), the delta sun is
 //! rendered first, the horizon term taken against that image's peak (`bounds::peak_lower_bound`), and the image
 //! kept when the delta sun then meets the tolerance; otherwise the choice falls back to the disk sun's grid and the
-//! trial's time is the price of asking. The reference (`reference_within_tolerance`) and `sunshade render` (the
-//! GPU, `cli::render`) both go through [`render_within_tolerance`].
+//! trial's time is the price of asking. Where specular surfaces are lit by disk lights or the sky, whose lobe grids
+//! have no derived bound, the image is rendered on a ladder of lobe grids instead and the finest one's error
+//! estimated by refinement ([`super::refinement`]): the sun is chosen for a quarter of the tolerance, the lobe grids get
+//! what the sun's bound and the arithmetic leave. The reference (`reference_within_tolerance`) and `sunshade
+//! render` (the GPU, `cli::render`) both go through [`render_within_tolerance`]; every render it makes is the
+//! caller's `render`, so a caller that sums their times has the cost of asking.
 
 use std::convert::Infallible;
 
-use super::predicted::{choose_and_predict, delta_trial, predict_with_peak, Prediction, Renderer};
+use super::predicted::{
+    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, predict_with_peak, Prediction, Renderer,
+};
+use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
@@ -15,12 +22,11 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::{Shadows, SunModel};
 
-/// What [`render_within_tolerance`] rendered: the render kept, its predicted error, and the delta trial where one
-/// was rendered and not kept (its cost is part of the render's).
+/// What [`render_within_tolerance`] rendered: the render kept and its predicted error (the renders made and not
+/// kept, a delta trial or the coarser rungs of a lobe study, were dropped as soon as they had served).
 pub struct WithinTolerance<T> {
     pub kept: T,
     pub prediction: Prediction,
-    pub discarded_trial: Option<T>,
 }
 
 /// Why [`render_within_tolerance`] rendered nothing: no setting can promise the tolerance, or the renderer failed.
@@ -32,7 +38,8 @@ pub enum TrialError<E> {
 /// Renders `scene` with `--tolerance`'s models (`settings.shading` updated to them) by `render` (whose result holds
 /// an image, `image_of`), and predicts its error; `renderer` whose error is predicted, `asked` the shadows asked
 /// for, `scene_can_occlude` whether anything in the scene can occlude a light. A delta render, asked for or
-/// chosen, has its horizon term taken against its own image's peak.
+/// chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or the sky
+/// with a tolerance: [`lobe_study`].
 #[allow(clippy::too_many_arguments)]
 pub fn render_within_tolerance<T, E>(
     scene: &Scene,
@@ -44,6 +51,9 @@ pub fn render_within_tolerance<T, E>(
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
+    if let Some(tolerance) = tolerance.filter(|_| lobes_need_study(scene, settings)) {
+        return lobe_study(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
+    }
     let trial = if delta_trial(scene, settings, renderer, asked, scene_can_occlude, tolerance) {
         let mut delta = settings.clone();
         delta.shading.sun = SunModel::Delta;
@@ -54,16 +64,79 @@ pub fn render_within_tolerance<T, E>(
     let peak = trial.as_ref().map(|t| image_peak(image_of(t)));
     let mut prediction = choose_and_predict(scene, settings, renderer, asked, scene_can_occlude, tolerance, peak)
         .map_err(TrialError::Tolerance)?;
-    let (kept, discarded_trial) = match trial {
-        Some(delta) if settings.shading.sun == SunModel::Delta => (delta, None),
-        trial => (render(settings).map_err(TrialError::Render)?, trial),
+    let kept = match trial {
+        Some(delta) if settings.shading.sun == SunModel::Delta => delta,
+        trial => {
+            drop(trial);
+            render(settings).map_err(TrialError::Render)?
+        }
     };
     if settings.shading.sun == SunModel::Delta && peak.is_none() {
         // A delta render asked for (or chosen without a trial): its horizon term against its own image's peak.
         let can_occlude = asked != Shadows::None && scene_can_occlude;
-        prediction = predict_with_peak(scene, settings, renderer, can_occlude, Some(image_peak(image_of(&kept))));
+        prediction = predict_with_peak(scene, settings, renderer, can_occlude, Some(image_peak(image_of(&kept))), None);
     }
-    Ok(WithinTolerance { kept, prediction, discarded_trial })
+    Ok(WithinTolerance { kept, prediction })
+}
+
+/// The shares of the tolerance the sun's models are chosen for in a lobe study, the first that the sun's bound
+/// meets: a sun sample costs one lobe evaluation a pixel, a lobe grid's `k²` per disk light and for the sky, so the
+/// lobe grids get the larger share unless a lobe too sharp for the sun's grids needs it.
+pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// `--tolerance` where specular surfaces are lit by disk lights or the sky: the sun's models chosen for a quarter
+/// of the tolerance (or a half, or three quarters: [`SUN_SHARES`]) by their bounds (the delta sun's horizon term floor-based, no trial), then the image rendered on the
+/// lobe grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits in
+/// what the sun's bound and the arithmetic leave of the tolerance. Refused as [`choose_for_tolerance_with_peak`]
+/// refuses (measured materials, light through occluders, f32 interpolation; [`choose_sun_within`]), or where the ladder's finest grid
+/// does not meet it.
+#[allow(clippy::too_many_arguments)]
+fn lobe_study<T, E>(
+    scene: &Scene,
+    settings: &mut RenderSettings,
+    renderer: Renderer,
+    asked: Shadows,
+    scene_can_occlude: bool,
+    tolerance: f64,
+    mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
+    image_of: impl Fn(&T) -> &Image,
+) -> Result<WithinTolerance<T>, TrialError<E>> {
+    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    let mut sun = Err(String::new());
+    for share in SUN_SHARES {
+        sun = choose_sun_within(scene, settings, renderer, can_occlude, share * tolerance, None);
+        if sun.is_ok() {
+            break;
+        }
+    }
+    settings.shading = sun.map_err(TrialError::Tolerance)?;
+    // The sun's terms and the arithmetic, without the lobe grids.
+    let budget = tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative;
+    let mut study = Ladder::new(renderer.arithmetic());
+    let mut previous: Option<T> = None;
+    let mut last = None;
+    for k in ladder() {
+        settings.shading.samples_per_axis = k;
+        let image = render(settings).map_err(TrialError::Render)?;
+        study.push(k, previous.as_ref().map(&image_of), image_of(&image));
+        previous = Some(image);
+        last = study.estimate();
+        if let Some(estimate) = last.filter(|e| e.gci <= budget) {
+            let kept = previous.take().expect("rendered");
+            let peak = (settings.shading.sun == SunModel::Delta).then(|| image_peak(image_of(&kept)));
+            let prediction = predict_with_peak(scene, settings, renderer, can_occlude, peak, Some(&estimate));
+            return Ok(WithinTolerance { kept, prediction });
+        }
+    }
+    Err(TrialError::Tolerance(format!(
+        "--tolerance {tolerance:e}: the lobe grids under disk lights and the sky did not meet the {budget:.1e} the \
+         sun's bound leaves by {}² ({}; docs/accuracy.md, \"Error bounds\")",
+        settings.shading.samples_per_axis,
+        match last {
+            Some(e) => format!("estimated {:.1e}", e.gci),
+            None => "the last grids' differences do not shrink like a converging grid's".into(),
+        }
+    )))
 }
 
 /// The reference image of `scene` with `--tolerance`'s models (`settings.shading` updated to them) and its

@@ -253,11 +253,14 @@ pub struct SceneArgs {
 
     /// Choose the cheapest sun model (delta, or the disk with the fewest samples) whose derived error bound, with
     /// the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
-    /// the models and the predicted bound (docs/accuracy.md, "Error bounds"). The sun is bounded for every
+    /// the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
     /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
-    /// (exact) and the sky only on Lambertian surfaces and unshadowed (their closed forms). Refused: specular or
-    /// measured materials under disk lights or a sky, their light through occluders, f32 interpolation, and shadows
-    /// other than rays (or `--shadows none`, which measures against the unshadowed truth).
+    /// (exact) and the sky on Lambertian surfaces by their closed forms. Specular surfaces under disk lights or a
+    /// sky: the image is rendered on a ladder of lobe grids (4² up to 162², overriding --samples) until the
+    /// finest one's error, estimated by refinement (Roache's grid convergence index), fits what the sun's bound
+    /// leaves; every rung's time counts in the render's. Refused: measured materials, light through occluders,
+    /// f32 interpolation, and shadows other than rays (or `--shadows none`, which measures against the unshadowed
+    /// truth).
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 

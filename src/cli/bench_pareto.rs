@@ -115,7 +115,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             };
             // A delta sun's horizon term is taken against its own image's peak.
             let peak = (s.shading.sun == crate::shading::SunModel::Delta).then(|| crate::compare::image_peak(&image));
-            let p = predicted::predict_with_peak(&scene, &s, renderer, can_occlude, peak);
+            let p = predicted::predict_with_peak(&scene, &s, renderer, can_occlude, peak, None);
             let predicted = (p.max_relative, !p.unbounded.is_empty());
             rows.push(Row { label, frame_ms: ms(median(times)), spread_ms: ms(spread), error, predicted });
             bar.inc(1);

@@ -100,6 +100,13 @@ pub fn sun_model_line(settings: &RenderSettings) -> String {
     }
 }
 
+/// The lobe grids of a render in words, for `-v`, where it has disk lights or a sky: "lobes under disk lights and
+/// the sky: 16² samples".
+pub fn lobe_model_line(settings: &RenderSettings) -> Option<String> {
+    (!settings.lights.disks.is_empty() || settings.lights.sky.is_some())
+        .then(|| format!("lobes under disk lights and the sky: {}² samples", settings.shading.samples_per_axis))
+}
+
 /// `sunshadeDaylight`: where the sun of `--time` stood and the clear sky it gave, when the render has one.
 pub fn daylight(a: &super::args::SceneArgs) -> Option<(String, String)> {
     let d = a.daylight.at_time()?;

@@ -117,6 +117,9 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         );
         eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings));
+        if let Some(line) = super::metadata::lobe_model_line(&settings) {
+            eprintln!("sunshade: {line}");
+        }
         if let Some(p) = &prediction {
             eprintln!("sunshade: {}", p.line());
         }

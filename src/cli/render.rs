@@ -131,6 +131,8 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let predicted_for =
         predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
     let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
+    // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
+    let mut spent = FrameTimings::default();
     let done = render_within_tolerance(
         scene_data,
         &mut settings,
@@ -138,20 +140,21 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         asked,
         can_occlude,
         tolerance,
-        |s| r.render(gpu_scene, s),
+        |s| {
+            let (image, t) = r.render(gpu_scene, s)?;
+            spent.pipelines += t.pipelines;
+            spent.render += t.render;
+            spent.readback += t.readback;
+            Ok::<_, crate::gpu::GpuError>((image, t))
+        },
         |(image, _)| image,
     )
     .map_err(|e| match e {
         TrialError::Tolerance(why) => CliError::Usage(why),
         TrialError::Render(e) => CliError::from(e),
     })?;
-    let (image, mut frame) = done.kept;
-    if let Some((_, tried)) = done.discarded_trial {
-        // The trial's time counts: it is part of this render's cost.
-        frame.pipelines += tried.pipelines;
-        frame.render += tried.render;
-        frame.readback += tried.readback;
-    }
+    let (image, _) = done.kept;
+    let frame = spent;
     let prediction = done.prediction;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
@@ -281,6 +284,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         );
         eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&job.settings));
+        if let Some(line) = super::metadata::lobe_model_line(&job.settings) {
+            eprintln!("sunshade: {line}");
+        }
         eprintln!("sunshade: {}", job.prediction.line());
         print_exposure(ev);
         match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {

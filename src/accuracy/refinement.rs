@@ -1,0 +1,258 @@
+//! The lobe grids' error estimated by refinement, where no derived bound covers it: a specular surface under disk
+//! lights or the sky integrates its lobe over the light on a `k²` grid whose error depends on the lobe, the
+//! light's size and distance and the surface's tilt (six angles of configuration, and measured tables of the
+//! sky's grid show no bound that a scan could give cheaply: docs/accuracy.md, "Error bounds"). `--tolerance`
+//! instead renders the image on a ladder of grids and estimates the finest one's error from the last three,
+//! by Richardson extrapolation with the observed order of convergence, reported as Roache's grid convergence
+//! index (GCI):
+//!
+//! Roache, P. J. (1994), "Perspective: A Method for Uniform Reporting of Grid Refinement Studies",
+//! J. Fluids Eng. 116(3), 405–413 (the GCI with its factor of safety 1.25 for three grids and an observed order).
+//!
+//! **Ladder**: `k₀ = 4`, `kᵢ₊₁ = ⌈√2 kᵢ⌉` per axis (the samples at least doubled, as the converged reference
+//! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
+//! only by their lobe grids (and rounding).
+//!
+//! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
+//! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding
+//! [`Ladder::noise`]), is then `C kᵢ₋₁^−p (1 − rᵢ^−p)` with `rᵢ = kᵢ / kᵢ₋₁`, so
+//!
+//! `dᵢ₋₁ / dᵢ = rᵢ₋₁^p (1 − rᵢ₋₁^−p) / (1 − rᵢ^−p)`            (solved for the observed order p by bisection)
+//!
+//! `eᵢ = dᵢ / (rᵢ^p − 1)`,  `GCI = 1.25 eᵢ`                      (the finest image's error, with Roache's factor)
+//!
+//! The ratios `rᵢ` differ a little (⌈·⌉), hence the general form rather than `ln(dᵢ₋₁/dᵢ)/ln r`. The order used
+//! is at most 2, the midpoint rule's on a smooth integrand: an observed order above it is two grids agreeing by
+//! chance, and would shrink the estimate. An order under [`MIN_ORDER`] (differences that do not shrink, or a
+//! difference after one that vanished) says the grids are not yet in their asymptotic range: the ladder goes on.
+//! Taking the max over pixels for both differences and applying one order to all is the "global norm" form of the
+//! study; the maxima may sit at different pixels, so the order is a property of the image, not of a pixel.
+//!
+//! **What it is not**: a bound. It is an estimate that holds where the pixels' errors follow the model, which is
+//! what `tests/accuracy.rs` measures against the converged reference on every scene of models/ and the BRDF chart
+//! under disk lights and the sky. Penumbrae (a shadow-ray grid's visible fraction) converge erratically, at first
+//! order or worse, with jumps where an occluder's edge crosses a cell; they are not estimated here.
+
+use crate::compare::{image_peak, pixel_difference, DiffOptions};
+use crate::film::Image;
+
+/// The finest lobe grid the ladder renders [per axis].
+pub const MAX_LOBE_GRID: u32 = 192;
+/// The first rung [per axis].
+pub const FIRST_LOBE_GRID: u32 = 4;
+/// The order below which the grids are taken as not yet in their asymptotic range.
+pub const MIN_ORDER: f64 = 0.5;
+/// The highest order used: the midpoint rule's on a smooth integrand.
+pub const MAX_ORDER: f64 = 2.0;
+/// Roache's factor of safety for a study of three grids.
+pub const SAFETY_FACTOR: f64 = 1.25;
+
+/// The next rung after `k`: the samples at least doubled.
+pub fn next_grid(k: u32) -> u32 {
+    ((k as f64) * std::f64::consts::SQRT_2).ceil() as u32
+}
+
+/// The rungs, coarsest first: 4, 6, 9, 13, 19, 27, 39, 56, 80, 114, 162.
+pub fn ladder() -> Vec<u32> {
+    let mut v = vec![FIRST_LOBE_GRID];
+    while next_grid(*v.last().unwrap()) <= MAX_LOBE_GRID {
+        v.push(next_grid(*v.last().unwrap()));
+    }
+    v
+}
+
+/// The max relative difference of two renders of the same view (the diff's floor from the finer one's peak),
+/// over the pixels either covers; a NaN or an infinity counts as infinite.
+pub fn max_difference(coarse: &Image, fine: &Image) -> f64 {
+    let floor = DiffOptions::default().floor_fraction * image_peak(fine);
+    coarse
+        .pixels()
+        .iter()
+        .zip(fine.pixels())
+        .filter(|(a, b)| a[3] > 0.0 || b[3] > 0.0)
+        .map(|(&a, &b)| pixel_difference(a, b, floor).rel)
+        .fold(0.0, f64::max)
+}
+
+/// The order `p` of `e(k) = C k^−p` that three grids `k₀ < k₁ < k₂` with differences `d₁ = |I₁ − I₀|` and
+/// `d₂ = |I₂ − I₁|` show: the root of `d₁/d₂ = r₁^p (1 − r₁^−p)/(1 − r₂^−p)`. The right side grows with p
+/// (from `ln r₁/ln r₂ · 1` at p → 0 to ∞), so bisection on [0, 16] finds it; `None` where `d₁/d₂` is below the
+/// right side's value at 0 (differences that do not shrink: no positive order) or either difference is not
+/// finite and positive. Above 16 the order is returned as 16 (far past [`MAX_ORDER`], where it is cut anyway).
+pub fn observed_order(k: [u32; 3], d1: f64, d2: f64) -> Option<f64> {
+    if !(d1.is_finite() && d2.is_finite() && d1 > 0.0 && d2 > 0.0) {
+        return None;
+    }
+    let (r1, r2) = (k[1] as f64 / k[0] as f64, k[2] as f64 / k[1] as f64);
+    // r^p − 1 by exp_m1 keeps its digits at small p (where `powf` − 1 would cancel).
+    let ratio = |p: f64| (p * r1.ln()).exp_m1() / (-(p * r2.ln())).exp_m1().abs();
+    let target = d1 / d2;
+    let at_zero = r1.ln() / r2.ln();
+    if target <= at_zero {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0f64, 16.0f64);
+    if ratio(hi) <= target {
+        return Some(hi);
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if ratio(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// The estimate of one study: the finest grid, its estimated max relative error (the GCI), the observed order
+/// and the ladder's last two differences (less rounding).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LobeEstimate {
+    pub samples_per_axis: u32,
+    pub gci: f64,
+    pub order: f64,
+    pub differences: [f64; 2],
+}
+
+impl LobeEstimate {
+    /// For the prediction's terms: "lobe grids 19², estimated by refinement (order 1.8, GCI)".
+    pub fn term(&self) -> String {
+        format!(
+            "lobe grids under disk lights and the sky {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
+            self.samples_per_axis, self.order
+        )
+    }
+}
+
+/// The running study: the grids rendered and the images' differences so far.
+pub struct Ladder {
+    /// Twice the renderer's arithmetic error: what two renders of the same integral may differ by in rounding.
+    noise: f64,
+    grids: Vec<u32>,
+    differences: Vec<f64>,
+}
+
+impl Ladder {
+    /// A study on a renderer whose arithmetic errs by `arithmetic` (relative).
+    pub fn new(arithmetic: f64) -> Self {
+        Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new() }
+    }
+
+    /// Two renders' rounding [relative], subtracted from every difference.
+    pub fn noise(&self) -> f64 {
+        self.noise
+    }
+
+    /// Records the image of grid `k` given the previous rung's image (`None` for the first).
+    pub fn push(&mut self, k: u32, previous: Option<&Image>, image: &Image) {
+        if let Some(prev) = previous {
+            self.differences.push((max_difference(prev, image) - self.noise).max(0.0));
+        }
+        self.grids.push(k);
+    }
+
+    /// The estimate for the last grid once three are in, `None` where the grids are not in their asymptotic range
+    /// (module text). Two differences of zero (the grids agree to rounding) estimate zero.
+    pub fn estimate(&self) -> Option<LobeEstimate> {
+        let n = self.grids.len();
+        if n < 3 {
+            return None;
+        }
+        let k = [self.grids[n - 3], self.grids[n - 2], self.grids[n - 1]];
+        let (d1, d2) = (self.differences[n - 3], self.differences[n - 2]);
+        let done = |gci: f64, order: f64| LobeEstimate { samples_per_axis: k[2], gci, order, differences: [d1, d2] };
+        if d2 == 0.0 {
+            // The last two grids agree to rounding; after a difference that vanished too, or one that shrank to
+            // nothing (an order past any bound, cut to MAX_ORDER), the finest grid's error is its rounding.
+            return Some(done(0.0, MAX_ORDER));
+        }
+        let order = observed_order(k, d1, d2)?;
+        if order < MIN_ORDER {
+            return None;
+        }
+        let p = order.min(MAX_ORDER);
+        let r = k[2] as f64 / k[1] as f64;
+        Some(done(SAFETY_FACTOR * d2 / (p * r.ln()).exp_m1(), p))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ladder_at_least_doubles_the_samples() {
+        let l = ladder();
+        assert_eq!(l, vec![4, 6, 9, 13, 19, 27, 39, 56, 80, 114, 162]);
+        assert!(l.windows(2).all(|w| w[1] * w[1] >= 2 * w[0] * w[0]));
+    }
+
+    /// The observed order of an exact power law is its exponent, for rungs of unequal ratios.
+    #[test]
+    fn the_observed_order_of_a_power_law_is_its_exponent() {
+        for p in [0.6, 1.0, 1.5, 2.0, 3.0] {
+            for k in [[4u32, 6, 9], [9, 13, 19], [27, 39, 56]] {
+                let e = |k: u32| 0.3 * (k as f64).powf(-p);
+                let (d1, d2) = (e(k[0]) - e(k[1]), e(k[1]) - e(k[2]));
+                let got = observed_order(k, d1, d2).unwrap();
+                assert!((got - p).abs() < 1e-9, "p {p}, k {k:?}: {got}");
+            }
+        }
+        // Differences that do not shrink have no positive order.
+        assert_eq!(observed_order([4, 6, 9], 1e-3, 1e-3), None);
+        assert_eq!(observed_order([4, 6, 9], 0.0, 1e-3), None);
+    }
+
+    fn flat(w: u32, v: f32) -> Image {
+        let mut img = Image::new(w, 1);
+        for p in img.pixels_mut() {
+            *p = [v, v, v, 1.0];
+        }
+        img
+    }
+
+    /// On a power law of order 1 or 2 the GCI bounds the finest image's true error, and is within a factor of
+    /// 1.25 of it (the safety factor alone, the model being exact).
+    #[test]
+    fn the_gci_covers_an_exact_power_law() {
+        for p in [1.0, 2.0] {
+            let truth = 1.0f32;
+            // A small amplitude, so that the differences relative to the pixel's value follow the power law
+            // (relative to a value that moves by 10%, the observed order of p = 1 reads 0.9).
+            let value = |k: u32| truth + 0.01 * (k as f32).powf(-p as f32);
+            let mut ladder = Ladder::new(0.0);
+            let mut prev: Option<Image> = None;
+            for &k in &[4u32, 6, 9] {
+                let img = flat(4, value(k));
+                ladder.push(k, prev.as_ref(), &img);
+                prev = Some(img);
+            }
+            let e = ladder.estimate().unwrap();
+            let true_error = (value(9) - truth) as f64 / value(9) as f64;
+            assert!(e.gci >= true_error && e.gci <= 1.3 * true_error, "p {p}: {e:?} against {true_error:.3e}");
+        }
+    }
+
+    /// Differences that grow, or one after a vanished one, are not in the asymptotic range; two agreeing to
+    /// rounding estimate zero.
+    #[test]
+    fn the_study_refuses_grids_out_of_range() {
+        let run = |values: [f32; 3], arithmetic: f64| {
+            let mut ladder = Ladder::new(arithmetic);
+            let mut prev: Option<Image> = None;
+            for (i, &v) in values.iter().enumerate() {
+                let img = flat(2, v);
+                ladder.push([4, 6, 9][i], prev.as_ref(), &img);
+                prev = Some(img);
+            }
+            ladder.estimate()
+        };
+        assert_eq!(run([1.0, 1.01, 1.03], 0.0), None);
+        assert_eq!(run([1.0, 1.0, 1.01], 0.0), None);
+        assert_eq!(run([1.0, 1.0, 1.0], 0.0).map(|e| e.gci), Some(0.0));
+        // Within the rounding of two renders: zero as well.
+        assert_eq!(run([1.0, 1.000_01, 1.0], 1e-5).map(|e| e.gci), Some(0.0));
+    }
+}
