@@ -1,15 +1,15 @@
 //! The predicted error of a render, from the bounds of its models ([`super::bounds`]), and `--tolerance`: the
 //! cheapest sun model whose bound meets a tolerance.
 //!
-//! What is bounded so far: the sun (delta or disk, its grid) over every material of the scene, the sharpest
-//! lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather than bounded,
-//! where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular surfaces
-//! ([`super::refinement`]). What is not, and is named in [`Prediction::unbounded`] instead of being silently left
-//! out: disk lights and the sky on specular surfaces without that study (on Lambertian ones their closed forms are
-//! exact, and the small-source estimate unbounded),
-//! penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and shadows turned
-//! off in a scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes:
-//! its lights' closed forms are exact ([`predict_irradiance`]).
+//! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
+//! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
+//! than bounded, where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular
+//! surfaces, and a measured material's grids, the sun's included ([`super::refinement`]). What is not, and is
+//! named in [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on
+//! Lambertian surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is
+//! unbounded), penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and
+//! shadows turned off in a scene that can shadow itself (there the error is up to 100%). An irradiance image has
+//! no lobes: its lights' closed forms are exact ([`predict_irradiance`]).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
@@ -94,6 +94,12 @@ fn brdf_name(brdf: &Brdf) -> String {
 /// over a scene with specular (or measured) materials.
 pub fn lobes_need_study(scene: &Scene, settings: &RenderSettings) -> bool {
     (!settings.lights.disks.is_empty() || settings.lights.sky.is_some()) && !only_lambertian(scene)
+}
+
+/// Whether `--tolerance` must estimate the sun's grid by refinement too: a measured material under the sun (its
+/// table's lookup has no derived curvature for the sun's bound).
+pub fn sun_needs_study(scene: &Scene, settings: &RenderSettings) -> bool {
+    settings.lights.sun.is_some() && has_measured(scene)
 }
 
 /// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
@@ -205,7 +211,8 @@ pub fn predict_with_peak(
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let lights = &settings.lights;
     let shading = &settings.shading;
-    if let Some(sun) = &lights.sun {
+    let sun_studied = lobes.is_some_and(|e| e.sun_grid);
+    if let Some(sun) = lights.sun.as_ref().filter(|_| !sun_studied) {
         let r = 0.5 * sun.angular_diameter as f64;
         let l = sun.direction.as_dvec3();
         let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
@@ -232,8 +239,8 @@ pub fn predict_with_peak(
             p.max_relative = 1.0;
         }
     }
-    if has_measured(scene) {
-        p.unbounded.push("measured BRDFs (their tables' lookup and grids)".into());
+    if has_measured(scene) && lobes.is_none() {
+        p.unbounded.push("measured BRDFs (their grids)".into());
     }
     let lambertian = only_lambertian(scene);
     if !lights.disks.is_empty() {
@@ -376,6 +383,38 @@ pub fn choose_for_tolerance_with_peak(
     choose_sun_within(scene, settings, renderer, can_occlude, tolerance, delta_peak)
 }
 
+/// What `--tolerance` refuses whatever the materials, or the settings with the disk lights' exact model (on
+/// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): light of disk lights
+/// and the sky through occluders (their visible fraction), f32 or device interpolation, shadows other than rays
+/// where the scene can shadow itself.
+pub(crate) fn techniques_within(
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    tolerance: f64,
+) -> Result<ShadingOptions, String> {
+    let lights = &settings.lights;
+    if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude {
+        return Err(format!(
+            "--tolerance {tolerance:e}: the scene can shadow itself, and the visible fraction of disk lights and the \
+             sky through occluders has no bound (a shadow-ray grid errs by the share of its cells an occluder's edge \
+             crosses); --shadows none bounds the render against the unshadowed truth"
+        ));
+    }
+    let mut shading = settings.shading;
+    shading.disk = DiskModel::Exact;
+    if let Renderer::Gpu { exact_interpolation: false } = renderer {
+        return Err(format!("--tolerance {tolerance:e}: f32 or device interpolation has no error bound: use f64"));
+    }
+    if can_occlude && shading.shadows != Shadows::Ray {
+        return Err(format!(
+            "--tolerance {tolerance:e}: the scene can shadow itself, and only shadow rays (--shadows ray, a device \
+             with ray queries) render its shadows with a known error outside penumbrae"
+        ));
+    }
+    Ok(shading)
+}
+
 /// [`choose_for_tolerance_with_peak`] but for the lobe grids under disk lights and the sky on specular surfaces,
 /// which the caller estimates by refinement ([`super::trial`]): the sun's models for `tolerance`, and what the
 /// other techniques refuse.
@@ -387,33 +426,15 @@ pub(crate) fn choose_sun_within(
     tolerance: f64,
     delta_peak: Option<f64>,
 ) -> Result<ShadingOptions, String> {
-    let lights = &settings.lights;
     if has_measured(scene) {
         return Err(format!(
-            "--tolerance {tolerance:e}: measured BRDFs have no derived error bound (docs/measured.md measures their \
-             lookup and grids)"
+            "--tolerance {tolerance:e}: measured BRDFs have no derived error bound; their grids are estimated by \
+             refinement, which renders the image several times (`render --tolerance` and `reference --tolerance` \
+             do; docs/accuracy.md, \"Error bounds\")"
         ));
     }
-    if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude {
-        return Err(format!(
-            "--tolerance {tolerance:e}: the scene can shadow itself, and the visible fraction of disk lights and the \
-             sky through occluders has no bound (a shadow-ray grid errs by the share of its cells an occluder's edge \
-             crosses); --shadows none bounds the render against the unshadowed truth"
-        ));
-    }
-    let mut shading = settings.shading;
-    // Lambertian surfaces under disk lights: the exact model is the closed form (no error); the small-source
-    // estimate has no bound.
-    shading.disk = DiskModel::Exact;
-    if let Renderer::Gpu { exact_interpolation: false } = renderer {
-        return Err(format!("--tolerance {tolerance:e}: f32 or device interpolation has no error bound: use f64"));
-    }
-    if can_occlude && shading.shadows != Shadows::Ray {
-        return Err(format!(
-            "--tolerance {tolerance:e}: the scene can shadow itself, and only shadow rays (--shadows ray, a device \
-             with ray queries) render its shadows with a known error outside penumbrae"
-        ));
-    }
+    let mut shading = techniques_within(settings, renderer, can_occlude, tolerance)?;
+    let lights = &settings.lights;
     let arithmetic = renderer.arithmetic();
     let Some(sun) = &lights.sun else { return Ok(shading) };
     let r = 0.5 * sun.angular_diameter as f64;

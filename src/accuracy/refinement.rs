@@ -11,7 +11,8 @@
 //!
 //! **Ladder**: `k₀ = 4`, `kᵢ₊₁ = ⌈√2 kᵢ⌉` per axis (the samples at least doubled, as the converged reference
 //! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
-//! only by their lobe grids (and rounding).
+//! only by their lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has
+//! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
 //! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding
@@ -107,21 +108,30 @@ pub fn observed_order(k: [u32; 3], d1: f64, d2: f64) -> Option<f64> {
 }
 
 /// The estimate of one study: the finest grid, its estimated max relative error (the GCI), the observed order
-/// and the ladder's last two differences (less rounding).
+/// and the ladder's last two differences (less rounding); `sun_grid`: whether the sun's grid was refined on the
+/// ladder too (a measured material under the sun), so that the estimate covers it instead of the sun's bound.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LobeEstimate {
     pub samples_per_axis: u32,
     pub gci: f64,
     pub order: f64,
     pub differences: [f64; 2],
+    pub sun_grid: bool,
 }
 
 impl LobeEstimate {
-    /// For the prediction's terms: "lobe grids 19², estimated by refinement (order 1.8, GCI)".
+    /// For the prediction's terms: "lobe grids under disk lights and the sky 19², estimated by refinement
+    /// (observed order 1.80, Roache's GCI):".
     pub fn term(&self) -> String {
         format!(
-            "lobe grids under disk lights and the sky {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
-            self.samples_per_axis, self.order
+            "{} {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
+            if self.sun_grid {
+                "the sun's grid and the lobe grids"
+            } else {
+                "lobe grids under disk lights and the sky"
+            },
+            self.samples_per_axis,
+            self.order
         )
     }
 }
@@ -132,12 +142,15 @@ pub struct Ladder {
     noise: f64,
     grids: Vec<u32>,
     differences: Vec<f64>,
+    /// Whether the sun's grid is refined with the lobe grids.
+    sun_grid: bool,
 }
 
 impl Ladder {
-    /// A study on a renderer whose arithmetic errs by `arithmetic` (relative).
-    pub fn new(arithmetic: f64) -> Self {
-        Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new() }
+    /// A study on a renderer whose arithmetic errs by `arithmetic` (relative), refining the sun's grid with the
+    /// lobe grids or not.
+    pub fn new(arithmetic: f64, sun_grid: bool) -> Self {
+        Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new(), sun_grid }
     }
 
     /// Two renders' rounding [relative], subtracted from every difference.
@@ -162,7 +175,13 @@ impl Ladder {
         }
         let k = [self.grids[n - 3], self.grids[n - 2], self.grids[n - 1]];
         let (d1, d2) = (self.differences[n - 3], self.differences[n - 2]);
-        let done = |gci: f64, order: f64| LobeEstimate { samples_per_axis: k[2], gci, order, differences: [d1, d2] };
+        let done = |gci: f64, order: f64| LobeEstimate {
+            samples_per_axis: k[2],
+            gci,
+            order,
+            differences: [d1, d2],
+            sun_grid: self.sun_grid,
+        };
         if d2 == 0.0 {
             // The last two grids agree to rounding; after a difference that vanished too, or one that shrank to
             // nothing (an order past any bound, cut to MAX_ORDER), the finest grid's error is its rounding.
@@ -222,7 +241,7 @@ mod tests {
             // A small amplitude, so that the differences relative to the pixel's value follow the power law
             // (relative to a value that moves by 10%, the observed order of p = 1 reads 0.9).
             let value = |k: u32| truth + 0.01 * (k as f32).powf(-p as f32);
-            let mut ladder = Ladder::new(0.0);
+            let mut ladder = Ladder::new(0.0, false);
             let mut prev: Option<Image> = None;
             for &k in &[4u32, 6, 9] {
                 let img = flat(4, value(k));
@@ -240,7 +259,7 @@ mod tests {
     #[test]
     fn the_study_refuses_grids_out_of_range() {
         let run = |values: [f32; 3], arithmetic: f64| {
-            let mut ladder = Ladder::new(arithmetic);
+            let mut ladder = Ladder::new(arithmetic, false);
             let mut prev: Option<Image> = None;
             for (i, &v) in values.iter().enumerate() {
                 let img = flat(2, v);

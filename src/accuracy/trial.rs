@@ -2,17 +2,18 @@
 //! from meeting the tolerance against the floor-based bound (`predicted::delta_worth_trying`), the delta sun is
 //! rendered first, the horizon term taken against that image's peak (`bounds::peak_lower_bound`), and the image
 //! kept when the delta sun then meets the tolerance; otherwise the choice falls back to the disk sun's grid and the
-//! trial's time is the price of asking. Where specular surfaces are lit by disk lights or the sky, whose lobe grids
-//! have no derived bound, the image is rendered on a ladder of lobe grids instead and the finest one's error
-//! estimated by refinement ([`super::refinement`]): the sun is chosen for a quarter of the tolerance, the lobe grids get
-//! what the sun's bound and the arithmetic leave. The reference (`reference_within_tolerance`) and `sunshade
-//! render` (the GPU, `cli::render`) both go through [`render_within_tolerance`]; every render it makes is the
-//! caller's `render`, so a caller that sums their times has the cost of asking.
+//! trial's time is the price of asking. Where grids have no derived bound (the lobe grids of specular surfaces
+//! under disk lights or the sky; the sun's grid on measured materials), the image is rendered on a ladder of grids
+//! instead and the finest one's error estimated by refinement ([`super::refinement`]). The reference
+//! (`reference_within_tolerance`) and `sunshade render` (the GPU, `cli::render`) both go through
+//! [`render_within_tolerance`]; every render it makes is the caller's `render`, so a caller that sums their times
+//! has the cost of asking.
 
 use std::convert::Infallible;
 
 use super::predicted::{
-    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, predict_with_peak, Prediction, Renderer,
+    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, predict_with_peak, sun_needs_study,
+    techniques_within, Prediction, Renderer,
 };
 use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
@@ -51,7 +52,8 @@ pub fn render_within_tolerance<T, E>(
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
-    if let Some(tolerance) = tolerance.filter(|_| lobes_need_study(scene, settings)) {
+    if let Some(tolerance) = tolerance.filter(|_| lobes_need_study(scene, settings) || sun_needs_study(scene, settings))
+    {
         return lobe_study(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
     }
     let trial = if delta_trial(scene, settings, renderer, asked, scene_can_occlude, tolerance) {
@@ -84,12 +86,14 @@ pub fn render_within_tolerance<T, E>(
 /// lobe grids get the larger share unless a lobe too sharp for the sun's grids needs it.
 pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 
-/// `--tolerance` where specular surfaces are lit by disk lights or the sky: the sun's models chosen for a quarter
-/// of the tolerance (or a half, or three quarters: [`SUN_SHARES`]) by their bounds (the delta sun's horizon term floor-based, no trial), then the image rendered on the
-/// lobe grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits in
-/// what the sun's bound and the arithmetic leave of the tolerance. Refused as [`choose_for_tolerance_with_peak`]
-/// refuses (measured materials, light through occluders, f32 interpolation; [`choose_sun_within`]), or where the ladder's finest grid
-/// does not meet it.
+/// `--tolerance` where specular surfaces are lit by disk lights or the sky, or a measured material by the sun: the
+/// sun's models chosen by their bounds for a quarter of the tolerance (or a half, or three quarters:
+/// [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on the lobe grids'
+/// ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits what the sun's
+/// bound and the arithmetic leave. With a measured material under the sun, the disk sun's grid is refined on the
+/// same rungs instead, and the estimate gets all of the tolerance but the arithmetic. Refused as
+/// [`techniques_within`] refuses (light through occluders, f32 interpolation, shadows other than rays), where the
+/// sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid does not meet it.
 #[allow(clippy::too_many_arguments)]
 fn lobe_study<T, E>(
     scene: &Scene,
@@ -102,21 +106,36 @@ fn lobe_study<T, E>(
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
     let can_occlude = asked != Shadows::None && scene_can_occlude;
-    let mut sun = Err(String::new());
-    for share in SUN_SHARES {
-        sun = choose_sun_within(scene, settings, renderer, can_occlude, share * tolerance, None);
-        if sun.is_ok() {
-            break;
+    let sun_grid = sun_needs_study(scene, settings);
+    let budget = if sun_grid || settings.lights.sun.is_none() {
+        // No sun's bound to choose: the sun's grid is on the ladder too (the disk sun; the estimate covers it), or
+        // there is no sun.
+        settings.shading =
+            techniques_within(settings, renderer, can_occlude, tolerance).map_err(TrialError::Tolerance)?;
+        if sun_grid {
+            settings.shading.sun = SunModel::Disk;
         }
-    }
-    settings.shading = sun.map_err(TrialError::Tolerance)?;
-    // The sun's terms and the arithmetic, without the lobe grids.
-    let budget = tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative;
-    let mut study = Ladder::new(renderer.arithmetic());
+        tolerance - renderer.arithmetic()
+    } else {
+        let mut sun = Err(String::new());
+        for share in SUN_SHARES {
+            sun = choose_sun_within(scene, settings, renderer, can_occlude, share * tolerance, None);
+            if sun.is_ok() {
+                break;
+            }
+        }
+        settings.shading = sun.map_err(TrialError::Tolerance)?;
+        // What the sun's terms and the arithmetic leave.
+        tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative
+    };
+    let mut study = Ladder::new(renderer.arithmetic(), sun_grid);
     let mut previous: Option<T> = None;
     let mut last = None;
     for k in ladder() {
         settings.shading.samples_per_axis = k;
+        if sun_grid {
+            settings.shading.sun_samples_per_axis = k;
+        }
         let image = render(settings).map_err(TrialError::Render)?;
         study.push(k, previous.as_ref().map(&image_of), image_of(&image));
         previous = Some(image);
