@@ -102,7 +102,7 @@ fn the_floor_under_a_disk_skylight_is_the_view_factor_everywhere() {
             assert!(n == 96 * 96 && worst <= 1e-5, "{name}: max relative error {worst:e} over {n} pixels");
             // The predicted bound covers the measurement, with nothing left unbounded.
             let renderer = match name {
-                "gpu" => predicted::Renderer::Gpu { exact_interpolation: true },
+                "gpu" => predicted::Renderer::Gpu { barycentrics: predicted::Barycentrics::F64 },
                 _ => predicted::Renderer::Reference,
             };
             let p = predicted::predict(&sc, &s, renderer, false);
@@ -114,7 +114,8 @@ fn the_floor_under_a_disk_skylight_is_the_view_factor_everywhere() {
         std::slice::from_ref(&floor),
         Material::with_brdf("shiny", Brdf::Phong { kd: [0.2; 3], ks: [0.5; 3], exponent: 5000.0 }),
     );
-    let p = predicted::predict(&shiny, &s, predicted::Renderer::Gpu { exact_interpolation: true }, false);
+    let p =
+        predicted::predict(&shiny, &s, predicted::Renderer::Gpu { barycentrics: predicted::Barycentrics::F64 }, false);
     assert!(p.unbounded.is_empty() && p.max_relative <= 1e-5, "{}", p.line());
 }
 

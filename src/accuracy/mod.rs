@@ -5,6 +5,8 @@
 //!   that does not hold are reported);
 //! - [`error`]: an image's error against such a truth (max relative with the diff's floor, p99, RMSE, pixels over
 //!   1e-2, 1e-3, 1e-4);
+//! - [`interpolation`]: the error f32 barycentrics add, bounded per pixel from the triangle's shape and the
+//!   radiance's change over that move;
 //! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
 //! - [`bounds`]: the sun models' error bounds, derived next to the code;
 //! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models;
@@ -18,6 +20,7 @@
 pub mod bounds;
 pub mod converged;
 pub mod error;
+pub mod interpolation;
 pub mod pareto;
 pub mod predicted;
 pub mod refinement;

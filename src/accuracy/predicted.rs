@@ -25,11 +25,22 @@ use super::bounds::{
 /// The largest sun grid `--tolerance` considers [cells a side].
 pub const MAX_TOLERANCE_SUN_GRID: u32 = 64;
 
+/// How the GPU's fragment shader gets its barycentrics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Barycentrics {
+    /// Computed in f64 (exact but for their rounding to f32).
+    F64,
+    /// Computed in f32: bounded per pixel by `accuracy::interpolation`, with `--tolerance`.
+    F32,
+    /// The device's interpolated varyings: no bound (the device's interpolation is not specified to a precision).
+    Device,
+}
+
 /// Which renderer's error is predicted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Renderer {
-    /// The GPU, with this interpolation exact (f64 barycentrics) or not.
-    Gpu { exact_interpolation: bool },
+    /// The GPU, with these barycentrics.
+    Gpu { barycentrics: Barycentrics },
     /// The CPU reference (f64 throughout).
     Reference,
 }
@@ -56,7 +67,17 @@ pub struct Prediction {
     pub unbounded: Vec<String>,
 }
 
+/// The prediction's name for f32 interpolation while its bound is not computed ([`Prediction::add_f32_bound`]).
+const F32_UNBOUNDED: &str = "f32 interpolation (bounded with --tolerance)";
+
 impl Prediction {
+    /// Adds the bound of f32 interpolation (`accuracy::interpolation`), which it no longer lists as unbounded.
+    pub fn add_f32_bound(&mut self, bound: f64) {
+        self.unbounded.retain(|u| u != F32_UNBOUNDED);
+        self.terms.push(("f32 interpolation (barycentric rounding, per pixel):".into(), bound));
+        self.max_relative = (self.max_relative + bound).min(1.0);
+    }
+
     /// The `-v` line: `predicted max relative error: 1.6e-4 (...)`.
     pub fn line(&self) -> String {
         let terms: Vec<String> = self.terms.iter().map(|(what, b)| format!("{what} {b:.1e}")).collect();
@@ -309,11 +330,13 @@ fn occlusion_and_arithmetic(p: &mut Prediction, shading: &ShadingOptions, render
             _ => p.unbounded.push("penumbrae (the shadow rays' visible fractions)".into()),
         }
     }
-    if let Renderer::Gpu { exact_interpolation } = renderer {
+    if let Renderer::Gpu { barycentrics } = renderer {
         p.terms.push(("GPU f32 shading:".into(), GPU_ARITHMETIC));
         p.max_relative = (p.max_relative + GPU_ARITHMETIC).min(1.0);
-        if !exact_interpolation {
-            p.unbounded.push("f32 or device interpolation".into());
+        match barycentrics {
+            Barycentrics::F64 => {}
+            Barycentrics::F32 => p.unbounded.push(F32_UNBOUNDED.into()),
+            Barycentrics::Device => p.unbounded.push("device interpolation".into()),
         }
     }
 }
@@ -403,8 +426,10 @@ pub(crate) fn techniques_within(
     }
     let mut shading = settings.shading;
     shading.disk = DiskModel::Exact;
-    if let Renderer::Gpu { exact_interpolation: false } = renderer {
-        return Err(format!("--tolerance {tolerance:e}: f32 or device interpolation has no error bound: use f64"));
+    if let Renderer::Gpu { barycentrics: Barycentrics::Device } = renderer {
+        return Err(format!(
+            "--tolerance {tolerance:e}: device interpolation has no error bound: use f64 or f32 (--interpolation)"
+        ));
     }
     if can_occlude && shading.shadows != Shadows::Ray {
         return Err(format!(

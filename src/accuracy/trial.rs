@@ -11,9 +11,10 @@
 
 use std::convert::Infallible;
 
+use super::interpolation::f32_interpolation_bound;
 use super::predicted::{
     choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, predict_with_peak, sun_needs_study,
-    techniques_within, Prediction, Renderer,
+    techniques_within, Barycentrics, Prediction, Renderer,
 };
 use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
@@ -40,9 +41,57 @@ pub enum TrialError<E> {
 /// an image, `image_of`), and predicts its error; `renderer` whose error is predicted, `asked` the shadows asked
 /// for, `scene_can_occlude` whether anything in the scene can occlude a light. A delta render, asked for or
 /// chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or the sky
-/// with a tolerance: [`lobe_study`].
+/// with a tolerance: [`lobe_study`]. On a GPU with f32 barycentrics, the bound they add
+/// (`accuracy::interpolation`) is computed by the reference with `reference` (mirroring the device) and kept
+/// within the tolerance beside the models'.
 #[allow(clippy::too_many_arguments)]
 pub fn render_within_tolerance<T, E>(
+    scene: &Scene,
+    settings: &mut RenderSettings,
+    renderer: Renderer,
+    asked: Shadows,
+    scene_can_occlude: bool,
+    tolerance: Option<f64>,
+    reference: &ReferenceOptions,
+    mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
+    image_of: impl Fn(&T) -> &Image,
+) -> Result<WithinTolerance<T>, TrialError<E>> {
+    let f32_barycentrics = renderer == Renderer::Gpu { barycentrics: Barycentrics::F32 };
+    let Some(tolerance) = tolerance.filter(|_| f32_barycentrics) else {
+        return models_within(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
+    };
+    // f32 barycentrics: the models chosen for what their bound leaves, which is known only for the models
+    // chosen; first for all of the tolerance, then, where the bound does not fit beside them, once more for what
+    // it leaves (with half again as margin: the bound moves a little with the models).
+    let initial = settings.clone();
+    let mut reserve = 0.0;
+    let mut bound = 0.0;
+    for _ in 0..2 {
+        *settings = initial.clone();
+        let within = tolerance - reserve;
+        let mut done =
+            models_within(scene, settings, renderer, asked, scene_can_occlude, Some(within), &mut render, &image_of)?;
+        bound = f32_interpolation_bound(scene, settings, reference);
+        if done.prediction.max_relative + bound <= tolerance {
+            done.prediction.add_f32_bound(bound);
+            return Ok(done);
+        }
+        if bound >= 0.5 * tolerance {
+            break;
+        }
+        reserve = 1.5 * bound;
+    }
+    Err(TrialError::Tolerance(format!(
+        "--tolerance {tolerance:e}: f32 interpolation's bound is {bound:.1e} on this view (its barycentrics' rounding \
+         on its triangles, and the radiance's change over it; or a textured, vertex-coloured, normal-mapped or \
+         emissive surface, where no bound is claimed): --interpolation f64 where the device has it"
+    )))
+}
+
+/// [`render_within_tolerance`] but for f32 interpolation's bound: the models, the delta trial and the grids'
+/// study.
+#[allow(clippy::too_many_arguments)]
+fn models_within<T, E>(
     scene: &Scene,
     settings: &mut RenderSettings,
     renderer: Renderer,
@@ -171,7 +220,7 @@ pub fn reference_within_tolerance(
 ) -> Result<(Image, Prediction), String> {
     let render = |s: &RenderSettings| Ok::<_, Infallible>(cpu::render(scene, s, options));
     let r = Renderer::Reference;
-    match render_within_tolerance(scene, settings, r, asked, scene_can_occlude, tolerance, render, |i| i) {
+    match render_within_tolerance(scene, settings, r, asked, scene_can_occlude, tolerance, options, render, |i| i) {
         Ok(done) => Ok((done.kept, done.prediction)),
         Err(TrialError::Tolerance(why)) => Err(why),
         Err(TrialError::Render(never)) => match never {},

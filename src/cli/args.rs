@@ -259,8 +259,10 @@ pub struct SceneArgs {
     /// sky: the image is rendered on a ladder of lobe grids (4² up to 162², overriding --samples) until the
     /// finest one's error, estimated by refinement (Roache's grid convergence index), fits what the sun's bound
     /// leaves; measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
-    /// render's. Refused: light of disk lights and the sky through occluders, f32 interpolation, and shadows other
-    /// than rays (or `--shadows none`, which measures against the unshadowed truth).
+    /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
+    /// and kept within REL beside the models'. Refused: light of disk lights and the sky through occluders, the
+    /// device's interpolation, and shadows other than rays (or `--shadows none`, which measures against the
+    /// unshadowed truth).
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 

@@ -110,9 +110,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
                 times.iter().max().copied().unwrap_or_default() - times.iter().min().copied().unwrap_or_default();
             let error = image_error(&image, &truth.image, Some(&excluded))
                 .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-            let renderer = predicted::Renderer::Gpu {
-                exact_interpolation: setting.interpolation == Interpolation::BarycentricF64,
-            };
+            let renderer =
+                predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(setting.interpolation) };
             // A delta sun's horizon term is taken against its own image's peak.
             let peak = (s.shading.sun == crate::shading::SunModel::Delta).then(|| crate::compare::image_peak(&image));
             let p = predicted::predict_with_peak(&scene, &s, renderer, can_occlude, peak, None);

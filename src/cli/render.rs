@@ -128,8 +128,14 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
-    let predicted_for =
-        predicted::Renderer::Gpu { exact_interpolation: r.interpolation() == Interpolation::BarycentricF64 };
+    let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
+    // The reference mirroring the device, for the bound of f32 interpolation.
+    let info = r.device_info();
+    let reference = ReferenceOptions {
+        sub_pixel_bits: info.sub_pixel_precision_bits,
+        fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
+        device_ray_queries: info.ray_query,
+    };
     let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
@@ -140,6 +146,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         asked,
         can_occlude,
         tolerance,
+        &reference,
         |s| {
             let (image, t) = r.render(gpu_scene, s)?;
             spent.pipelines += t.pipelines;
@@ -172,6 +179,15 @@ pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> (I
         (image, Some(edges))
     } else {
         (cpu::render(scene, &job.settings, &options), None)
+    }
+}
+
+/// How the prediction names the device's interpolation.
+pub fn predicted_barycentrics(interpolation: Interpolation) -> predicted::Barycentrics {
+    match interpolation {
+        Interpolation::BarycentricF64 => predicted::Barycentrics::F64,
+        Interpolation::BarycentricF32 => predicted::Barycentrics::F32,
+        Interpolation::Device => predicted::Barycentrics::Device,
     }
 }
 

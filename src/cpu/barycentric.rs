@@ -40,6 +40,21 @@ pub fn triangle_barycentrics_exact(c: [Vec4; 3], ndc: Vec2) -> DVec3 {
     b / sum
 }
 
+/// The barycentrics as the shader's f32 `triangle_barycentrics_exact` computes them on a device without
+/// shaderFloat64 (or with `--interpolation f32`): the same operations in the same order, each rounded to f32, no
+/// fused multiply-add (the shader's `precise`). `accuracy::interpolation` bounds how far these are from
+/// [`triangle_barycentrics_exact`].
+pub fn triangle_barycentrics_f32(c: [Vec4; 3], ndc: Vec2) -> [f32; 3] {
+    let d = c.map(|v| (v.x - ndc.x * v.w, v.y - ndc.y * v.w));
+    let cross = |a: (f32, f32), b: (f32, f32)| a.0 * b.1 - a.1 * b.0;
+    let b = [cross(d[1], d[2]), cross(d[2], d[0]), cross(d[0], d[1])];
+    let sum = b[0] + b[1] + b[2];
+    if sum == 0.0 {
+        return [1.0 / 3.0; 3];
+    }
+    b.map(|x| x / sum)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -198,6 +198,46 @@ pub fn render_selected(
     render_inner(scene, settings, options, Some(selected), &shader).0
 }
 
+/// For each pixel, per channel, the largest change of its radiance (as [`render`] shades it, with `settings`'
+/// shadows) when its barycentrics move to one of the six corners `l ± r eᵢ` of the ball `Σ|δlᵢ| ≤ r`,
+/// `r = radius(clip-space vertices, pixel NDC)` (`accuracy::interpolation` takes the largest change over the ball
+/// from these corners). A pixel whose surface reads textures, vertex colours, a normal map, emission or an alpha
+/// mask (interpolated there from the barycentrics too, which this does not move) or whose radius is not finite
+/// gets an infinite change: no claim.
+pub fn barycentric_sensitivity(
+    scene: &Scene,
+    settings: &RenderSettings,
+    options: &ReferenceOptions,
+    radius: &(dyn Fn([glam::Vec4; 3], glam::Vec2) -> f64 + Sync),
+) -> Image {
+    let occluders = occluders_for(scene, settings, options);
+    let rays = occluders.as_ref();
+    let viewer = settings.viewer();
+    let shader = move |t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
+        let r = radius(t.clip, pixel_ndc(x, y, settings.width, settings.height));
+        if t.surface != 0 || !r.is_finite() {
+            return ([f64::INFINITY; 3], false);
+        }
+        let at = |w: [f64; 3]| {
+            shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (&r.occluders as &dyn Occlusion, r.lights)))
+        };
+        let centre = at(w);
+        let mut change = [0.0f64; 3];
+        for i in 0..3 {
+            for sign in [-1.0, 1.0] {
+                let mut moved = w;
+                moved[i] += sign * r;
+                let l = at(moved);
+                for c in 0..3 {
+                    change[c] = change[c].max((l[c] - centre[c]).abs());
+                }
+            }
+        }
+        (change, false)
+    };
+    render_inner(scene, settings, options, None, &shader).0
+}
+
 /// How near a shadow ray may pass an occluder's edge before its answer counts as fragile: `2⁻¹⁸` of the
 /// coordinates' magnitude, several times the f32 rounding of the GPU's positions and directions (2⁻²³).
 pub const FRAGILE_RAY_RELATIVE: f64 = 1.0 / 262144.0;

@@ -112,3 +112,19 @@ pub fn scene_of(parts: &[sunshade::authoring::shapes::MeshData], material: sunsh
         .collect();
     Scene { meshes, materials: vec![material], ..Default::default() }
 }
+
+/// The max relative error (the diff's floor) of `image` against the converged reference of `scene` with
+/// `settings`, refined to `accuracy` (five doublings at most) with `reference`'s options, the truth's unconverged
+/// pixels left out; and how many those were.
+pub fn error_against_converged(
+    scene: &Scene,
+    settings: &sunshade::settings::RenderSettings,
+    image: &Image,
+    accuracy: f64,
+    reference: &sunshade::cpu::ReferenceOptions,
+) -> (f64, usize) {
+    use sunshade::accuracy::converged::{render_converged, ConvergenceOptions};
+    let truth = render_converged(scene, settings, reference, &ConvergenceOptions { accuracy, max_refinements: 5 });
+    let e = sunshade::accuracy::error::image_error(image, &truth.image, Some(&truth.unconverged_mask())).unwrap();
+    (e.max_rel, truth.unconverged.len())
+}
