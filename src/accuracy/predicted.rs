@@ -7,9 +7,10 @@
 //! surfaces, and a measured material's grids, the sun's included ([`super::refinement`]). What is not, and is
 //! named in [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on
 //! Lambertian surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is
-//! unbounded), penumbrae (a shadow ray grid's visible fraction), shadow maps, f32 or device interpolation, and
-//! shadows turned off in a scene that can shadow itself (there the error is up to 100%). An irradiance image has
-//! no lobes: its lights' closed forms are exact ([`predict_irradiance`]).
+//! unbounded), penumbrae (a shadow ray grid's visible fraction), shadow maps, the device's interpolation (f32
+//! barycentrics are bounded where `--tolerance` computes it: `super::interpolation`), and shadows turned off in a
+//! scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes: its lights'
+//! closed forms are exact ([`predict_irradiance`]).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
@@ -408,7 +409,7 @@ pub fn choose_for_tolerance_with_peak(
 
 /// What `--tolerance` refuses whatever the materials, or the settings with the disk lights' exact model (on
 /// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): light of disk lights
-/// and the sky through occluders (their visible fraction), f32 or device interpolation, shadows other than rays
+/// and the sky through occluders (their visible fraction), the device's interpolation, shadows other than rays
 /// where the scene can shadow itself.
 pub(crate) fn techniques_within(
     settings: &RenderSettings,

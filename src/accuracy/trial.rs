@@ -88,8 +88,8 @@ pub fn render_within_tolerance<T, E>(
     )))
 }
 
-/// [`render_within_tolerance`] but for f32 interpolation's bound: the models, the delta trial and the grids'
-/// study.
+/// What [`render_within_tolerance`] does besides f32 interpolation's bound: the models by their bounds, the delta
+/// trial, the grids' study.
 #[allow(clippy::too_many_arguments)]
 fn models_within<T, E>(
     scene: &Scene,
@@ -141,8 +141,9 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 /// ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits what the sun's
 /// bound and the arithmetic leave. With a measured material under the sun, the disk sun's grid is refined on the
 /// same rungs instead, and the estimate gets all of the tolerance but the arithmetic. Refused as
-/// [`techniques_within`] refuses (light through occluders, f32 interpolation, shadows other than rays), where the
-/// sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid does not meet it.
+/// [`techniques_within`] refuses (light through occluders, the device's interpolation, shadows other than rays),
+/// where the sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid does not
+/// meet it.
 #[allow(clippy::too_many_arguments)]
 fn lobe_study<T, E>(
     scene: &Scene,
@@ -197,8 +198,8 @@ fn lobe_study<T, E>(
         }
     }
     Err(TrialError::Tolerance(format!(
-        "--tolerance {tolerance:e}: the lobe grids under disk lights and the sky did not meet the {budget:.1e} the \
-         sun's bound leaves by {}² ({}; docs/accuracy.md, \"Error bounds\")",
+        "--tolerance {tolerance:e}: the grids estimated by refinement did not meet the {budget:.1e} that the sun's \
+         bound and the arithmetic leave by {}² ({}; docs/accuracy.md, \"Error bounds\")",
         settings.shading.samples_per_axis,
         match last {
             Some(e) => format!("estimated {:.1e}", e.gci),
