@@ -655,6 +655,16 @@ fn bench_pareto_measures_each_setting_against_the_converged_reference() {
     assert!(disk < delta, "disk {disk:e}, delta {delta:e}");
     assert!(rows.iter().any(|r| r["front (max)"] == "★"));
     assert!(rows.iter().all(|r| r["GPU frame [ms]"].as_f64().unwrap() > 0.0));
+    // What `--tolerance` chose at 1e-2, 1e-3, 1e-4 (a sphere cannot shadow itself): each kept image meets its T
+    // against the same truth, and so does its prediction.
+    let tolerance = json["tables"][1]["rows"].as_array().unwrap();
+    assert_eq!(tolerance.len(), 3, "{}", json["tables"][1]);
+    for r in tolerance {
+        let t = r["T"].as_f64().unwrap();
+        assert!(r["max rel"].as_f64().unwrap() <= t, "{r}");
+        assert!(r["predicted"].as_f64().unwrap() <= t, "{r}");
+        assert!(r["renders"].as_f64().unwrap() >= 1.0, "{r}");
+    }
     let png = image::open(&plot).unwrap();
     assert_eq!((png.width(), png.height()), (1280, 400), "two charts: max and p99");
 }

@@ -2,7 +2,8 @@
 //! range (`sweep`), each setting's GPU frame time (median and spread of `--repeat` warm runs) and its error
 //! against the converged reference (`accuracy::converged`; the pixels where the truth itself did not converge are
 //! left out and counted), the Pareto fronts of frame time against the max and the 99th-percentile relative
-//! error, a Markdown table (or JSON) and optionally a log-log plot of each.
+//! error, a Markdown table (or JSON) and optionally a log-log plot of each; and what `--tolerance` chose and cost
+//! at 1e-2, 1e-3, 1e-4 (`bench_tolerance`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -10,6 +11,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::bench::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
+use super::bench_tolerance::{tolerance_rows, tolerance_table};
 use super::generated::{machine, print_output, today, update_region};
 use super::sweep::{sweep, Relevance};
 use super::CliError;
@@ -99,6 +101,19 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let excluded = truth.unconverged_mask();
 
         let uploaded: Vec<GpuScene> = renderers.iter().map(|r| r.upload(&scene)).collect::<Result<_, _>>()?;
+        bar.set_message(format!("{name}: --tolerance"));
+        let predicted_default =
+            predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(default_mode) };
+        let tolerance_rows = tolerance_rows(
+            &scene,
+            &truth_settings,
+            &mut renderers[0],
+            &uploaded[0],
+            predicted_default,
+            &reference,
+            &truth,
+            a.repeat,
+        )?;
         let mut rows = Vec::new();
         for setting in sweep(&relevance, default_mode, &modes) {
             let label = setting.label(&relevance);
@@ -152,6 +167,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             );
         }
         out += "\n";
+        out += &tolerance_table(&name, &tolerance_rows);
         costs.push((name.clone(), exactness_cost(&rows)));
         for (metric, fronts, value) in [
             ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),

@@ -12,6 +12,7 @@ mod bench_measured;
 mod bench_pareto;
 mod bench_shadows;
 mod bench_textures;
+mod bench_tolerance;
 mod daylight;
 mod diff;
 mod fit_brdf;
