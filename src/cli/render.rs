@@ -130,12 +130,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     settings.shading.shadows = choice.technique;
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     // The reference mirroring the device, for the bound of f32 interpolation.
-    let info = r.device_info();
-    let reference = ReferenceOptions {
-        sub_pixel_bits: info.sub_pixel_precision_bits,
-        fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
-        device_ray_queries: info.ray_query,
-    };
+    let reference = device_reference_options(r.device_info(), a);
     let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
@@ -193,7 +188,12 @@ pub fn predicted_barycentrics(interpolation: Interpolation) -> predicted::Baryce
 
 /// The reference options that mirror the device that rendered `job`.
 fn reference_options(session: &mut Session, a: &RenderArgs, job: &Rendered) -> ReferenceOptions {
-    let info = session.renderer_mut(job.renderer).device_info();
+    device_reference_options(session.renderer_mut(job.renderer).device_info(), a)
+}
+
+/// The reference options that mirror a device: its sub-pixel bits and ray queries, and the viewport's FMA as
+/// `--fused-viewport` says (else as the host has it).
+fn device_reference_options(info: &crate::gpu::DeviceInfo, a: &RenderArgs) -> ReferenceOptions {
     ReferenceOptions {
         sub_pixel_bits: info.sub_pixel_precision_bits,
         fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
