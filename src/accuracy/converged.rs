@@ -135,7 +135,7 @@ impl Converged {
 
 /// The sample counts of one refinement: every count at least doubled, `n → ⌈n·√2⌉` per axis.
 pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
-    let up = |n: u32| ((n as f64) * std::f64::consts::SQRT_2).ceil() as u32;
+    let up = super::refinement::next_grid;
     ShadingOptions {
         sun_samples_per_axis: up(shading.sun_samples_per_axis),
         samples_per_axis: up(shading.samples_per_axis),

@@ -15,8 +15,8 @@
 //! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
-//! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding
-//! [`Ladder::noise`]), is then `C kᵢ₋₁^−p (1 − rᵢ^−p)` with `rᵢ = kᵢ / kᵢ₋₁`, so
+//! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding,
+//! twice the renderer's arithmetic), is then `C kᵢ₋₁^−p (1 − rᵢ^−p)` with `rᵢ = kᵢ / kᵢ₋₁`, so
 //!
 //! `dᵢ₋₁ / dᵢ = rᵢ₋₁^p (1 − rᵢ₋₁^−p) / (1 − rᵢ^−p)`            (solved for the observed order p by bisection)
 //!
@@ -48,7 +48,7 @@ pub const MAX_ORDER: f64 = 2.0;
 /// Roache's factor of safety for a study of three grids.
 pub const SAFETY_FACTOR: f64 = 1.25;
 
-/// The next rung after `k`: the samples at least doubled.
+/// The next rung after `k`: the samples at least doubled, `⌈√2 k⌉` (the converged reference's doubling too).
 pub fn next_grid(k: u32) -> u32 {
     ((k as f64) * std::f64::consts::SQRT_2).ceil() as u32
 }
@@ -151,11 +151,6 @@ impl Ladder {
     /// lobe grids or not.
     pub fn new(arithmetic: f64, sun_grid: bool) -> Self {
         Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new(), sun_grid }
-    }
-
-    /// Two renders' rounding [relative], subtracted from every difference.
-    pub fn noise(&self) -> f64 {
-        self.noise
     }
 
     /// Records the image of grid `k` given the previous rung's image (`None` for the first).
