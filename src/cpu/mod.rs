@@ -198,30 +198,37 @@ pub fn render_selected(
     render_inner(scene, settings, options, Some(selected), &shader).0
 }
 
-/// For each pixel, per channel, the largest change of its radiance (as [`render`] shades it, with `settings`'
-/// shadows) when its barycentrics move to one of the six corners `l ± r eᵢ` of the ball `Σ|δlᵢ| ≤ r`,
-/// `r = radius(clip-space vertices, pixel NDC)` (`accuracy::interpolation` takes the largest change over the ball
-/// from these corners). A pixel whose surface reads textures, vertex colours, a normal map, emission or an alpha
-/// mask (interpolated there from the barycentrics too, which this does not move) or whose radius is not finite
-/// gets an infinite change: no claim.
+/// For each pixel, its radiance as [`render`] gives it (with `settings`' shadows), and per channel the largest
+/// change of that radiance when its barycentrics move to one of the six corners `l ± r eᵢ` of the ball
+/// `Σ|δlᵢ| ≤ r`, `r = radius(clip-space vertices, pixel NDC)` (`accuracy::interpolation` takes the largest change
+/// over the ball from these corners): `(radiance, change)`, one shading pass. A pixel whose surface reads
+/// textures, vertex colours, a normal map, emission or an alpha mask (interpolated there from the barycentrics
+/// too, which this does not move) or whose radius is not finite gets an infinite change: no claim.
 pub fn barycentric_sensitivity(
     scene: &Scene,
     settings: &RenderSettings,
     options: &ReferenceOptions,
     radius: &(dyn Fn([glam::Vec4; 3], glam::Vec2) -> f64 + Sync),
-) -> Image {
+) -> (Image, Image) {
+    use std::sync::atomic::{AtomicU32, Ordering};
     let occluders = occluders_for(scene, settings, options);
     let rays = occluders.as_ref();
     let viewer = settings.viewer();
-    let shader = move |t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
-        let r = radius(t.clip, pixel_ndc(x, y, settings.width, settings.height));
-        if t.surface != 0 || !r.is_finite() {
-            return ([f64::INFINITY; 3], false);
-        }
+    let (width, height) = (settings.width, settings.height);
+    // Each pixel's radiance, rounded to f32 as `render` stores it, written by the pass that shades it.
+    let centres: Vec<[AtomicU32; 3]> = (0..width as usize * height as usize).map(|_| Default::default()).collect();
+    let shader = |t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
         let at = |w: [f64; 3]| {
             shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (&r.occluders as &dyn Occlusion, r.lights)))
         };
         let centre = at(w);
+        for (slot, value) in centres[(y * width + x) as usize].iter().zip(centre) {
+            slot.store((value as f32).to_bits(), Ordering::Relaxed);
+        }
+        let r = radius(t.clip, pixel_ndc(x, y, width, height));
+        if t.surface != 0 || !r.is_finite() {
+            return ([f64::INFINITY; 3], false);
+        }
         let mut change = [0.0f64; 3];
         for i in 0..3 {
             for sign in [-1.0, 1.0] {
@@ -235,7 +242,15 @@ pub fn barycentric_sensitivity(
         }
         (change, false)
     };
-    render_inner(scene, settings, options, None, &shader).0
+    let change = render_inner(scene, settings, options, None, &shader).0;
+    let mut radiance = Image::new(width, height);
+    for ((p, c), centre) in radiance.pixels_mut().iter_mut().zip(change.pixels()).zip(&centres) {
+        if c[3] > 0.0 {
+            let v = centre.each_ref().map(|a| f32::from_bits(a.load(Ordering::Relaxed)));
+            *p = [v[0], v[1], v[2], 1.0];
+        }
+    }
+    (radiance, change)
 }
 
 /// How near a shadow ray may pass an occluder's edge before its answer counts as fragile: `2⁻¹⁸` of the
