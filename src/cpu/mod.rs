@@ -34,7 +34,7 @@ use self::barycentric::{pixel_ndc, triangle_barycentrics};
 use self::clip::{clip_mask, clip_triangle, ClipVertex, ATTRIBUTES};
 use self::fragment::{covers, ray_frame, shade, surface_sample};
 use self::interpolate::Interpolator;
-pub use self::occluders::{occluder_bvh, Occluders};
+pub use self::occluders::Occluders;
 use self::raster::RasterTriangle;
 use self::transform::clip_position;
 use self::viewport::{snap, Viewport};
@@ -43,6 +43,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{discontinuity_margin as surface_discontinuity, surface_flags, SURFACE_ALPHA_MASK};
 use crate::shading::{Occlusion, ShadowedLights, Shadows};
+pub use crate::visibility::occluder_bvh;
 use crate::visibility::ShadowChoice;
 
 /// How the reference mirrors the device.

@@ -11,7 +11,7 @@ use glam::DVec3;
 use crate::scene::{AlphaMode, Scene};
 use crate::shading::surface::{masked_hit_blocks, SurfaceSample};
 use crate::shading::Occlusion;
-use crate::visibility::{Bvh, WatertightRay};
+use crate::visibility::{occluder_bvh, Bvh, WatertightRay};
 
 /// A masked triangle's material, corners [m], texture coordinates per set, and vertex alphas (if the mesh has
 /// colours).
@@ -28,16 +28,6 @@ pub struct Occluders<'a> {
     /// Per BVH triangle (the scene's order), the masked ones' data.
     masked: Vec<Option<MaskedTriangle>>,
     scene: &'a Scene,
-}
-
-/// Every triangle of the scene in world space, for the shadow rays.
-pub fn occluder_bvh(scene: &Scene) -> Bvh {
-    let triangles = scene
-        .meshes
-        .iter()
-        .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
-        .collect();
-    Bvh::new(triangles)
 }
 
 impl<'a> Occluders<'a> {

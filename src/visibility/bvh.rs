@@ -98,6 +98,19 @@ impl Bvh {
         self.order.len()
     }
 
+    /// The triangle indices (as given to [`Bvh::new`]) in leaf order: a leaf's `first..first + count` index this.
+    pub fn order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// The nodes, root first, each as `(min, max, first, count)` [m]: a leaf (`count > 0`) holds
+    /// `order()[first..first + count]`, an inner node (`count == 0`) has its children at `first` and `first + 1`.
+    /// The boxes are padded as the traversal here uses them. The GPU's traversal (shaders/occluders.glsl) walks
+    /// the same tree.
+    pub fn nodes(&self) -> impl Iterator<Item = (DVec3, DVec3, u32, u32)> + '_ {
+        self.nodes.iter().map(|n| (n.min, n.max, n.first, n.count))
+    }
+
     /// Whether the ray hits any triangle with `t_min < t < t_max` (a shadow ray: the light is occluded).
     pub fn any_hit(&self, ray: &WatertightRay, t_min: f64, t_max: f64) -> bool {
         self.traverse(ray, t_min, t_max, true).is_some()

@@ -25,7 +25,20 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
+use super::Bvh;
 use crate::scene::Scene;
+
+/// Every triangle of the scene in world space (the meshes' triangles in turn, as the GPU's occluder records), in a
+/// BVH, for the shadow rays of both renderers: the reference's f64 rays (`cpu::Occluders`) and, on devices without
+/// ray queries, the GPU's (`gpu::shadow_bvh`).
+pub fn occluder_bvh(scene: &Scene) -> Bvh {
+    let triangles = scene
+        .meshes
+        .iter()
+        .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
+        .collect();
+    Bvh::new(triangles)
+}
 
 /// Whether any triangle of the scene might occlude a light from a visible surface (see the module docs).
 pub fn can_occlude(scene: &Scene) -> bool {
