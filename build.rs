@@ -2,7 +2,8 @@
 //! `$OUT_DIR`, embedded in the binary by `src/gpu/shaders.rs` (the table `spirv_modules.rs` generated here).
 //!
 //! Variants are the `#define`s chosen when the device is known: one interpolation mode of three, and the
-//! `SUNSHADE_NAIVE_MATH` diagnostic, and for fragment shaders `SUNSHADE_RAY_QUERY` (shadow rays). Everything else is a specialization constant, set at pipeline creation.
+//! `SUNSHADE_NAIVE_MATH` diagnostic, and for fragment shaders `SUNSHADE_RAY_QUERY` or `SUNSHADE_RAY_BVH` (shadow rays, by ray queries or by
+//! the shader's own BVH walk). Everything else is a specialization constant, set at pipeline creation.
 //! A compile error fails the build with shaderc's `file:line: error` message.
 
 use std::path::{Path, PathBuf};
@@ -16,6 +17,8 @@ const NAIVE_MATH: &str = "SUNSHADE_NAIVE_MATH";
 /// Fragment shaders with shadow rays (`GL_EXT_ray_query`): a module of their own, so that the capability never
 /// appears in the modules for devices without it. Not combined with the naive-math diagnostic.
 const RAY_QUERY: &str = "SUNSHADE_RAY_QUERY";
+/// Fragment shaders with shadow rays on devices without ray queries: the occluders' BVH walked in the shader.
+const RAY_BVH: &str = "SUNSHADE_RAY_BVH";
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
@@ -41,6 +44,7 @@ fn main() {
             variants.push((stage, vec![interpolation, NAIVE_MATH]));
             if stage.ends_with(".frag") {
                 variants.push((stage, vec![interpolation, RAY_QUERY]));
+                variants.push((stage, vec![interpolation, RAY_BVH]));
             }
         }
     }

@@ -21,6 +21,10 @@
 #define SHADOWS_NONE 0u
 #define SHADOWS_RAY 1u
 #define SHADOWS_MAP 2u
+// The coverage alpha of a fragment whose loops llvmpipe's limiter cut short (fragment.glsl's coverage_alpha), and
+// the probe loop's iterations; values match gpu::loop_budget.
+#define LOOP_BUDGET_SPENT -1.0
+#define LOOP_PROBE_ITERATIONS 2u
 // What the fragment shader writes (VARIANT_QUANTITY); values match gpu::layout.
 #define QUANTITY_RADIANCE 0u
 #define QUANTITY_IRRADIANCE 1u
@@ -118,7 +122,7 @@ layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
-    uvec4 counts;   // x: number of disk lights; y, z unused; w: samples per axis (disks, sky)
+    uvec4 counts;   // x: number of disk lights; y unused; z: LOOP_PROBE_ITERATIONS (fragment.glsl); w: samples per axis (disks, sky)
     uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions);
                     // z: shadow-map filter, 1 PCSS, 2 nearest
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
@@ -155,11 +159,26 @@ layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
     float surface_data[];
 };
 
-// Per triangle of the acceleration structure (its primitive order): global vertex indices, and the material
-// (bit 31: the mesh has vertex colours); read by shadow rays that meet alpha-masked triangles.
+// Per triangle of the acceleration structure (its primitive order; with SUNSHADE_RAY_BVH, the tree's leaf order):
+// global vertex indices, and the material (bit 31: the mesh has vertex colours); read by shadow rays.
 layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
+
+#ifdef SUNSHADE_RAY_BVH
+// The occluders' tree for shadow rays on devices without ray queries (gpu::shadow_bvh::BvhNodeGpu, 32 bytes): a
+// box [m] (padded for the f32 slab test), and a leaf's first record of OccluderTriangles and their count, or an
+// inner node's (count 0) first child (the second follows it).
+struct BvhNode {
+    vec3 lo;
+    uint first;
+    vec3 hi;
+    uint count;
+};
+layout(std430, set = 0, binding = 12) readonly buffer BvhNodes {
+    BvhNode bvh_nodes[];
+};
+#endif
 
 // Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rho
 // [1/sr] as rgb (a unused: one 16-byte load per sample; gpu::layout::measured_tables); materials naming the same

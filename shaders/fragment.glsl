@@ -7,6 +7,20 @@
 #include "transform.glsl"
 #include "surface.glsl"
 
+// The coverage alpha of a shaded fragment: 1, or LOOP_BUDGET_SPENT where llvmpipe's loop limiter has cut the
+// fragment's loops short. llvmpipe (lavapipe) gives every shader invocation one budget of 65535 loop iterations,
+// all loops together (Mesa's LP_MAX_TGSI_LOOP_ITERATIONS); once it is spent, every loop exits after its current
+// iteration, silently: a lobe grid or a shadow ray's walk left unfinished (docs/platform.md). This probe loop runs
+// lights.counts.z (2) iterations, not known to the compiler, so it is not unrolled; it stops after one exactly when
+// the budget is spent, and the renderer refuses an image with such pixels (gpu::loop_budget).
+float coverage_alpha() {
+    uint probe = 0u;
+    for (uint i = 0u; i < lights.counts.z; ++i) {
+        probe += 1u;
+    }
+    return probe == lights.counts.z ? 1.0 : LOOP_BUDGET_SPENT;
+}
+
 vec3 fragment_vertex_position(uint index) {
     uint base = index * FLOATS_PER_VERTEX + VERTEX_POSITION;
     return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);

@@ -117,12 +117,12 @@ void main() {
     }
     if (VARIANT_QUANTITY == QUANTITY_IRRADIANCE) {
         // The irradiance at the surface [W/m^2] (shading::quantity): the lights' visible parts, no material.
-        out_radiance = vec4(irradiance_visible(frame), 1.0);
+        out_radiance = vec4(irradiance_visible(frame), coverage_alpha());
         return;
     }
     vec3 radiance = radiance_out(material, frame);
     if ((VARIANT_SURFACE & SURFACE_EMISSION) != 0u) {
         radiance = radiance + emission;
     }
-    out_radiance = vec4(radiance, 1.0);
+    out_radiance = vec4(radiance, coverage_alpha());
 }

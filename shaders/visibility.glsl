@@ -15,47 +15,36 @@
 // "Infinitely far" for rays to the sun and the sky: beyond any f32 scene (coordinates are below 1e15 m).
 #define RAY_T_INFINITE 1.0e30
 
-#ifdef SUNSHADE_RAY_QUERY
-#include "surface.glsl"
+#if defined(SUNSHADE_RAY_QUERY) || defined(SUNSHADE_RAY_BVH)
+#include "occluders.glsl"
+#endif
 
+#ifdef SUNSHADE_RAY_QUERY
 layout(set = 0, binding = 4) uniform accelerationStructureEXT scene_tlas;
 
 // Whether any triangle meets origin + t direction for 0 < t < t_max: a ray query that stops at the first hit,
 // both faces. The acceleration structure is opaque unless the scene has alpha-masked triangles; then each
-// candidate hit is confirmed where its triangle's alpha reaches the cutoff (masked_hit_blocks, at the hit's
-// barycentrics; src/cpu/occluders.rs in the reference), so light passes where the mask cuts the surface away.
+// candidate hit is confirmed where the triangle blocks (occluders.glsl's blocks, at the hit's barycentrics;
+// src/cpu/occluders.rs in the reference), so light passes where the mask cuts the surface away.
 bool occluded(vec3 origin, vec3 direction, float t_max) {
     rayQueryEXT q;
     rayQueryInitializeEXT(q, scene_tlas, gl_RayFlagsTerminateOnFirstHitEXT, 0xFFu, origin, 0.0, direction, t_max);
     while (rayQueryProceedEXT(q)) {
         uvec4 tri = occluder_triangles[rayQueryGetIntersectionPrimitiveIndexEXT(q, false)];
-        vec2 b = rayQueryGetIntersectionBarycentricsEXT(q, false);
-        REAL3 w = REAL3(REAL(1.0) - REAL(b.x) - REAL(b.y), REAL(b.x), REAL(b.y));
-        SurfaceSample s;
-        for (uint set = 0u; set < 2u; ++set) {
-            uint offset = set == 0u ? SURFACE_VERTEX_UV0 : SURFACE_VERTEX_UV1;
-            REAL2 uv = w.x * REAL2(vec2(surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + offset],
-                                        surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + offset + 1u]))
-                     + w.y * REAL2(vec2(surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + offset],
-                                        surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + offset + 1u]))
-                     + w.z * REAL2(vec2(surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset],
-                                        surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset + 1u]));
-            s.uv[set] = uv;
-            s.uv_x[set] = uv;
-            s.uv_y[set] = uv;
-        }
-        s.color = vec4(1.0);
-        if ((tri.w & 0x80000000u) != 0u) {
-            uint c = SURFACE_VERTEX_COLOR + 3u;
-            s.color.a = float(w.x * REAL(surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + c])
-                + w.y * REAL(surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + c])
-                + w.z * REAL(surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + c]));
-        }
-        if (masked_hit_blocks(materials[tri.w & 0x7fffffffu], s)) {
+        if (blocks(tri, rayQueryGetIntersectionBarycentricsEXT(q, false))) {
             rayQueryConfirmIntersectionEXT(q);
         }
     }
     return rayQueryGetIntersectionTypeEXT(q, true) != gl_RayQueryCommittedIntersectionNoneEXT;
+}
+#elif defined(SUNSHADE_RAY_BVH)
+// The same on a device without ray queries: the occluders' tree walked in the shader (occluders.glsl). A zero
+// or non-finite direction meets nothing (as WatertightRay::new refuses it).
+bool occluded(vec3 origin, vec3 direction, float t_max) {
+    if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
+        return false;
+    }
+    return any_hit(watertight_ray(origin, direction), t_max);
 }
 #else
 bool occluded(vec3 origin, vec3 direction, float t_max) {

@@ -574,3 +574,35 @@ fn f32_interpolation_stays_within_its_bound_on_the_gpu() {
     eprintln!("brdfs.glb, f32 barycentrics, T = 1e-3: measured {measured:.2e}");
     assert!(measured <= 1e-3, "{measured:.3e}\n{e}");
 }
+
+/// `render --tolerance` on scenes that shadow themselves under the sun, on any device: `auto` casts shadow rays
+/// (without ray queries, the fragment shader's walk of the BVH) instead of shadow maps, which have no bound, and the
+/// image meets T against the converged reference with shadow rays (its unconverged pixels, the penumbrae, left out).
+#[test]
+fn render_tolerance_casts_shadow_rays_on_any_device() {
+    let dir = common::TempDir::new("tolerance-shadows");
+    let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    for name in ["teapot.glb", "sunset.glb"] {
+        let out = dir.path(&format!("{name}.exr"));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
+            .args(["render", models.join(name).to_str().unwrap(), "--width", "48", "--height", "36"])
+            .args(["--tolerance", "1e-2", "-v", "-o", out.to_str().unwrap()])
+            .env("SUNSHADE_VALIDATION", "1")
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
+            return; // a device without f64 interpolation has no bound to keep
+        }
+        assert!(o.status.success(), "{name}: {e}");
+        assert!(e.contains("shadows: ray"), "{name}: {e}");
+        let scene = common::load(&models.join(name));
+        let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
+        s.shading.shadows = Shadows::Ray;
+        let image = sunshade::film::read_image(&out).unwrap();
+        let (measured, unconverged) =
+            common::error_against_converged(&scene, &s, &image, 1e-3, &ReferenceOptions::default());
+        eprintln!("{name}: T = 1e-2 with shadow rays, measured {measured:.2e} ({unconverged} pixels unconverged)");
+        assert!(measured <= 1e-2, "{name}: {measured:.3e} over 1e-2\n{e}");
+    }
+}

@@ -149,15 +149,18 @@ fn shaders_avoid_inaccurate_builtins() {
 /// GPU-only with the reason, so that a new file cannot slip past the mirror.
 #[test]
 fn every_shader_file_is_mirrored_or_declared_gpu_only() {
-    let mirrored: &[(&str, &str)] = &[
-        ("radiometry.glsl", "src/shading"),
-        ("brdf.glsl", "src/shading"),
-        ("shade.glsl", "src/shading"),
-        ("visibility.glsl", "src/shading"),
-        ("surface.glsl", "src/shading"),
-        ("texture_filter.glsl", "src/shading"),
-        ("measured.glsl", "src/shading"),
-        ("transform.glsl", "src/cpu"),
+    let mirrored: &[(&str, &[&str])] = &[
+        ("radiometry.glsl", &["src/shading"]),
+        ("brdf.glsl", &["src/shading"]),
+        ("shade.glsl", &["src/shading"]),
+        ("visibility.glsl", &["src/shading"]),
+        ("surface.glsl", &["src/shading"]),
+        ("texture_filter.glsl", &["src/shading"]),
+        ("measured.glsl", &["src/shading"]),
+        ("transform.glsl", &["src/cpu"]),
+        // The occluders: the BVH walk and the watertight test (src/visibility), and which hits block a ray
+        // (src/cpu/occluders.rs, the reference's occluders).
+        ("occluders.glsl", &["src/visibility", "src/cpu"]),
     ];
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
     // replacements for lavapipe's inaccurate built-ins (Rust uses f64's); the shadow map (the reference casts rays,
@@ -179,14 +182,14 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         if gpu_only.contains(&name.as_str()) {
             continue;
         }
-        let (_, rust_dir) = mirrored
+        let (_, rust_dirs) = mirrored
             .iter()
             .find(|(f, _)| *f == name)
             .unwrap_or_else(|| panic!("shaders/{name} is neither mirrored nor declared GPU-only"));
-        let rust: String = sources(rust_dir).into_iter().map(|(_, t)| t).collect();
+        let rust: String = rust_dirs.iter().flat_map(|d| sources(d)).map(|(_, t)| t).collect();
         let text = std::fs::read_to_string(dir.join(&name)).unwrap();
         for f in glsl_functions(&text) {
-            assert!(rust.contains(&format!("fn {f}(")), "shaders/{name}: `{f}` has no Rust function in {rust_dir}");
+            assert!(rust.contains(&format!("fn {f}(")), "shaders/{name}: `{f}` has no Rust function in {rust_dirs:?}");
         }
     }
 }

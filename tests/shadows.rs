@@ -158,7 +158,7 @@ fn penumbra_of_a_straight_edge_converges_to_the_circular_segment() {
 
 #[test]
 fn gpu_ray_queries_agree_with_the_reference_on_the_penumbra() {
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     let scene = edge_scene();
     let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
     let s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, 16);
@@ -348,7 +348,7 @@ fn the_sun_at_the_horizon_throws_long_shadows() {
 fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
     // Every scene of models/ with its own lights, shadows by ray queries against the f64 reference, to the
     // tolerance of `render --check`.
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     let mut checked = 0;
     for name in ["room.gltf", "teapot.glb", "spheres.glb", "cube.glb", "brdfs.glb", "overcast.glb", "sunset.glb"] {
@@ -376,7 +376,7 @@ fn gpu_ray_queries_agree_with_the_reference_on_glossy_spheres_under_the_sky() {
     // brdfs.glb's glossy spheres on their floor under an overcast sky alone, every sky sample casting its ray
     // (the lobe grids over the hemisphere and over the lunes the horizontal cuts it into, shading::sky_lune):
     // against the f64 reference, to the tolerance of `render --check`.
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     let scene = common::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/brdfs.glb"));
     let lights = sunshade::scene::Lights { sky: Some([300.0; 3]), ..Default::default() };
     let mut s =
@@ -519,7 +519,7 @@ fn gpu_ray_query_differences_lie_at_fragile_rays() {
     // sun and the sky: the GPU's ray queries and the reference's f64 rays may answer differently only for rays
     // that pass within 2^-18 of the scene's size from an occluder's boundary, and the reference flags those
     // pixels; every pixel over the tolerance must be one of them.
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     let soup =
         sunshade::authoring::shapes::triangle_soup(Vec3::new(0.0, 0.6, 0.0), Vec3::new(0.8, 0.4, 0.8), 3000, 0.2, 7);
     let sc = scene(&[floor(1.5), soup]);
@@ -545,7 +545,7 @@ fn gpu_ray_queries_agree_with_the_reference_at_every_scale_and_at_grazing_sun() 
     // The blocks (a box standing on the floor, a 1 mm plate) at 1 mm, 1 m and 10 km, under a 45° sun and a sun
     // 0.5° above the horizon, seen from above: the GPU's shadow rays against the reference's, to the check
     // tolerance, differences allowed only at fragile rays.
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     for scale in [1e-3f32, 1.0, 1e3] {
         let sc = blocks_scene(scale, 5.0);
         let camera = camera_down(DVec3::new(1.5, 0.0, 0.0) * scale as f64, 3.0 * scale as f64, 10.0 * scale as f64);
@@ -760,7 +760,7 @@ fn gpu_shadow_maps_pass_light_through_alpha_masked_cutouts() {
 
 #[test]
 fn gpu_ray_queries_pass_light_through_alpha_masked_cutouts() {
-    let Some(mut gpu) = common::ray_query_renderer() else { return };
+    let mut gpu = common::shadow_ray_renderer();
     let (scene, s) = masked_cutout_scene();
     let g = gpu.render(&scene, &s);
     let (c, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &gpu.reference_options());

@@ -434,8 +434,8 @@ pub(crate) fn techniques_within(
     }
     if can_occlude && shading.shadows != Shadows::Ray {
         return Err(format!(
-            "--tolerance {tolerance:e}: the scene can shadow itself, and only shadow rays (--shadows ray, a device \
-             with ray queries) render its shadows with a known error outside penumbrae"
+            "--tolerance {tolerance:e}: the scene can shadow itself, and only shadow rays (--shadows ray, or auto) \
+             render its shadows with a known error outside penumbrae"
         ));
     }
     Ok(shading)

@@ -85,7 +85,7 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
         );
         println!(
             "      ray queries (VK_KHR_ray_query + acceleration structures): {}",
-            if d.ray_query { "yes" } else { "no" }
+            if d.ray_query { "yes" } else { "no (--shadows ray walks the scene's BVH in the fragment shader)" }
         );
         if let Some(why) = &d.unusable {
             println!("      not usable: {why}");

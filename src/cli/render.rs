@@ -122,7 +122,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     session.renderer_mut(renderer).check_size(settings.width, settings.height)?;
     let upload = session.upload(scene, renderer)?;
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
-    let choice = r.shadow_choice(gpu_scene, &settings)?;
+    let mut choice = r.shadow_choice(gpu_scene, &settings)?;
+    if a.scene.tolerance.is_some() && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
+        // Shadow maps have no error bound; `--tolerance` casts rays on any device (without ray queries, by the
+        // fragment shader's walk of the occluders' BVH).
+        choice = crate::visibility::ShadowChoice {
+            technique: Shadows::Ray,
+            reason: "auto with --tolerance: shadow rays, whose error outside penumbrae is known (the device has no \
+                     ray queries: the fragment shader walks the occluders' BVH)"
+                .into(),
+            warning: false,
+        };
+    }
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
     }

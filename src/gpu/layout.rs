@@ -353,7 +353,7 @@ pub fn lights_bytes(
     let header = LightsHeader {
         sun,
         sky,
-        counts: [lights.disks.len() as u32, 0, 0, shading.samples_per_axis],
+        counts: [lights.disks.len() as u32, 0, super::loop_budget::LOOP_PROBE_ITERATIONS, shading.samples_per_axis],
         sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, 0],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
         sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
@@ -427,6 +427,9 @@ mod tests {
             assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
         }
         assert!(glsl.contains(&format!("#define MAX_DISK_MAPS {MAX_DISK_MAPS}u\n")));
+        use super::super::loop_budget::{LOOP_BUDGET_SPENT, LOOP_PROBE_ITERATIONS};
+        assert!(glsl.contains(&format!("#define LOOP_PROBE_ITERATIONS {LOOP_PROBE_ITERATIONS}u\n")));
+        assert!(glsl.contains(&format!("#define LOOP_BUDGET_SPENT {LOOP_BUDGET_SPENT:.1}\n")));
         assert!(glsl.contains("#define NO_TEXTURE 0xffffffffu\n"));
         // The vertex layout: FLOATS_PER_VERTEX and each attribute's offset in floats.
         assert!(glsl.contains(&format!("#define FLOATS_PER_VERTEX {}u\n", std::mem::size_of::<Vertex>() / 4)));

@@ -18,11 +18,13 @@ mod context;
 mod device_info;
 mod error;
 pub mod layout;
+pub mod loop_budget;
 mod memory;
 mod pipeline;
 pub mod pipeline_cache;
 mod renderer;
 pub mod shaders;
+pub mod shadow_bvh;
 mod shadow_map;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};

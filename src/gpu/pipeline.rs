@@ -29,8 +29,10 @@ pub(crate) struct ScenePipeline {
     pub descriptor_set: vk::DescriptorSet,
     vertex_module: vk::ShaderModule,
     fragment_module: vk::ShaderModule,
-    /// The fragment shader with shadow rays (devices with ray queries only).
-    ray_query_module: vk::ShaderModule,
+    /// The fragment shader with shadow rays: by ray queries, or by the shader's walk of the occluders' BVH on
+    /// devices without them (`ray_bvh`); null with the naive-math diagnostic.
+    ray_module: vk::ShaderModule,
+    ray_bvh: bool,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
     /// The depth-only pipeline of the sun's shadow map (vertex stage only), created at first use.
@@ -44,6 +46,15 @@ pub(crate) struct ScenePipeline {
     unsaved: bool,
 }
 
+/// How the fragment shader with shadow rays casts them: by the device's ray queries (`SUNSHADE_RAY_QUERY`,
+/// binding 4 the acceleration structure) or by walking the occluders' BVH itself (`SUNSHADE_RAY_BVH`, binding
+/// 12 its nodes; `gpu::shadow_bvh`), on devices without ray queries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowRays {
+    Query,
+    Bvh,
+}
+
 impl ScenePipeline {
     /// `with_normals`: the vertex shader also reads the normal (for device interpolation). `cache_dir`: where the
     /// pipeline cache lives on disk (`None`: in memory only).
@@ -52,7 +63,7 @@ impl ScenePipeline {
         vertex_spirv: &[u32],
         fragment_spirv: &[u32],
         shadow_mask_spirv: &[u32],
-        ray_query_spirv: Option<&[u32]>,
+        ray_spirv: Option<(&[u32], ShadowRays)>,
         with_normals: bool,
         cache_dir: Option<&Path>,
     ) -> Result<Self, GpuError> {
@@ -65,7 +76,8 @@ impl ScenePipeline {
             descriptor_set: vk::DescriptorSet::null(),
             vertex_module: vk::ShaderModule::null(),
             fragment_module: vk::ShaderModule::null(),
-            ray_query_module: vk::ShaderModule::null(),
+            ray_module: vk::ShaderModule::null(),
+            ray_bvh: matches!(ray_spirv, Some((_, ShadowRays::Bvh))),
             with_normals,
             variants: HashMap::new(),
             shadow: vk::Pipeline::null(),
@@ -80,7 +92,7 @@ impl ScenePipeline {
             // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the texels (a uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel
             // buffer holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always
             // bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices
-            // with ray queries. All read by the fragment shader. The descriptor pool is sized from the same table.
+            // with ray queries, or 12 the occluders' BVH nodes (a storage buffer), on devices without. All read by the fragment shader. The descriptor pool is sized from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),
@@ -94,8 +106,10 @@ impl ScenePipeline {
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];
-            if ray_query_spirv.is_some() {
-                table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
+            match ray_spirv {
+                Some((_, ShadowRays::Query)) => table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1)),
+                Some((_, ShadowRays::Bvh)) => table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1)),
+                None => {}
             }
             let bindings: Vec<_> = table
                 .iter()
@@ -150,13 +164,13 @@ impl ScenePipeline {
             out.shadow_mask_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(shadow_mask_spirv), None)
                 .vk("vkCreateShaderModule")?;
-            if let Some(words) = ray_query_spirv {
-                out.ray_query_module = d
+            if let Some((words, _)) = ray_spirv {
+                out.ray_module = d
                     .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
                     .vk("vkCreateShaderModule")?;
             }
             let mut hashed = vec![vertex_spirv, fragment_spirv, shadow_mask_spirv];
-            hashed.extend(ray_query_spirv);
+            hashed.extend(ray_spirv.map(|(words, _)| words));
             let name = pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&hashed));
             out.cache = Some(DiskPipelineCache::open(d, cache_dir, &name)?);
         }
@@ -224,8 +238,14 @@ impl ScenePipeline {
     }
 
     /// Whether pipelines with shadow rays can be made (the device has ray queries).
-    pub fn has_ray_queries(&self) -> bool {
-        self.ray_query_module != vk::ShaderModule::null()
+    pub fn has_shadow_rays(&self) -> bool {
+        self.ray_module != vk::ShaderModule::null()
+    }
+
+    /// Whether the shadow rays walk the occluders' BVH in the shader (binding 12) rather than query the device's
+    /// acceleration structure (binding 4).
+    pub fn rays_walk_bvh(&self) -> bool {
+        self.ray_bvh
     }
 
     /// Creates the pipelines of `variants` that do not exist yet, several at once (a thread each, at most as many
@@ -235,9 +255,9 @@ impl ScenePipeline {
     pub fn prepare_variants(&mut self, variants: &[ShaderVariant]) -> Result<(), GpuError> {
         let mut missing: Vec<ShaderVariant> = Vec::new();
         for &v in variants {
-            if v.shadows == SHADOWS_RAY && !self.has_ray_queries() {
+            if v.shadows == SHADOWS_RAY && !self.has_shadow_rays() {
                 return Err(GpuError::Unsupported(format!(
-                    "{} has no ray queries for shadow rays",
+                    "{}: no shadow rays with the naive-math diagnostic",
                     self.dev.info.name
                 )));
             }
@@ -248,14 +268,14 @@ impl ScenePipeline {
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
         let (d, layout, with_normals) = (&self.dev.device, self.layout, self.with_normals);
-        let (vertex, fragment, ray_query) = (self.vertex_module, self.fragment_module, self.ray_query_module);
+        let (vertex, fragment, rays) = (self.vertex_module, self.fragment_module, self.ray_module);
         let mut first_error = None;
         for chunk in missing.chunks(threads) {
             let created: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|scope| {
                 let handles: Vec<_> = chunk
                     .iter()
                     .map(|&variant| {
-                        let fs = if variant.shadows == SHADOWS_RAY { ray_query } else { fragment };
+                        let fs = if variant.shadows == SHADOWS_RAY { rays } else { fragment };
                         // SAFETY: valid device, layout, modules and cache, owned by self and alive for the scope;
                         // vkCreateGraphicsPipelines may be called from several threads at once.
                         scope.spawn(move || unsafe {
@@ -400,7 +420,7 @@ impl Drop for ScenePipeline {
             d.destroy_pipeline(self.shadow, None);
             d.destroy_shader_module(self.vertex_module, None);
             d.destroy_shader_module(self.fragment_module, None);
-            d.destroy_shader_module(self.ray_query_module, None);
+            d.destroy_shader_module(self.ray_module, None);
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

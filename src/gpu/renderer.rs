@@ -16,8 +16,9 @@ use super::layout::{
     PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
-use super::pipeline::{ScenePipeline, COLOR_FORMAT, DEPTH_FORMAT};
+use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
+use super::shadow_bvh::BvhNodeGpu;
 use super::shadow_map::DepthMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
@@ -62,8 +63,12 @@ pub struct GpuScene {
     texture_table: Buffer,
     /// Texture coordinates and colours per vertex (`SurfaceVertex`), read by textured materials.
     surface_vertices: Buffer,
-    /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
+    /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits; on
+    /// devices without ray queries every triangle's, in the BVH's leaf order.
     occluder_triangles: Buffer,
+    /// The occluders' BVH nodes (`shadow_bvh::BvhNodeGpu`) for the shader's walk; one dummy node with ray
+    /// queries.
+    bvh_nodes: Buffer,
     /// The measured BRDF tables (`layout::measured_tables`).
     measured: Buffer,
     draws: Vec<Draw>,
@@ -160,15 +165,19 @@ impl Renderer {
             Some(stages) if interpolation == guess => stages?,
             _ => compile_stages(interpolation, options.naive_math)?,
         };
-        // The fragment shader with shadow rays, where the device has ray queries (not with the naive-math
-        // diagnostic).
-        let ray_query = if dev.info.ray_query && !options.naive_math {
-            Some(
-                shaders::stage_spirv("scene.frag", &[interpolation_define(interpolation), "SUNSHADE_RAY_QUERY"])
-                    .map_err(GpuError::ShaderCompile)?,
-            )
-        } else {
+        // The fragment shader with shadow rays: by ray queries where the device has them, else by walking the
+        // occluders' BVH in the shader (not with the naive-math diagnostic).
+        let rays = if options.naive_math {
             None
+        } else {
+            let (define, kind) = if dev.info.ray_query {
+                ("SUNSHADE_RAY_QUERY", ShadowRays::Query)
+            } else {
+                ("SUNSHADE_RAY_BVH", ShadowRays::Bvh)
+            };
+            let words = shaders::stage_spirv("scene.frag", &[interpolation_define(interpolation), define])
+                .map_err(GpuError::ShaderCompile)?;
+            Some((words, kind))
         };
         let shadow_mask = shaders::stage_spirv("shadow_mask.frag", &[interpolation_define(interpolation)])
             .map_err(GpuError::ShaderCompile)?;
@@ -177,7 +186,7 @@ impl Renderer {
             &vs,
             &fs,
             &shadow_mask,
-            ray_query.as_deref(),
+            rays.as_ref().map(|(words, kind)| (&words[..], *kind)),
             interpolation == Interpolation::Device,
             options.pipeline_cache_dir.as_deref(),
         )?;
@@ -270,7 +279,8 @@ impl Renderer {
         let mut indices = Vec::new();
         let mut draws = Vec::new();
         // With ray queries: every triangle's indices into the whole vertex buffer, for the acceleration structure.
-        let rq = self.pipeline.has_ray_queries();
+        let rq = self.pipeline.has_shadow_rays() && !self.pipeline.rays_walk_bvh();
+        let bvh = self.pipeline.rays_walk_bvh();
         let mut global_indices = Vec::new();
         let (measured, measured_offsets) = measured_tables(&scene.materials);
         let materials: Vec<_> =
@@ -386,15 +396,16 @@ impl Renderer {
             )?),
             _ => None,
         };
-        let occluder_triangles = Buffer::storage(
-            &self.dev,
-            bytemuck::cast_slice(&occluder_records(
-                scene,
-                &draws.iter().map(|d| d.vertex_offset).collect::<Vec<_>>(),
-                rq && masked,
-            )),
-            "occluder triangles",
-        )?;
+        let vertex_offsets: Vec<i32> = draws.iter().map(|d| d.vertex_offset).collect();
+        // Without ray queries, the occluders' tree for the shader's walk (its records in leaf order); else the
+        // records in the acceleration structure's order where masked hits read them, and one dummy node.
+        let (nodes, records) = if bvh {
+            super::shadow_bvh::shadow_bvh(scene, &vertex_offsets)
+        } else {
+            (vec![BvhNodeGpu::zeroed()], occluder_records(scene, &vertex_offsets, rq && masked))
+        };
+        let occluder_triangles = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder triangles")?;
+        let bvh_nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
         Ok(GpuScene {
             accel,
             vertices,
@@ -404,6 +415,7 @@ impl Renderer {
             texture_table,
             surface_vertices,
             occluder_triangles,
+            bvh_nodes,
             measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): `auto` renders no shadow pass where it is
@@ -416,17 +428,20 @@ impl Renderer {
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
     /// the device has ray queries and reads shadow maps where it has none. `map` shadows the sun and the first
     /// `MAX_DISK_MAPS` disk lights from their maps and leaves the sky (and further disks) unoccluded, with a
-    /// warning where the scene has them. `ray` without ray queries is refused.
+    /// warning where the scene has them. `ray` casts rays on any device: by ray queries, or, without them, by the
+    /// fragment shader's walk of the occluders' BVH (`shadow_bvh`; slower on the same device, the same rays).
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
-        let rq = self.pipeline.has_ray_queries();
+        let rq = self.pipeline.has_shadow_rays() && !self.pipeline.rays_walk_bvh();
         let requested = settings.shading.shadows;
         let mut choice = crate::visibility::choose(requested, &settings.lights, scene.can_occlude, rq);
-        if choice.technique == Shadows::Ray && !rq {
+        if choice.technique == Shadows::Ray && !self.pipeline.has_shadow_rays() {
             return Err(GpuError::Unsupported(format!(
-                "{} has no ray queries (VK_KHR_ray_query) for --shadows ray: use the lavapipe of \
-                 scripts/lavapipe-rt.sh, --shadows map (the sun and disk lights), or --shadows none",
+                "{}: no shadow rays with the naive-math diagnostic: --shadows map or none",
                 self.dev.info.name
             )));
+        }
+        if choice.technique == Shadows::Ray && self.pipeline.rays_walk_bvh() {
+            choice.reason += " (the device has no ray queries: the fragment shader walks the occluders' BVH)";
         }
         if choice.technique == Shadows::Map {
             if settings.lights.disks.len() > MAX_DISK_MAPS {
@@ -498,7 +513,8 @@ impl Renderer {
         )?;
         let any_map = sun_map.is_some() || disk_maps.iter().any(Option::is_some);
         let shadows = match technique {
-            Shadows::Ray if scene.accel.is_some() => SHADOWS_RAY,
+            // Rays need something to meet: the acceleration structure, or the BVH (every scene with geometry).
+            Shadows::Ray if scene.accel.is_some() || self.pipeline.rays_walk_bvh() => SHADOWS_RAY,
             Shadows::Map if any_map => SHADOWS_MAP,
             _ => SHADOWS_NONE,
         };
@@ -549,6 +565,7 @@ impl Renderer {
         let render = t_render.elapsed();
         let t_readback = Instant::now();
         let image = self.read_back(width, height)?;
+        super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::Unsupported)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.check_validation()?;
@@ -647,6 +664,17 @@ impl Renderer {
                     .image_info(infos)
             });
             d.update_descriptor_sets(&writes, &[]);
+            // Binding 12: the occluders' BVH, for the pipelines whose shadow rays walk it.
+            if self.pipeline.rays_walk_bvh() {
+                let info =
+                    [vk::DescriptorBufferInfo { buffer: scene.bvh_nodes.buffer, offset: 0, range: vk::WHOLE_SIZE }];
+                let write = vk::WriteDescriptorSet::default()
+                    .dst_set(self.pipeline.descriptor_set)
+                    .dst_binding(12)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .buffer_info(&info);
+                d.update_descriptor_sets(&[write], &[]);
+            }
             // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
             if let Some(accel) = &scene.accel {
                 let structures = [accel.top_level()];

@@ -14,6 +14,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("measured.glsl", include_str!("../../shaders/measured.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
+    ("occluders.glsl", include_str!("../../shaders/occluders.glsl")),
     ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),
     ("texture_filter.glsl", include_str!("../../shaders/texture_filter.glsl")),
@@ -80,9 +81,11 @@ mod tests {
                 assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
             }
             if name.ends_with(".frag") {
-                let words = compile(name, SOURCES, &["SUNSHADE_F64_BARYCENTRICS", "SUNSHADE_RAY_QUERY"])
-                    .unwrap_or_else(|e| panic!("{e}"));
-                assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+                for rays in ["SUNSHADE_RAY_QUERY", "SUNSHADE_RAY_BVH"] {
+                    let words =
+                        compile(name, SOURCES, &["SUNSHADE_F64_BARYCENTRICS", rays]).unwrap_or_else(|e| panic!("{e}"));
+                    assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+                }
             }
         }
     }
@@ -90,9 +93,9 @@ mod tests {
     #[test]
     fn modules_built_ahead_equal_run_time_compilation() {
         // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
-        // 2 stages × 3 interpolations × (plain, naive math), the fragment stage's 3 with ray queries, and the
-        // masked shadow-map stage's 3.
-        assert_eq!(MODULES.len(), 18);
+        // 2 stages × 3 interpolations × (plain, naive math), the fragment stage's 3 with ray queries and 3 with
+        // the BVH walk, and the masked shadow-map stage's 3.
+        assert_eq!(MODULES.len(), 21);
         for m in MODULES {
             let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);

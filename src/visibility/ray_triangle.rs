@@ -136,6 +136,42 @@ impl Sheared {
     }
 }
 
+/// The GPU's watertight test (shaders/occluders.glsl's `watertight_ray` and `intersect`, without ray queries),
+/// in f32 as the shader computes it, unfused: whether the ray from `origin` along `direction` meets the triangle
+/// with `0 < t < t_max`, and the hit's barycentrics of its second and third corners.
+pub fn intersect_f32(origin: [f32; 3], direction: [f32; 3], [a, b, c]: [[f32; 3]; 3], t_max: f32) -> Option<[f32; 2]> {
+    let d = direction;
+    let m = d.map(f32::abs);
+    let kz = if m[0] >= m[1] && m[0] >= m[2] {
+        0
+    } else if m[1] >= m[2] {
+        1
+    } else {
+        2
+    };
+    let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if d[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+    let rel = |v: [f32; 3]| [v[0] - origin[0], v[1] - origin[1], v[2] - origin[2]];
+    let (pa, pb, pc) = (rel(a), rel(b), rel(c));
+    let project = |p: [f32; 3]| (p[kx] - sx * p[kz], p[ky] - sy * p[kz]);
+    let ((ax, ay), (bx, by), (cx, cy)) = (project(pa), project(pb), project(pc));
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return None;
+    }
+    let t = (u * (sz * pa[kz]) + v * (sz * pb[kz]) + w * (sz * pc[kz])) / det;
+    (t > 0.0 && t < t_max).then_some([v / det, w / det])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,5 +235,74 @@ mod tests {
             let r = WatertightRay::new(origin, aim - origin).unwrap();
             assert!(tris.iter().any(|&t| r.intersect(t, 0.0, 2.0).is_some()), "slipped through at {aim}");
         }
+    }
+
+    /// The GPU's f32 test (shaders/occluders.glsl, mirrored by `intersect_f32`) is watertight too: the fan's shared
+    /// edges and centre, in f32, never let a ray through.
+    #[test]
+    fn the_f32_test_is_watertight_on_the_fan() {
+        let n = 97;
+        let centre = [0.3f32, -0.2, 10.0];
+        let ring: Vec<[f32; 3]> = (0..n)
+            .map(|i| {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                [centre[0] + a.cos() * 3.7, centre[1] + a.sin() * 2.3, centre[2] + 0.4 * (3.0 * a).sin()]
+            })
+            .collect();
+        let tris: Vec<[[f32; 3]; 3]> = (0..n).map(|i| [centre, ring[i], ring[(i + 1) % n]]).collect();
+        let origin = [0.011f32, 0.017, -0.5];
+        let mut aims = vec![centre];
+        for r in &ring {
+            for k in 1..8 {
+                let f = k as f32 / 8.0;
+                aims.push([0, 1, 2].map(|c| centre[c] + f * (r[c] - centre[c])));
+            }
+        }
+        for aim in aims {
+            let d = [0, 1, 2].map(|c| aim[c] - origin[c]);
+            assert!(tris.iter().any(|&t| intersect_f32(origin, d, t, 2.0).is_some()), "slipped through at {aim:?}");
+        }
+    }
+
+    /// The f32 test answers as the f64 one for rays that pass farther than 2⁻¹⁸ of the triangle's size from its
+    /// boundary (the reference's "fragile" margin), on random triangles and rays; its barycentrics are the hit's.
+    #[test]
+    fn the_f32_test_agrees_with_f64_away_from_edges() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut checked, mut hits) = (0, 0);
+        for _ in 0..200_000 {
+            let scale = 10f64.powf(3.0 * next());
+            let v = |n: &mut dyn FnMut() -> f64| DVec3::new(n(), n(), n()) * scale;
+            let tri32 = [v(&mut next), v(&mut next), v(&mut next)].map(|p| p.as_vec3().to_array());
+            let tri = tri32.map(|p| DVec3::from_array(p.map(f64::from)));
+            let origin32 = v(&mut next).as_vec3().to_array();
+            let dir32 = DVec3::new(next(), next(), next()).as_vec3().to_array();
+            let (origin, dir) = (DVec3::from_array(origin32.map(f64::from)), DVec3::from_array(dir32.map(f64::from)));
+            let Some(ray) = WatertightRay::new(origin, dir) else { continue };
+            let size = (tri[1] - tri[0]).length().max((tri[2] - tri[0]).length());
+            let margin = ray.edge_margin(tri, 0.0, 1e30);
+            // Rays within the margin of an edge, or meeting the plane near the origin, may go either way.
+            let t = ray.hit_t(tri).unwrap_or(0.0);
+            if margin.is_some_and(|m| m.abs() <= size / 262_144.0) || t.abs() < 1e-4 * scale {
+                continue;
+            }
+            let f64_hit = ray.intersect(tri, 0.0, 1e30).is_some();
+            let f32_hit = intersect_f32(origin32, dir32, tri32, 1e30);
+            assert_eq!(f64_hit, f32_hit.is_some(), "{tri:?} from {origin} along {dir}");
+            if let Some([b1, b2]) = f32_hit {
+                let at = tri[0] + (tri[1] - tri[0]) * b1 as f64 + (tri[2] - tri[0]) * b2 as f64;
+                let along = origin + dir * t;
+                assert!((at - along).length() <= 1e-3 * size.max(along.length()), "barycentrics {b1} {b2}");
+                hits += 1;
+            }
+            checked += 1;
+        }
+        assert!(checked > 150_000 && hits > 5_000, "{checked} checked, {hits} hits");
     }
 }

@@ -1,0 +1,190 @@
+// The scene's triangles as occluders of shadow rays. Mirrors src/cpu/occluders.rs (`blocks`: an alpha-masked
+// triangle lets light through where its alpha is below the cutoff) and, for devices without ray queries
+// (SUNSHADE_RAY_BVH), src/visibility/bvh.rs and ray_triangle.rs: the same tree (gpu::shadow_bvh lays it out,
+// its boxes padded for f32), walked with an explicit stack, and Woop, Benthin & Wald's watertight test
+// ("Watertight Ray/Triangle Intersection", JCGT 2(1), 2013) in f32, so that a ray through an edge that two
+// triangles share meets one of them. See the Rust for the derivations.
+#ifndef SUNSHADE_OCCLUDERS_GLSL
+#define SUNSHADE_OCCLUDERS_GLSL
+
+#include "bindings.glsl"
+#include "surface.glsl"
+
+// Whether a shadow ray's hit at barycentrics b (of the triangle's second and third corners) on the occluder
+// triangle `tri` (global vertex indices; material, bit 31: the mesh has vertex colours) blocks it: always for a
+// triangle that is not alpha-masked; for a masked one, where its alpha at the hit reaches the cutoff
+// (masked_hit_blocks; the texture read at the hit's coordinates, no footprint).
+bool blocks(uvec4 tri, vec2 b) {
+    MaterialGpu material = materials[tri.w & 0x7fffffffu];
+    if (material.kind.z == 0u) {
+        return true;
+    }
+    REAL3 w = REAL3(REAL(1.0) - REAL(b.x) - REAL(b.y), REAL(b.x), REAL(b.y));
+    SurfaceSample s;
+    for (uint set = 0u; set < 2u; ++set) {
+        uint offset = set == 0u ? SURFACE_VERTEX_UV0 : SURFACE_VERTEX_UV1;
+        REAL2 uv = w.x * REAL2(vec2(surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + offset],
+                                    surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + offset + 1u]))
+                 + w.y * REAL2(vec2(surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + offset],
+                                    surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + offset + 1u]))
+                 + w.z * REAL2(vec2(surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset],
+                                    surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset + 1u]));
+        s.uv[set] = uv;
+        s.uv_x[set] = uv;
+        s.uv_y[set] = uv;
+    }
+    s.color = vec4(1.0);
+    if ((tri.w & 0x80000000u) != 0u) {
+        uint c = SURFACE_VERTEX_COLOR + 3u;
+        s.color.a = float(w.x * REAL(surface_data[tri.x * FLOATS_PER_SURFACE_VERTEX + c])
+            + w.y * REAL(surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + c])
+            + w.z * REAL(surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + c]));
+    }
+    return masked_hit_blocks(material, s);
+}
+
+#ifdef SUNSHADE_RAY_BVH
+
+// A corner of an occluder triangle: the world position [m] of global vertex i (the vertex buffer's f32, which the
+// reference's rays meet as f64).
+#define OCCLUDER_CORNER(i) vec3(vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION], \
+    vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 1u], \
+    vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 2u])
+
+// A ray prepared for the watertight test (WatertightRay in the Rust): the direction's dominant axis kz, the other
+// two kx, ky (swapped where the direction along kz is negative, keeping the winding), and the shear
+// (dx/dz, dy/dz, 1/dz).
+struct WatertightRay {
+    vec3 origin;
+    vec3 direction;
+    uvec3 k;
+    vec3 shear;
+};
+
+WatertightRay watertight_ray(vec3 origin, vec3 direction) {
+    vec3 a = abs(direction);
+    uint kz = (a.x >= a.y && a.x >= a.z) ? 0u : (a.y >= a.z ? 1u : 2u);
+    uint kx = (kz + 1u) % 3u;
+    uint ky = (kx + 1u) % 3u;
+    if (direction[kz] < 0.0) {
+        uint swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    WatertightRay r;
+    r.origin = origin;
+    r.direction = direction;
+    r.k = uvec3(kx, ky, kz);
+    r.shear = vec3(direction[kx] / direction[kz], direction[ky] / direction[kz], 1.0 / direction[kz]);
+    return r;
+}
+
+// Whether the ray meets the triangle (a, b, c) (either winding) with 0 < t < t_max; `bary`: the hit's
+// barycentrics of b and c. `precise` keeps each edge function's two products and difference unfused, as the
+// Rust computes them: an edge shared by two triangles then gives exactly opposite (or equal) values in both, and
+// a ray through it cannot slip between them (a fused multiply-add rounds one product and not the other).
+bool intersect(WatertightRay r, vec3 a, vec3 b, vec3 c, float t_max, out vec2 bary) {
+    uint kx = r.k.x;
+    uint ky = r.k.y;
+    uint kz = r.k.z;
+    precise vec3 pa = a - r.origin;
+    precise vec3 pb = b - r.origin;
+    precise vec3 pc = c - r.origin;
+    precise float ax = pa[kx] - r.shear.x * pa[kz];
+    precise float ay = pa[ky] - r.shear.y * pa[kz];
+    precise float bx = pb[kx] - r.shear.x * pb[kz];
+    precise float by = pb[ky] - r.shear.y * pb[kz];
+    precise float cx = pc[kx] - r.shear.x * pc[kz];
+    precise float cy = pc[ky] - r.shear.y * pc[kz];
+    precise float u = cx * by - cy * bx;
+    precise float v = ax * cy - ay * cx;
+    precise float w = bx * ay - by * ax;
+    if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) {
+        return false;
+    }
+    precise float det = u + v + w;
+    if (det == 0.0) {
+        return false;
+    }
+    precise float t = (u * (r.shear.z * pa[kz]) + v * (r.shear.z * pb[kz]) + w * (r.shear.z * pc[kz])) / det;
+    bary = vec2(v, w) / det;
+    return t > 0.0 && t < t_max;
+}
+
+// The slab test of a node's box for 0 < t < t_max (`inv`: 1/direction where it is not 0). An axis along which
+// the ray does not move keeps the box exactly when the origin lies within its slab (the Rust's ±inf and NaN
+// products give the same answer; division by 0 is avoided here).
+bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
+    float lo = 0.0;
+    float hi = t_max;
+    for (uint k = 0u; k < 3u; ++k) {
+        if (direction[k] == 0.0) {
+            if (origin[k] < node.lo[k] || origin[k] > node.hi[k]) {
+                return false;
+            }
+            continue;
+        }
+        float a = (node.lo[k] - origin[k]) * inv[k];
+        float b = (node.hi[k] - origin[k]) * inv[k];
+        lo = max(lo, min(a, b));
+        hi = min(hi, max(a, b));
+        if (lo > hi) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE); any_hit tests them unrolled.
+#define BVH_LEAF_SIZE 4u
+// The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
+#define BVH_STACK_SIZE 96
+// Leaf slot s of `node` in any_hit: its triangle, if the leaf has that many, met by the ray and blocking it.
+#define LEAF_TRIANGLE(s) \
+    if ((s) < node.count) { \
+        uvec4 tri = occluder_triangles[node.first + (s)]; \
+        vec2 bary; \
+        if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary) \
+            && blocks(tri, bary)) { \
+            return true; \
+        } \
+    }
+
+// Whether the ray meets, with 0 < t < t_max, a triangle that blocks it: the tree walked from the root with an
+// explicit stack (at most one pending sibling a level of a tree fewer than 78 levels deep). Each node taken from the stack is
+// one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes and stacks
+// only those the ray meets: the walk's iterations are the nodes it enters, not the boxes it tests.
+bool any_hit(WatertightRay r, float t_max) {
+    vec3 d = r.direction;
+    vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 0.0, d.y != 0.0 ? 1.0 / d.y : 0.0, d.z != 0.0 ? 1.0 / d.z : 0.0);
+    if (!slab(bvh_nodes[0], r.origin, d, inv, t_max)) {
+        return false;
+    }
+    uint stack[BVH_STACK_SIZE];
+    uint top = 1u;
+    stack[0] = 0u;
+    while (top > 0u) {
+        top -= 1u;
+        BvhNode node = bvh_nodes[stack[top]];
+        if (node.count == 0u) {
+            if (slab(bvh_nodes[node.first], r.origin, d, inv, t_max)) {
+                stack[top] = node.first;
+                top += 1u;
+            }
+            if (slab(bvh_nodes[node.first + 1u], r.origin, d, inv, t_max)) {
+                stack[top] = node.first + 1u;
+                top += 1u;
+            }
+            continue;
+        }
+        // A leaf's triangles (at most BVH_LEAF_SIZE), unrolled: each loop iteration spends llvmpipe's budget.
+        LEAF_TRIANGLE(0u)
+        LEAF_TRIANGLE(1u)
+        LEAF_TRIANGLE(2u)
+        LEAF_TRIANGLE(3u)
+    }
+    return false;
+}
+
+#endif
+#endif

@@ -1,0 +1,95 @@
+//! Shadow rays on devices without ray queries: the occluders' BVH (`visibility::occluder_bvh`, the tree the
+//! reference's rays walk) laid out for the fragment shader, which walks it in software (shaders/occluders.glsl,
+//! defined `SUNSHADE_RAY_BVH`). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 10 the occluder records
+//! (`layout::occluder_records`) in the tree's leaf order, so that a leaf's `first..first + count` indexes them
+//! directly; the triangles' corners are read from the vertex buffer (binding 3) by the records' global indices,
+//! the same f32 world positions the reference's f64 rays are cast against.
+//!
+//! **Padding for f32.** The tree's boxes are built in f64 and padded by 1e-9 relative; the shader's slab test
+//! runs in f32, and must never cut a box the ray touches (a box only decides what is tested, so padding costs time,
+//! never correctness). Each slab distance `(bound − o) · (1/d)` is three roundings of at most `2⁻²⁴` relative, on
+//! a difference of at most `2M` (M the largest coordinate magnitude of the scene: shadow rays start on its
+//! surfaces), so the point it places along the ray is off by at most about `6 · 2⁻²⁴ M < 2⁻²¹ M`; the boxes are
+//! widened by [`F32_BOX_PAD`]` · M` (eight times that) before rounding to f32, whose own rounding (`2⁻²⁴ M`) the
+//! pad covers too.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::scene::Scene;
+
+/// The boxes' widening for the f32 slab test, relative to the scene's largest coordinate magnitude: `2⁻¹⁸`.
+pub const F32_BOX_PAD: f64 = 1.0 / 262_144.0;
+
+/// One node of the tree (`BvhNode` in shaders/bindings.glsl; 32 bytes, std430): its box [m] in f32, widened by
+/// [`F32_BOX_PAD`], and `first`/`count` as in `visibility::Bvh::nodes`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct BvhNodeGpu {
+    pub min: [f32; 3],
+    pub first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+/// The nodes of the scene's occluder tree (one empty leaf for a scene without triangles) and the occluder
+/// records (`layout::occluder_records`, every triangle's, with these `vertex_offsets`) in its leaf order.
+pub fn shadow_bvh(scene: &Scene, vertex_offsets: &[i32]) -> (Vec<BvhNodeGpu>, Vec<[u32; 4]>) {
+    let bvh = crate::visibility::occluder_bvh(scene);
+    let records = super::layout::occluder_records(scene, vertex_offsets, true);
+    let magnitude = bvh.nodes().next().map_or(0.0, |(min, max, _, _)| min.abs().max(max.abs()).max_element());
+    let pad = F32_BOX_PAD * magnitude + 1e-30;
+    let mut nodes: Vec<BvhNodeGpu> = bvh
+        .nodes()
+        .map(|(min, max, first, count)| BvhNodeGpu {
+            min: (min - pad).as_vec3().to_array(),
+            max: (max + pad).as_vec3().to_array(),
+            first,
+            count,
+        })
+        .collect();
+    let ordered: Vec<[u32; 4]> = bvh.order().iter().map(|&i| records[i as usize]).collect();
+    if bvh.triangle_count() == 0 {
+        // No triangle: a root leaf of none (the shader's walk then tests nothing), and one dummy record.
+        nodes = vec![BvhNodeGpu { min: [0.0; 3], first: 0, max: [0.0; 3], count: 0 }];
+        return (nodes, vec![[0; 4]]);
+    }
+    (nodes, ordered)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// Every f32 box holds its f64 box widened by the f32 pad, and the leaves' records are the triangles'.
+    #[test]
+    fn the_f32_boxes_hold_the_trees_boxes_with_their_pad() {
+        // 300 triangles of a grid (a tree several levels deep), far from the origin.
+        let mut mesh = crate::scene::Mesh::default();
+        for i in 0..10u32 {
+            for j in 0..15u32 {
+                let at = |di: u32, dj: u32| glam::Vec3::new((i + di) as f32 * 0.37, 1e3, (j + dj) as f32 * 0.21 + 5e2);
+                let v = mesh.positions.len() as u32;
+                mesh.positions.extend([at(0, 0), at(1, 0), at(0, 1), at(1, 1)]);
+                mesh.indices.extend([v, v + 1, v + 2, v + 2, v + 1, v + 3]);
+            }
+        }
+        mesh.material = 3;
+        let scene = Scene { meshes: vec![mesh], ..Default::default() };
+        let (nodes, records) = shadow_bvh(&scene, &vec![0; scene.meshes.len()]);
+        let bvh = crate::visibility::occluder_bvh(&scene);
+        for (gpu, (min, max, first, count)) in nodes.iter().zip(bvh.nodes()) {
+            let lo = DVec3::from_array(gpu.min.map(f64::from));
+            let hi = DVec3::from_array(gpu.max.map(f64::from));
+            assert!(lo.cmple(min).all() && hi.cmpge(max).all(), "{gpu:?} against {min} {max}");
+            assert_eq!((gpu.first, gpu.count), (first, count));
+        }
+        assert!(nodes.len() > 31, "{} nodes", nodes.len());
+        assert_eq!(records.len(), bvh.triangle_count());
+        // Leaf order: record k is the triangle order()[k], its corners' global indices and material.
+        for (k, &t) in bvh.order().iter().enumerate() {
+            let idx = &scene.meshes[0].indices[3 * t as usize..3 * t as usize + 3];
+            assert_eq!(records[k], [idx[0], idx[1], idx[2], 3]);
+        }
+    }
+}
