@@ -49,8 +49,9 @@ pub fn shadow_bvh(scene: &Scene, vertex_offsets: &[i32]) -> (Vec<BvhNodeGpu>, Ve
         .collect();
     let ordered: Vec<[u32; 4]> = bvh.order().iter().map(|&i| records[i as usize]).collect();
     if bvh.triangle_count() == 0 {
-        // No triangle: a root leaf of none (the shader's walk then tests nothing), and one dummy record.
-        nodes = vec![BvhNodeGpu { min: [0.0; 3], first: 0, max: [0.0; 3], count: 0 }];
+        // No triangle to meet (a count of 0 would read as an inner node): a root leaf of one record whose three
+        // corners are the same vertex, a degenerate triangle no ray meets (the watertight test's det is 0).
+        nodes = vec![BvhNodeGpu { min: [0.0; 3], first: 0, max: [0.0; 3], count: 1 }];
         return (nodes, vec![[0; 4]]);
     }
     (nodes, ordered)
@@ -85,7 +86,15 @@ mod tests {
             assert_eq!((gpu.first, gpu.count), (first, count));
         }
         assert!(nodes.len() > 31, "{} nodes", nodes.len());
+        // The shader's walk is sized by the same constants.
+        let glsl = include_str!("../../shaders/occluders.glsl");
+        use crate::visibility::bvh::{LEAF_SIZE, STACK_SIZE};
+        assert!(glsl.contains(&format!("#define BVH_LEAF_SIZE {LEAF_SIZE}u\n")), "BVH_LEAF_SIZE");
+        assert!(glsl.contains(&format!("#define BVH_STACK_SIZE {STACK_SIZE}\n")), "BVH_STACK_SIZE");
         assert_eq!(records.len(), bvh.triangle_count());
+        // A scene without triangles: one leaf holding one degenerate record.
+        let (empty, dummy) = shadow_bvh(&Scene::default(), &[]);
+        assert_eq!((empty.len(), empty[0].count, dummy), (1, 1, vec![[0; 4]]));
         // Leaf order: record k is the triangle order()[k], its corners' global indices and material.
         for (k, &t) in bvh.order().iter().enumerate() {
             let idx = &scene.meshes[0].indices[3 * t as usize..3 * t as usize + 3];
