@@ -874,3 +874,47 @@ fn shadow_flags_warnings_and_refusals() {
         assert_eq!(report["over_tolerance"]["total"], 0, "{report}");
     }
 }
+
+/// llvmpipe's loop limiter (docs/platform.md): the sky's three lobe grids at 162² per axis (79 218 loop iterations a
+/// fragment) are cut short there, silently by lavapipe; sunshade's probe finds the pixels and refuses the image
+/// with the way out, while 140² (59 220) renders. Elsewhere both render.
+#[test]
+fn lavapipe_loop_budget_is_detected_not_trusted() {
+    let dir = common::TempDir::new("loop-budget");
+    let brdfs = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/brdfs.glb");
+    let render = |samples: u32| {
+        let n = samples.to_string();
+        let out = dir.path(&format!("sky-{samples}.exr"));
+        sunshade(&[
+            "render",
+            s(&brdfs),
+            "-o",
+            s(&out),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--shadows",
+            "none",
+            "--sun-irradiance",
+            "0",
+            "--sky-radiance",
+            "100",
+            "--samples",
+            &n,
+        ])
+    };
+    let info: serde_json::Value = serde_json::from_slice(&sunshade(&["info", "--json"]).stdout).unwrap();
+    let chosen = info["chosen"].as_u64().unwrap() as usize;
+    let llvmpipe = info["devices"][chosen]["name"].as_str().unwrap().contains("llvmpipe");
+    let o = render(140 * 140);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = render(162 * 162);
+    if llvmpipe {
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("cut the loops of") && stderr(&o).contains("--samples"), "{}", stderr(&o));
+        assert!(!dir.path(&format!("sky-{}.exr", 162 * 162)).exists(), "no image is written");
+    } else {
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+}

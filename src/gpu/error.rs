@@ -29,6 +29,9 @@ pub enum GpuError {
     TooLarge(String),
     #[error("{0}")]
     Unsupported(String),
+    /// llvmpipe's loop limiter cut some pixels' loops short (`gpu::loop_budget`): the image was refused.
+    #[error("{0}")]
+    LoopBudget(String),
     #[error("{} Vulkan validation message(s); the first: {}", .0.len(), .0.first().map(String::as_str).unwrap_or(""))]
     Validation(Vec<String>),
 }

@@ -565,7 +565,7 @@ impl Renderer {
         let render = t_render.elapsed();
         let t_readback = Instant::now();
         let image = self.read_back(width, height)?;
-        super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::Unsupported)?;
+        super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.check_validation()?;
