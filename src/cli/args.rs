@@ -261,8 +261,8 @@ pub struct SceneArgs {
     /// leaves; measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
     /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
     /// and kept within REL beside the models'. Refused: light of disk lights and the sky through occluders, the
-    /// device's interpolation, and shadows other than rays (or `--shadows none`, which measures against the
-    /// unshadowed truth).
+    /// device's interpolation, and `--shadows map` (`auto` casts shadow rays, on a device without ray queries by
+    /// the shader's walk of the scene's BVH; `--shadows none` measures against the unshadowed truth).
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 

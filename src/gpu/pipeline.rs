@@ -248,6 +248,11 @@ impl ScenePipeline {
         self.ray_bvh
     }
 
+    /// Whether the shadow rays are ray queries (the scene then gets an acceleration structure).
+    pub fn has_ray_queries(&self) -> bool {
+        self.has_shadow_rays() && !self.ray_bvh
+    }
+
     /// Creates the pipelines of `variants` that do not exist yet, several at once (a thread each, at most as many
     /// as the machine has cores): a driver compiles a pipeline on the thread that asks for it (lavapipe: LLVM, a
     /// few hundred milliseconds a variant), and the pipeline cache is internally synchronized. A variant with

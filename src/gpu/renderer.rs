@@ -279,7 +279,7 @@ impl Renderer {
         let mut indices = Vec::new();
         let mut draws = Vec::new();
         // With ray queries: every triangle's indices into the whole vertex buffer, for the acceleration structure.
-        let rq = self.pipeline.has_shadow_rays() && !self.pipeline.rays_walk_bvh();
+        let rq = self.pipeline.has_ray_queries();
         let bvh = self.pipeline.rays_walk_bvh();
         let mut global_indices = Vec::new();
         let (measured, measured_offsets) = measured_tables(&scene.materials);
@@ -431,7 +431,7 @@ impl Renderer {
     /// warning where the scene has them. `ray` casts rays on any device: by ray queries, or, without them, by the
     /// fragment shader's walk of the occluders' BVH (`shadow_bvh`; slower on the same device, the same rays).
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
-        let rq = self.pipeline.has_shadow_rays() && !self.pipeline.rays_walk_bvh();
+        let rq = self.pipeline.has_ray_queries();
         let requested = settings.shading.shadows;
         let mut choice = crate::visibility::choose(requested, &settings.lights, scene.can_occlude, rq);
         if choice.technique == Shadows::Ray && !self.pipeline.has_shadow_rays() {
