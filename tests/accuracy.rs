@@ -400,19 +400,13 @@ fn render_tolerance_studies_the_lobe_grids_on_the_gpu() {
     let mut grids = Vec::new();
     for tolerance in [1e-2, 1e-3] {
         let out = dir.path(&format!("lobes-{tolerance:e}.exr"));
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
-            .args(["render", "models/brdfs.glb", "--width", "64", "--height", "64", "--shadows", "none"])
-            .args(["--sun-elevation", "40", "--sun-azimuth", "30", "--sun-irradiance", "1000"])
-            .args(["--sky-radiance", "100", "--disk-light", "0,3,1.5:0,-1,0:0.6:500"])
-            .args(["--tolerance", &tolerance.to_string(), "-v", "-o", out.to_str().unwrap()])
-            .env("SUNSHADE_VALIDATION", "1")
-            .output()
-            .unwrap();
-        let e = String::from_utf8_lossy(&o.stderr);
-        if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
+        let flags = format!(
+            "models/brdfs.glb --width 64 --height 64 --shadows none --sun-elevation 40 --sun-azimuth 30 \
+             --sun-irradiance 1000 --sky-radiance 100 --disk-light 0,3,1.5:0,-1,0:0.6:500 --tolerance {tolerance} -v"
+        );
+        let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
-        }
-        assert!(o.status.success(), "{e}");
+        };
         assert!(e.contains("estimated by refinement"), "{e}");
         let grid: u32 = e
             .split("lobes under disk lights and the sky: ")
@@ -584,17 +578,10 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
     let models = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     for name in ["teapot.glb", "sunset.glb"] {
         let out = dir.path(&format!("{name}.exr"));
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
-            .args(["render", models.join(name).to_str().unwrap(), "--width", "48", "--height", "36"])
-            .args(["--tolerance", "1e-2", "-v", "-o", out.to_str().unwrap()])
-            .env("SUNSHADE_VALIDATION", "1")
-            .output()
-            .unwrap();
-        let e = String::from_utf8_lossy(&o.stderr);
-        if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
+        let flags = format!("models/{name} --width 48 --height 36 --tolerance 1e-2 -v");
+        let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
-        }
-        assert!(o.status.success(), "{name}: {e}");
+        };
         assert!(e.contains("shadows: ray"), "{name}: {e}");
         let scene = common::load(&models.join(name));
         let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
@@ -605,4 +592,24 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
         eprintln!("{name}: T = 1e-2 with shadow rays, measured {measured:.2e} ({unconverged} pixels unconverged)");
         assert!(measured <= 1e-2, "{name}: {measured:.3e} over 1e-2\n{e}");
     }
+}
+
+/// `sunshade render FLAGS -o OUT` with validation on (FLAGS split at white space, paths relative to the crate):
+/// its stderr, asserting success; `None` where the device's interpolation has no bound for `--tolerance` to keep
+/// (a device without f64 interpolation).
+fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
+        .arg("render")
+        .args(flags.split_whitespace())
+        .arg("-o")
+        .arg(out)
+        .env("SUNSHADE_VALIDATION", "1")
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
+        return None;
+    }
+    assert!(o.status.success(), "{e}");
+    Some(e)
 }
