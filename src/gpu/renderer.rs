@@ -18,7 +18,7 @@ use super::layout::{
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
-use super::shadow_bvh::BvhNodeGpu;
+use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
@@ -63,12 +63,14 @@ pub struct GpuScene {
     texture_table: Buffer,
     /// Texture coordinates and colours per vertex (`SurfaceVertex`), read by textured materials.
     surface_vertices: Buffer,
-    /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits; on
-    /// devices without ray queries every triangle's, in the BVH's leaf order.
+    /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
     occluder_triangles: Buffer,
-    /// The occluders' BVH nodes (`shadow_bvh::BvhNodeGpu`) for the shader's walk; one dummy node with ray
-    /// queries.
+    /// One dummy BVH node (binding 12 until the walk is laid out).
     bvh_nodes: Buffer,
+    /// Without ray queries: what the walk is laid out from, and, once a render has cast rays, its buffers (the
+    /// nodes, and the occluder records in leaf order), which then take bindings 12 and 10.
+    walk_source: Option<WalkSource>,
+    walk: std::cell::OnceCell<(Buffer, Buffer)>,
     /// The measured BRDF tables (`layout::measured_tables`).
     measured: Buffer,
     draws: Vec<Draw>,
@@ -397,15 +399,13 @@ impl Renderer {
             _ => None,
         };
         let vertex_offsets: Vec<i32> = draws.iter().map(|d| d.vertex_offset).collect();
-        // Without ray queries, the occluders' tree for the shader's walk (its records in leaf order); else the
-        // records in the acceleration structure's order where masked hits read them, and one dummy node.
-        let (nodes, records) = if bvh {
-            super::shadow_bvh::shadow_bvh(scene, &vertex_offsets)
-        } else {
-            (vec![BvhNodeGpu::zeroed()], occluder_records(scene, &vertex_offsets, rq && masked))
-        };
+        // The records in the acceleration structure's order where masked hits read them (else one dummy), and one
+        // dummy node. Without ray queries, what the shader's walk needs is laid out when a render first casts rays
+        // (`walk`).
+        let records = occluder_records(scene, &vertex_offsets, rq && masked);
         let occluder_triangles = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder triangles")?;
-        let bvh_nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
+        let bvh_nodes = Buffer::storage(&self.dev, bytemuck::bytes_of(&BvhNodeGpu::zeroed()), "occluder BVH nodes")?;
+        let walk_source = bvh.then(|| WalkSource::new(scene, &vertex_offsets));
         Ok(GpuScene {
             accel,
             vertices,
@@ -416,6 +416,8 @@ impl Renderer {
             surface_vertices,
             occluder_triangles,
             bvh_nodes,
+            walk_source,
+            walk: std::cell::OnceCell::new(),
             measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): `auto` renders no shadow pass where it is
@@ -477,6 +479,12 @@ impl Renderer {
         self.ensure_target(width, height)?;
         self.lights = None;
         let technique = self.shadow_choice(scene, settings)?.technique;
+        if let (Shadows::Ray, Some(source), None) = (technique, &scene.walk_source, scene.walk.get()) {
+            let (nodes, records) = source.layout();
+            let nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
+            let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
+            let _ = scene.walk.set((nodes, records));
+        }
         // The sun's shadow map, where `map` is the technique and there is a sun and geometry.
         let sun_map = match (technique, &settings.lights.sun, scene.bounds) {
             (Shadows::Map, Some(sun), Some(bounds)) => {
@@ -622,7 +630,7 @@ impl Renderer {
                     (3, vb.buffer),
                     (8, scene.texture_table.buffer),
                     (9, scene.surface_vertices.buffer),
-                    (10, scene.occluder_triangles.buffer),
+                    (10, scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, records)| records.buffer)),
                     (11, scene.measured.buffer),
                 ];
                 let infos = buffers
@@ -666,8 +674,8 @@ impl Renderer {
             d.update_descriptor_sets(&writes, &[]);
             // Binding 12: the occluders' BVH, for the pipelines whose shadow rays walk it.
             if self.pipeline.rays_walk_bvh() {
-                let info =
-                    [vk::DescriptorBufferInfo { buffer: scene.bvh_nodes.buffer, offset: 0, range: vk::WHOLE_SIZE }];
+                let buffer = scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer);
+                let info = [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];
                 let write = vk::WriteDescriptorSet::default()
                     .dst_set(self.pipeline.descriptor_set)
                     .dst_binding(12)

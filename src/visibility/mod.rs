@@ -12,6 +12,6 @@ pub mod shadow_map;
 pub mod technique;
 
 pub use bvh::Bvh;
-pub use occluders::{can_occlude, occluder_bvh};
+pub use occluders::{can_occlude, occluder_bvh, occluder_triangles};
 pub use ray_triangle::WatertightRay;
 pub use technique::{choose, choose_reference, ShadowChoice};

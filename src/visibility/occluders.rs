@@ -32,12 +32,16 @@ use crate::scene::Scene;
 /// BVH, for the shadow rays of both renderers: the reference's f64 rays (`cpu::Occluders`) and, on devices without
 /// ray queries, the GPU's (`gpu::shadow_bvh`).
 pub fn occluder_bvh(scene: &Scene) -> Bvh {
-    let triangles = scene
+    Bvh::new(occluder_triangles(scene))
+}
+
+/// Every triangle of the scene in world space [m], the meshes' triangles in turn: what [`occluder_bvh`] holds.
+pub fn occluder_triangles(scene: &Scene) -> Vec<[DVec3; 3]> {
+    scene
         .meshes
         .iter()
         .flat_map(|m| m.indices.chunks_exact(3).map(move |t| [0, 1, 2].map(|k| m.positions[t[k] as usize].as_dvec3())))
-        .collect();
-    Bvh::new(triangles)
+        .collect()
 }
 
 /// Whether any triangle of the scene might occlude a light from a visible surface (see the module docs).
