@@ -8,9 +8,10 @@
 #include "surface.glsl"
 
 // The coverage alpha of a shaded fragment: 1, or LOOP_BUDGET_SPENT where llvmpipe's loop limiter has cut the
-// fragment's loops short. llvmpipe (lavapipe) gives every shader invocation one budget of 65535 loop iterations,
-// all loops together (Mesa's LP_MAX_TGSI_LOOP_ITERATIONS); once it is spent, every loop exits after its current
-// iteration, silently: a lobe grid or a shadow ray's walk left unfinished (docs/platform.md). This probe loop runs
+// fragment's loops short. llvmpipe (Mesa 22.3's lavapipe; not seen on 25.0.7) gives every shader invocation one
+// budget of 65535 loop iterations, all loops together (Mesa's LP_MAX_TGSI_LOOP_ITERATIONS); once it is spent,
+// every loop exits after its current iteration, silently: a lobe grid or a shadow ray's walk left unfinished
+// (docs/platform.md). This probe loop runs
 // lights.counts.z (2) iterations, not known to the compiler, so it is not unrolled; it stops after one exactly when
 // the budget is spent, and the renderer refuses an image with such pixels (gpu::loop_budget).
 float coverage_alpha() {
