@@ -151,9 +151,9 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     }
 
 // Whether the ray meets, with 0 < t < t_max, a triangle that blocks it: the tree walked from the root with an
-// explicit stack (at most one pending sibling a level of a tree fewer than 78 levels deep). Each node taken from the stack is
-// one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes and stacks
-// only those the ray meets: the walk's iterations are the nodes it enters, not the boxes it tests.
+// explicit stack (at most one pending sibling a level of a tree fewer than 78 levels deep). Each node taken from
+// the stack is one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes
+// and stacks only those the ray meets: the walk's iterations are the nodes it enters, not the boxes it tests.
 bool any_hit(WatertightRay r, float t_max) {
     vec3 d = r.direction;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 0.0, d.y != 0.0 ? 1.0 / d.y : 0.0, d.z != 0.0 ? 1.0 / d.z : 0.0);

@@ -7,8 +7,9 @@
 //! The quarter bounds the depth: `log_{4/3} 2³² < 78` levels for any `u32` count, so the walks' stacks of
 //! [`STACK_SIZE`] (one pending sibling a level) cannot overflow. On a scene of a large flat floor under compact
 //! objects (sunset.glb) the surface-area splits separate the floor from the objects early: a ray along the floor
-//! at the setting sun entered 624 nodes at worst with median splits, which matters on lavapipe, where every node a
-//! shader's walk enters spends one of the 65535 loop iterations a fragment has (`gpu::loop_budget`).
+//! at the setting sun took up to 624 steps (nodes and leaf triangles) with median splits, which matters on
+//! lavapipe, where every node a shader's walk enters spends one of the 65535 loop iterations a fragment has
+//! (`gpu::loop_budget`).
 //!
 //! Exactness does not depend on the tree: a box test only decides what is tested, and the boxes are widened by a
 //! relative 1e-9 so that rounding in the slab test can never skip a triangle the ray touches. `any_hit` (shadow
