@@ -145,8 +145,6 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
-    // The grids of the last render asked for, for the message where the device cannot run it.
-    let settings_at_failure = std::cell::Cell::new((0u32, 0u32));
     let done = render_within_tolerance(
         scene_data,
         &mut settings,
@@ -156,7 +154,6 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         tolerance,
         &reference,
         |s| {
-            settings_at_failure.set((s.shading.samples_per_axis, s.shading.sun_samples_per_axis));
             let (image, t) = r.render(gpu_scene, s)?;
             spent.pipelines += t.pipelines;
             spent.render += t.render;
@@ -165,17 +162,16 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         },
         |(image, _)| image,
     )
-    .map_err(|e| match e {
-        TrialError::Tolerance(why) => CliError::Usage(why),
-        // A grid the study went on to that the device cannot run: no setting it can render meets the tolerance.
-        TrialError::Render(crate::gpu::GpuError::LoopBudget(why)) if tolerance.is_some() => CliError::Usage(format!(
-            "--tolerance {:e}: the next render of its study ({}² lobe grids, {}² sun samples) is beyond this \
+    .map_err(|e| match (e, tolerance) {
+        (TrialError::Tolerance(why), _) => CliError::Usage(why),
+        // A grid the study went on to that the device cannot run (`settings` holds the grids of the render that
+        // failed): no setting it can render meets the tolerance.
+        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
+            "--tolerance {t:e}: the next render of its study ({}² lobe grids, {}² sun samples) is beyond this \
              device: {why}",
-            tolerance.unwrap_or_default(),
-            settings_at_failure.get().0,
-            settings_at_failure.get().1
+            settings.shading.samples_per_axis, settings.shading.sun_samples_per_axis
         )),
-        TrialError::Render(e) => CliError::from(e),
+        (TrialError::Render(e), _) => CliError::from(e),
     })?;
     let (image, _) = done.kept;
     let frame = spent;
