@@ -188,7 +188,8 @@ fn sun_cost(shading: &ShadingOptions) -> u32 {
 /// where the truth itself did not converge, the penumbrae, left out), and cost no more at looser T.
 #[test]
 fn tolerance_meets_itself_on_the_reference() {
-    use sunshade::accuracy::trial::reference_within_tolerance;
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let outside = Tolerance::outside_penumbrae;
     let dir = common::TempDir::new("tolerance");
     let mut cases: Vec<(String, sunshade::scene::Scene, Option<DVec3>)> = Vec::new();
     let mut models: Vec<_> = std::fs::read_dir("models")
@@ -232,16 +233,23 @@ fn tolerance_meets_itself_on_the_reference() {
             // As `reference --tolerance` does: the delta sun tried first where its image's peak may decide.
             let mut t = s.clone();
             let asked = s.shading.shadows;
-            let (image, prediction) =
-                match reference_within_tolerance(scene, &mut t, &reference, asked, can_occlude, Some(tolerance)) {
-                    Ok(c) => c,
-                    Err(e) => {
-                        assert!(s.lights.sky.is_some() || !s.lights.disks.is_empty(), "{name}: refused: {e}");
-                        assert!(e.contains("visible fraction of disk"), "{e}");
-                        report += &format!("{name}: refused ({e})\n");
-                        break;
-                    }
-                };
+            let (image, prediction) = match reference_within_tolerance(
+                scene,
+                &mut t,
+                &reference,
+                asked,
+                can_occlude,
+                Some(outside(tolerance)),
+            ) {
+                Ok(c) => c,
+                Err(e) => {
+                    assert!(s.lights.sky.is_some() || !s.lights.disks.is_empty(), "{name}: refused: {e}");
+                    assert!(e.contains("visible fraction of disk"), "{e}");
+                    assert!(e.contains("--tolerance-in-penumbrae"), "{e}");
+                    report += &format!("{name}: refused ({e})\n");
+                    break;
+                }
+            };
             let chosen = t.shading;
             let (measured, left_out) = common::error_against_converged(scene, &s, &image, tolerance / 10.0, &reference);
             let predicted = prediction.max_relative;
@@ -314,7 +322,8 @@ fn tolerance_meets_itself_on_the_gpu() {
 #[test]
 fn the_delta_trial_keeps_the_delta_sun_where_its_image_peak_allows() {
     use sunshade::accuracy::error::image_error;
-    use sunshade::accuracy::trial::reference_within_tolerance;
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let outside = Tolerance::outside_penumbrae;
     use sunshade::shading::SunModel;
     let scene = common::load(std::path::Path::new("models/brdfs.glb"));
     let mut s = settings::resolve_with(&scene, 96, 96, &CameraOptions::default(), &LightOptions::default()).unwrap();
@@ -324,7 +333,8 @@ fn the_delta_trial_keeps_the_delta_sun_where_its_image_peak_allows() {
     for (tolerance, want) in [(1e-2, SunModel::Delta), (1e-3, SunModel::Disk)] {
         let mut t = s.clone();
         let (image, prediction) =
-            reference_within_tolerance(&scene, &mut t, &reference, Shadows::None, true, Some(tolerance)).unwrap();
+            reference_within_tolerance(&scene, &mut t, &reference, Shadows::None, true, Some(outside(tolerance)))
+                .unwrap();
         let measured = image_error(&image, &truth.image, Some(&truth.unconverged_mask())).unwrap().max_rel;
         eprintln!("T = {tolerance:e}: {:?}, measured {measured:.2e}; {}", t.shading.sun, prediction.line());
         assert_eq!(t.shading.sun, want, "T = {tolerance:e}: {}", prediction.line());
@@ -431,7 +441,8 @@ fn render_tolerance_studies_the_lobe_grids_on_the_gpu() {
 /// study's GCI) is at most T and at least what was measured, and a looser T never takes a finer lobe grid.
 #[test]
 fn tolerance_estimates_the_lobe_grids_by_refinement_on_the_reference() {
-    use sunshade::accuracy::trial::reference_within_tolerance;
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let outside = Tolerance::outside_penumbrae;
     use sunshade::scene::DiskLight;
     let dir = common::TempDir::new("tolerance-lobes");
     let sun = SunOptions { direction: Some(DVec3::from_array(chart::sun_direction(60.0))), ..Default::default() };
@@ -470,15 +481,21 @@ fn tolerance_estimates_the_lobe_grids_by_refinement_on_the_reference() {
         let mut grids = Vec::new();
         for tolerance in [1e-2, 1e-3, 1e-4] {
             let mut t = s.clone();
-            let (image, prediction) =
-                match reference_within_tolerance(scene, &mut t, &reference, Shadows::None, true, Some(tolerance)) {
-                    Ok(c) => c,
-                    Err(e) => {
-                        assert!(tolerance < 1e-3 && e.contains("did not meet"), "{name}, T = {tolerance:e}: {e}");
-                        report += &format!("{name}, T = {tolerance:e}: refused ({e})\n");
-                        break;
-                    }
-                };
+            let (image, prediction) = match reference_within_tolerance(
+                scene,
+                &mut t,
+                &reference,
+                Shadows::None,
+                true,
+                Some(outside(tolerance)),
+            ) {
+                Ok(c) => c,
+                Err(e) => {
+                    assert!(tolerance < 1e-3 && e.contains("did not meet"), "{name}, T = {tolerance:e}: {e}");
+                    report += &format!("{name}, T = {tolerance:e}: refused ({e})\n");
+                    break;
+                }
+            };
             let (measured, left_out) = common::error_against_converged(scene, &s, &image, tolerance / 10.0, &reference);
             report += &format!(
                 "{name}, T = {tolerance:e}: lobes {}², sun {:?} {}², measured {measured:.2e}, {}, {} pixels left \
@@ -592,6 +609,35 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
         eprintln!("{name}: T = 1e-2 with shadow rays, measured {measured:.2e} ({unconverged} pixels unconverged)");
         assert!(measured <= 1e-2, "{name}: {measured:.3e} over 1e-2\n{e}");
     }
+}
+
+/// `render --tolerance 1e-2 --tolerance-in-penumbrae` on sunset.glb (the sun's penumbrae) on any device: the shadow
+/// rays' grids join the study, `-v` says so, and the image meets T everywhere, penumbrae included, against the
+/// reference with every grid at 181² (an independent render, not the converged reference, whose per-pixel test
+/// two grids of a penumbra can pass by chance).
+#[test]
+fn render_tolerance_in_penumbrae_meets_it_there() {
+    let dir = common::TempDir::new("tolerance-penumbrae");
+    let out = dir.path("sunset.exr");
+    let flags = "models/sunset.glb --width 48 --height 36 --tolerance 1e-2 --tolerance-in-penumbrae -v";
+    let Some(e) = render_with_tolerance(flags, &out) else {
+        return; // a device without f64 interpolation has no bound to keep
+    };
+    assert!(e.contains("penumbrae included"), "{e}");
+    assert!(!e.contains("not bounded"), "{e}");
+    let scene = common::load(std::path::Path::new("models/sunset.glb"));
+    let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
+    s.shading.shadows = Shadows::Ray;
+    s.shading.sun = sunshade::shading::SunModel::Disk;
+    s.shading.samples_per_axis = 181;
+    s.shading.sun_samples_per_axis = 181;
+    s.shading.shadow_samples_per_axis = 181;
+    let fine = cpu::render(&scene, &s, &ReferenceOptions::default());
+    let image = sunshade::film::read_image(&out).unwrap();
+    let measured = sunshade::accuracy::error::image_error(&image, &fine, None).unwrap().max_rel;
+    let line = e.lines().find(|l| l.contains("predicted max relative error")).unwrap_or_default();
+    eprintln!("sunset.glb, T = 1e-2 in penumbrae: measured {measured:.2e} against 181²; {line}");
+    assert!(measured <= 1e-2, "{measured:.3e} over 1e-2\n{e}");
 }
 
 /// `sunshade render FLAGS -o OUT` with validation on (FLAGS split at white space, paths relative to the crate):

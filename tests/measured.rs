@@ -527,7 +527,7 @@ fn albedo_of_a_measured_material_matches_its_analytic_source() {
 /// unbounded, for T = 1e-2, 1e-3 and 1e-4, and a looser T never takes a finer grid.
 #[test]
 fn tolerance_estimates_measured_materials_by_refinement() {
-    use sunshade::accuracy::trial::reference_within_tolerance;
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
     use sunshade::shading::Shadows;
     let dir = TempDir::new("merl-tolerance");
     write(&dir, "ward.binary", ward_table_bytes());
@@ -551,9 +551,15 @@ fn tolerance_estimates_measured_materials_by_refinement() {
         let mut grids = Vec::new();
         for tolerance in [1e-2, 1e-3, 1e-4] {
             let mut t = s.clone();
-            let (image, prediction) =
-                reference_within_tolerance(&scene, &mut t, &reference, Shadows::None, false, Some(tolerance))
-                    .unwrap_or_else(|e| panic!("{what}, T = {tolerance:e}: {e}\n{report}"));
+            let (image, prediction) = reference_within_tolerance(
+                &scene,
+                &mut t,
+                &reference,
+                Shadows::None,
+                false,
+                Some(Tolerance::outside_penumbrae(tolerance)),
+            )
+            .unwrap_or_else(|e| panic!("{what}, T = {tolerance:e}: {e}\n{report}"));
             let (measured, left_out) =
                 common::error_against_converged(&scene, &s, &image, tolerance / 10.0, &reference);
             report += &format!(

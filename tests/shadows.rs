@@ -774,3 +774,79 @@ fn gpu_ray_queries_pass_light_through_alpha_masked_cutouts() {
         report.text("gpu", "reference")
     );
 }
+
+/// `--tolerance T` on the reference where the scene shadows itself: the grids, shadow rays' included, are
+/// estimated by refinement, and an image kept meets T against the circular segment's exact penumbra of a
+/// straight edge (relative with the diff's floor: 1% of the image's peak, so that in the penumbra's dark end the
+/// visible fraction must be right to `T/100`), or the study refuses. The real sun (0.53°), its penumbra resolved by 56 pixels or by 2; edges along the grid's
+/// axis and at 30° to it (the concentric map's cells meet an axis-aligned edge row by row). A refusal may be
+/// conservative (the estimate's order is cut to a jump's 1): the finest grid's measured error is reported.
+#[test]
+fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
+    use sunshade::accuracy::error::image_error;
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let everywhere = Tolerance::everywhere;
+    let mut report = String::new();
+    let mut kept = 0;
+    // (Scale-invariant: a 10° sun's penumbra at the same share of the image gives the same errors.)
+    for (diameter, span) in [(0.53f64, 1.7), (0.53, 40.0), (0.53, 200.0)] {
+        let half_angle = (diameter.to_radians() as f32 as f64) / 2.0;
+        for degrees in [0.0f64, 30.0] {
+            // The roof's edge turned by `degrees` about the vertical: a floor point's signed distance past the
+            // edge is its coordinate `across` it.
+            let (c, s) = (degrees.to_radians().cos(), degrees.to_radians().sin());
+            let (across, along) = (DVec3::new(c, 0.0, -s), DVec3::new(s, 0.0, c));
+            let roof = quad((DVec3::Y - 5.0 * across).as_vec3(), (5.0 * across).as_vec3(), (5.0 * along).as_vec3());
+            let scene = scene(&[floor(1.0), roof]);
+            // The image spans `span` penumbrae (±tan σ under an edge 1 m up): resolved by 56 pixels, or by 2.
+            let camera = camera_down(DVec3::ZERO, span * half_angle.tan() / 12.0, 5.0);
+            let base = settings(96, 8, camera, sun_lights(DVec3::Y, diameter), Shadows::Ray, 8);
+            let mut exact = Image::new(base.width, base.height);
+            for y in 0..base.height {
+                for x in 0..base.width {
+                    let v = zenith_sun_fraction_under_edge(floor_point(&base, x, y).dot(across), 1.0, half_angle);
+                    let l = (E_PERP as f64 / PI * v) as f32;
+                    exact.set(x, y, [l, l, l, 1.0]);
+                }
+            }
+            let case = format!("{diameter}° sun, edge at {degrees}°, {span} penumbrae wide");
+            let mut costs = Vec::new();
+            for tolerance in [1e-2, 1e-3, 1e-4] {
+                let mut s = base.clone();
+                let reference = ReferenceOptions::default();
+                match reference_within_tolerance(
+                    &scene,
+                    &mut s,
+                    &reference,
+                    Shadows::Ray,
+                    true,
+                    Some(everywhere(tolerance)),
+                ) {
+                    Ok((image, prediction)) => {
+                        let e = image_error(&image, &exact, None).unwrap().max_rel;
+                        report += &format!(
+                            "{case}, T = {tolerance:e}: {}² shadow rays, measured {e:.2e}, predicted {:.2e}\n",
+                            s.shading.shadow_samples_per_axis, prediction.max_relative
+                        );
+                        assert!(prediction.line().contains("penumbrae included"), "{}", prediction.line());
+                        assert!(e <= tolerance, "over T:\n{report}");
+                        costs.push(s.shading.shadow_samples_per_axis);
+                        kept += 1;
+                    }
+                    Err(why) => {
+                        assert!(why.contains("did not meet"), "{case}, T = {tolerance:e}: {why}");
+                        let mut finest = base.clone();
+                        finest.shading.sun_samples_per_axis = 162;
+                        finest.shading.shadow_samples_per_axis = 162;
+                        let e = image_error(&cpu::render(&scene, &finest, &reference), &exact, None).unwrap().max_rel;
+                        report += &format!("{case}, T = {tolerance:e}: refused; 162² errs {e:.2e}\n");
+                        break;
+                    }
+                }
+            }
+            assert!(costs.windows(2).all(|w| w[0] <= w[1]), "{case}: looser T must cost no more: {costs:?}");
+        }
+    }
+    eprintln!("{report}");
+    assert!(kept >= 2, "{report}");
+}

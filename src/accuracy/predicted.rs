@@ -4,10 +4,10 @@
 //! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
 //! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
 //! than bounded, where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular
-//! surfaces, and a measured material's grids, the sun's included ([`super::refinement`]). What is not, and is
-//! named in [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on
-//! Lambertian surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is
-//! unbounded), penumbrae (a shadow ray grid's visible fraction), shadow maps, the device's interpolation (f32
+//! surfaces, a measured material's grids, the sun's included, and in a scene that shadows itself every grid with
+//! the shadow rays' (penumbrae) ([`super::refinement`]). What is not, and is named in [`Prediction::unbounded`]
+//! instead of being silently left out: those grids without the study (on Lambertian surfaces the closed forms of
+//! disk lights and the sky are exact; the small-source estimate is unbounded), shadow maps, the device's interpolation (f32
 //! barycentrics are bounded where `--tolerance` computes it: `super::interpolation`), and shadows turned off in a
 //! scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes: its lights'
 //! closed forms are exact ([`predict_irradiance`]).
@@ -124,6 +124,16 @@ pub fn sun_needs_study(scene: &Scene, settings: &RenderSettings) -> bool {
     settings.lights.sun.is_some() && has_measured(scene)
 }
 
+/// Whether `--tolerance-in-penumbrae` must estimate the visible fractions' shadow-ray grids by refinement (and so
+/// every grid with them, [`super::trial`]): the scene can shadow itself (`can_occlude`, shadows asked for) and
+/// casts shadow rays, whose grids have no derived bound in a penumbra (an occluder's edge across a light: the
+/// share of the cells it cuts, [`super::refinement`]).
+pub fn penumbrae_need_study(settings: &RenderSettings, can_occlude: bool) -> bool {
+    let lights = &settings.lights;
+    let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
+    can_occlude && settings.shading.shadows == Shadows::Ray && lit
+}
+
 /// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
 /// the closed-form irradiance is then the whole of their light, exact).
 fn only_lambertian(scene: &Scene) -> bool {
@@ -228,7 +238,7 @@ pub fn predict_with_peak(
     lobes: Option<&LobeEstimate>,
 ) -> Prediction {
     if settings.shading.quantity == Quantity::Irradiance {
-        return predict_irradiance(settings, renderer, can_occlude);
+        return predict_irradiance(settings, renderer, can_occlude, lobes);
     }
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let lights = &settings.lights;
@@ -283,11 +293,11 @@ pub fn predict_with_peak(
             (false, Some(_)) => {}
         }
     }
-    if let Some(estimate) = lobes.filter(|_| !lambertian) {
+    if let Some(estimate) = lobes.filter(|e| !lambertian || e.sun_grid || e.shadow_grid) {
         p.terms.push((estimate.term(), estimate.gci));
         p.max_relative += estimate.gci;
     }
-    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude);
+    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, lobes);
     p
 }
 
@@ -295,8 +305,14 @@ pub fn predict_with_peak(
 /// closed form (the disk sun's, partly set disk included; an exact disk light's projected solid angle; the sky's
 /// `π L (1 + cos t)/2`), exact but for the arithmetic. Left unbounded: the delta sun where its disk would
 /// straddle a surface's horizon (absolute error up to `(2/(3π)) r E⊥`, which no floor relates to the image's
-/// peak without knowing it), the small-source estimate, and occlusion as for radiance.
-fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude: bool) -> Prediction {
+/// peak without knowing it), the small-source estimate, and occlusion as for radiance (penumbrae estimated where
+/// `--tolerance` made the study: `shadows`).
+fn predict_irradiance(
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    shadows: Option<&LobeEstimate>,
+) -> Prediction {
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let (lights, shading) = (&settings.lights, &settings.shading);
     if lights.sun.is_some() {
@@ -314,13 +330,24 @@ fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude
     if lights.sky.is_some() {
         p.terms.push(("irradiance of the sky (closed form):".into(), 0.0));
     }
-    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude);
+    if let Some(estimate) = shadows.filter(|e| e.shadow_grid) {
+        p.terms.push((estimate.term(), estimate.gci));
+        p.max_relative += estimate.gci;
+    }
+    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, shadows);
     p
 }
 
 /// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, and what no bound
-/// covers), and the renderer's arithmetic and interpolation.
-fn occlusion_and_arithmetic(p: &mut Prediction, shading: &ShadingOptions, renderer: Renderer, can_occlude: bool) {
+/// covers: penumbrae unless `estimate` refined the shadow rays' grids), and the renderer's arithmetic and
+/// interpolation.
+fn occlusion_and_arithmetic(
+    p: &mut Prediction,
+    shading: &ShadingOptions,
+    renderer: Renderer,
+    can_occlude: bool,
+    estimate: Option<&LobeEstimate>,
+) {
     if can_occlude {
         match shading.shadows {
             Shadows::None => {
@@ -328,6 +355,7 @@ fn occlusion_and_arithmetic(p: &mut Prediction, shading: &ShadingOptions, render
                 p.max_relative = 1.0;
             }
             Shadows::Map => p.unbounded.push("the shadow maps".into()),
+            _ if estimate.is_some_and(|e| e.shadow_grid) => {}
             _ => p.unbounded.push("penumbrae (the shadow rays' visible fractions)".into()),
         }
     }
@@ -409,20 +437,23 @@ pub fn choose_for_tolerance_with_peak(
 
 /// What `--tolerance` refuses whatever the materials, or the settings with the disk lights' exact model (on
 /// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): light of disk lights
-/// and the sky through occluders (their visible fraction), the device's interpolation, shadows other than rays
-/// where the scene can shadow itself.
+/// and the sky through occluders (their visible fraction) unless the shadow rays' grids are estimated by
+/// refinement (`shadow_grids`: `--tolerance-in-penumbrae`, [`penumbrae_need_study`]), the device's
+/// interpolation, shadows other than rays where the scene can shadow itself.
 pub(crate) fn techniques_within(
     settings: &RenderSettings,
     renderer: Renderer,
     can_occlude: bool,
+    shadow_grids: bool,
     tolerance: f64,
 ) -> Result<ShadingOptions, String> {
     let lights = &settings.lights;
-    if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude {
+    if (!lights.disks.is_empty() || lights.sky.is_some()) && can_occlude && !shadow_grids {
         return Err(format!(
             "--tolerance {tolerance:e}: the scene can shadow itself, and the visible fraction of disk lights and the \
              sky through occluders has no bound (a shadow-ray grid errs by the share of its cells an occluder's edge \
-             crosses); --shadows none bounds the render against the unshadowed truth"
+             crosses): --tolerance-in-penumbrae estimates it by refinement (costly: it converges at first order), \
+             --shadows none bounds the render against the unshadowed truth"
         ));
     }
     let mut shading = settings.shading;
@@ -459,7 +490,7 @@ pub(crate) fn choose_sun_within(
              do; docs/accuracy.md, \"Error bounds\")"
         ));
     }
-    let mut shading = techniques_within(settings, renderer, can_occlude, tolerance)?;
+    let mut shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
     let lights = &settings.lights;
     let arithmetic = renderer.arithmetic();
     let Some(sun) = &lights.sun else { return Ok(shading) };

@@ -13,6 +13,8 @@
 //! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
 //! only by their lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has
 //! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
+//! Where the scene shadows itself (shadow rays), every grid is refined on the rungs, the visible fractions'
+//! shadow-ray grids too (`shadow_grid`): the penumbrae (below).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
 //! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding,
@@ -31,8 +33,16 @@
 //!
 //! **What it is not**: a bound. It is an estimate that holds where the pixels' errors follow the model, which is
 //! what `tests/accuracy.rs` measures against the converged reference on every scene of models/ and the BRDF chart
-//! under disk lights and the sky. Penumbrae (a shadow-ray grid's visible fraction) converge erratically, at first
-//! order or worse, with jumps where an occluder's edge crosses a cell; they are not estimated here.
+//! under disk lights and the sky.
+//!
+//! **Penumbrae.** A shadow-ray grid's visible fraction has a jump where an occluder's edge crosses the light, so
+//! a penumbra pixel converges at first order or slower, erratically: the share of the cells the edge cuts shrinks
+//! as `1/k`, their errors partly cancel (`k^−1.5` for an edge at a random angle), and a rung can agree with the
+//! next by chance. The max over the image's pixels is steadier than any one pixel (many pixels, many edge
+//! positions), and its observed order on the models' penumbrae reads 0.8 to 2 (docs/accuracy.md,
+//! "Penumbrae"). The order used is at most 1 there ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case, which
+//! doubles the estimate of an order-2 reading), and an order under [`MIN_ORDER`] sends the ladder on. Still an estimate: `tests/accuracy.rs` checks it against the
+//! converged reference on the models' penumbrae and against the exact circular segment of a straight edge.
 
 use crate::compare::{image_peak, pixel_difference, DiffOptions};
 use crate::film::Image;
@@ -45,6 +55,9 @@ pub const FIRST_LOBE_GRID: u32 = 4;
 pub const MIN_ORDER: f64 = 0.5;
 /// The highest order used: the midpoint rule's on a smooth integrand.
 pub const MAX_ORDER: f64 = 2.0;
+/// The highest order used where the shadow rays' grids are refined: a jump's (an occluder's edge across a
+/// light), whose midpoint grid errs by `O(1/k)` at worst (module text, "Penumbrae").
+pub const MAX_ORDER_WITH_PENUMBRAE: f64 = 1.0;
 /// Roache's factor of safety for a study of three grids.
 pub const SAFETY_FACTOR: f64 = 1.25;
 
@@ -109,7 +122,8 @@ pub fn observed_order(k: [u32; 3], d1: f64, d2: f64) -> Option<f64> {
 
 /// The estimate of one study: the finest grid, its estimated max relative error (the GCI), the observed order
 /// and the ladder's last two differences (less rounding); `sun_grid`: whether the sun's grid was refined on the
-/// ladder too (a measured material under the sun), so that the estimate covers it instead of the sun's bound.
+/// ladder too (a measured material under the sun, or penumbrae), so that the estimate covers it instead of the
+/// sun's bound; `shadow_grid`: whether the visible fractions' shadow-ray grids were, so that it covers penumbrae.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LobeEstimate {
     pub samples_per_axis: u32,
@@ -117,6 +131,7 @@ pub struct LobeEstimate {
     pub order: f64,
     pub differences: [f64; 2],
     pub sun_grid: bool,
+    pub shadow_grid: bool,
 }
 
 impl LobeEstimate {
@@ -125,10 +140,10 @@ impl LobeEstimate {
     pub fn term(&self) -> String {
         format!(
             "{} {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
-            if self.sun_grid {
-                "the sun's grid and the lobe grids"
-            } else {
-                "lobe grids under disk lights and the sky"
+            match (self.sun_grid, self.shadow_grid) {
+                (_, true) => "every grid (the sun's, the lobes', the shadow rays': penumbrae included)",
+                (true, false) => "the sun's grid and the lobe grids",
+                (false, false) => "lobe grids under disk lights and the sky",
             },
             self.samples_per_axis,
             self.order
@@ -144,13 +159,25 @@ pub struct Ladder {
     differences: Vec<f64>,
     /// Whether the sun's grid is refined with the lobe grids.
     sun_grid: bool,
+    /// Whether the shadow-ray grids are.
+    shadow_grid: bool,
 }
 
 impl Ladder {
-    /// A study on a renderer whose arithmetic errs by `arithmetic` (relative), refining the sun's grid with the
-    /// lobe grids or not.
-    pub fn new(arithmetic: f64, sun_grid: bool) -> Self {
-        Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new(), sun_grid }
+    /// A study on a renderer whose arithmetic errs by `arithmetic` (relative), refining the sun's grid and the
+    /// shadow-ray grids with the lobe grids or not.
+    pub fn new(arithmetic: f64, sun_grid: bool, shadow_grid: bool) -> Self {
+        Self { noise: 2.0 * arithmetic, grids: Vec::new(), differences: Vec::new(), sun_grid, shadow_grid }
+    }
+
+    /// The highest order the estimate uses: [`MAX_ORDER_WITH_PENUMBRAE`] where the shadow rays' grids are
+    /// refined, else [`MAX_ORDER`].
+    fn max_order(&self) -> f64 {
+        if self.shadow_grid {
+            MAX_ORDER_WITH_PENUMBRAE
+        } else {
+            MAX_ORDER
+        }
     }
 
     /// Records the image of grid `k` given the previous rung's image (`None` for the first).
@@ -176,17 +203,18 @@ impl Ladder {
             order,
             differences: [d1, d2],
             sun_grid: self.sun_grid,
+            shadow_grid: self.shadow_grid,
         };
         if d2 == 0.0 {
             // The last two grids agree to rounding; after a difference that vanished too, or one that shrank to
             // nothing (an order past any bound, cut to MAX_ORDER), the finest grid's error is its rounding.
-            return Some(done(0.0, MAX_ORDER));
+            return Some(done(0.0, self.max_order()));
         }
         let order = observed_order(k, d1, d2)?;
         if order < MIN_ORDER {
             return None;
         }
-        let p = order.min(MAX_ORDER);
+        let p = order.min(self.max_order());
         let r = k[2] as f64 / k[1] as f64;
         Some(done(SAFETY_FACTOR * d2 / (p * r.ln()).exp_m1(), p))
     }
@@ -236,7 +264,7 @@ mod tests {
             // A small amplitude, so that the differences relative to the pixel's value follow the power law
             // (relative to a value that moves by 10%, the observed order of p = 1 reads 0.9).
             let value = |k: u32| truth + 0.01 * (k as f32).powf(-p as f32);
-            let mut ladder = Ladder::new(0.0, false);
+            let mut ladder = Ladder::new(0.0, false, false);
             let mut prev: Option<Image> = None;
             for &k in &[4u32, 6, 9] {
                 let img = flat(4, value(k));
@@ -254,7 +282,7 @@ mod tests {
     #[test]
     fn the_study_refuses_grids_out_of_range() {
         let run = |values: [f32; 3], arithmetic: f64| {
-            let mut ladder = Ladder::new(arithmetic, false);
+            let mut ladder = Ladder::new(arithmetic, false, false);
             let mut prev: Option<Image> = None;
             for (i, &v) in values.iter().enumerate() {
                 let img = flat(2, v);

@@ -13,8 +13,8 @@ use std::convert::Infallible;
 
 use super::interpolation::f32_interpolation_bound;
 use super::predicted::{
-    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, predict_with_peak, sun_needs_study,
-    techniques_within, Barycentrics, Prediction, Renderer,
+    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, penumbrae_need_study, predict_with_peak,
+    sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer,
 };
 use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
@@ -29,6 +29,30 @@ use crate::shading::{Shadows, SunModel};
 pub struct WithinTolerance<T> {
     pub kept: T,
     pub prediction: Prediction,
+}
+
+/// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it
+/// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside the sun's
+/// penumbrae, which the prediction names as not bounded, and light of disk lights and the sky through occluders
+/// is refused (nearly every pixel they light near an occluder is in a penumbra); with it, the shadow rays' grids
+/// are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in penumbrae
+/// (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    pub max_relative: f64,
+    pub in_penumbrae: bool,
+}
+
+impl Tolerance {
+    /// The promise outside the sun's penumbrae (`--tolerance` alone).
+    pub fn outside_penumbrae(max_relative: f64) -> Self {
+        Self { max_relative, in_penumbrae: false }
+    }
+
+    /// The promise in penumbrae too (`--tolerance-in-penumbrae`).
+    pub fn everywhere(max_relative: f64) -> Self {
+        Self { max_relative, in_penumbrae: true }
+    }
 }
 
 /// Why [`render_within_tolerance`] rendered nothing: no setting can promise the tolerance, or the renderer failed.
@@ -51,13 +75,13 @@ pub fn render_within_tolerance<T, E>(
     renderer: Renderer,
     asked: Shadows,
     scene_can_occlude: bool,
-    tolerance: Option<f64>,
+    tolerance: Option<Tolerance>,
     reference: &ReferenceOptions,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
     let f32_barycentrics = renderer == Renderer::Gpu { barycentrics: Barycentrics::F32 };
-    let Some(tolerance) = tolerance.filter(|_| f32_barycentrics) else {
+    let Some(Tolerance { max_relative: tolerance, in_penumbrae }) = tolerance.filter(|_| f32_barycentrics) else {
         return models_within(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
     };
     // f32 barycentrics: the models chosen for what their bound leaves, which is known only for the models
@@ -68,7 +92,7 @@ pub fn render_within_tolerance<T, E>(
     let mut bound = 0.0;
     for _ in 0..2 {
         *settings = initial.clone();
-        let within = tolerance - reserve;
+        let within = Tolerance { max_relative: tolerance - reserve, in_penumbrae };
         let mut done =
             models_within(scene, settings, renderer, asked, scene_can_occlude, Some(within), &mut render, &image_of)?;
         bound = f32_interpolation_bound(scene, settings, reference);
@@ -97,14 +121,18 @@ fn models_within<T, E>(
     renderer: Renderer,
     asked: Shadows,
     scene_can_occlude: bool,
-    tolerance: Option<f64>,
+    tolerance: Option<Tolerance>,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
-    if let Some(tolerance) = tolerance.filter(|_| lobes_need_study(scene, settings) || sun_needs_study(scene, settings))
-    {
-        return lobe_study(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
+    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    let penumbrae = tolerance.is_some_and(|t| t.in_penumbrae) && penumbrae_need_study(settings, can_occlude);
+    let study = lobes_need_study(scene, settings) || sun_needs_study(scene, settings) || penumbrae;
+    if let Some(t) = tolerance.filter(|_| study) {
+        let tolerance = t.max_relative;
+        return lobe_study(scene, settings, renderer, asked, scene_can_occlude, tolerance, penumbrae, render, image_of);
     }
+    let tolerance = tolerance.map(|t| t.max_relative);
     let trial = if delta_trial(scene, settings, renderer, asked, scene_can_occlude, tolerance) {
         let mut delta = settings.clone();
         delta.shading.sun = SunModel::Delta;
@@ -124,7 +152,6 @@ fn models_within<T, E>(
     };
     if settings.shading.sun == SunModel::Delta && peak.is_none() {
         // A delta render asked for (or chosen without a trial): its horizon term against its own image's peak.
-        let can_occlude = asked != Shadows::None && scene_can_occlude;
         prediction = predict_with_peak(scene, settings, renderer, can_occlude, Some(image_peak(image_of(&kept))), None);
     }
     Ok(WithinTolerance { kept, prediction })
@@ -135,15 +162,17 @@ fn models_within<T, E>(
 /// lobe grids get the larger share unless a lobe too sharp for the sun's grids needs it.
 pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 
-/// `--tolerance` where specular surfaces are lit by disk lights or the sky, or a measured material by the sun: the
-/// sun's models chosen by their bounds for a quarter of the tolerance (or a half, or three quarters:
-/// [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on the lobe grids'
-/// ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits what the sun's
-/// bound and the arithmetic leave. With a measured material under the sun, the disk sun's grid is refined on the
-/// same rungs instead, and the estimate gets all of the tolerance but the arithmetic. Refused as
-/// [`techniques_within`] refuses (light through occluders, the device's interpolation, shadows other than rays),
-/// where the sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid does not
-/// meet it.
+/// `--tolerance` where specular surfaces are lit by disk lights or the sky, a measured material by the sun, or the
+/// scene shadows itself: the sun's models chosen by their bounds for a quarter of the tolerance (or a half, or
+/// three quarters: [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on
+/// the lobe grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits
+/// what the sun's bound and the arithmetic leave. With a measured material under the sun, the disk sun's grid is
+/// refined on the same rungs instead, and the estimate gets all of the tolerance but the arithmetic; where the
+/// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]),
+/// the shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a
+/// specular penumbra). Refused as [`techniques_within`] refuses (light of disk lights and the sky through
+/// occluders without `shadow_grids`, the device's interpolation, shadows other than rays), where the sun's bound
+/// cannot meet three quarters of the tolerance, or where the ladder's finest grid does not meet it.
 #[allow(clippy::too_many_arguments)]
 fn lobe_study<T, E>(
     scene: &Scene,
@@ -152,16 +181,17 @@ fn lobe_study<T, E>(
     asked: Shadows,
     scene_can_occlude: bool,
     tolerance: f64,
+    shadow_grid: bool,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
     let can_occlude = asked != Shadows::None && scene_can_occlude;
-    let sun_grid = sun_needs_study(scene, settings);
+    let sun_grid = settings.lights.sun.is_some() && (sun_needs_study(scene, settings) || shadow_grid);
     let budget = if sun_grid || settings.lights.sun.is_none() {
         // No sun's bound to choose: the sun's grid is on the ladder too (the disk sun; the estimate covers it), or
         // there is no sun.
-        settings.shading =
-            techniques_within(settings, renderer, can_occlude, tolerance).map_err(TrialError::Tolerance)?;
+        settings.shading = techniques_within(settings, renderer, can_occlude, shadow_grid, tolerance)
+            .map_err(TrialError::Tolerance)?;
         if sun_grid {
             settings.shading.sun = SunModel::Disk;
         }
@@ -178,13 +208,16 @@ fn lobe_study<T, E>(
         // What the sun's terms and the arithmetic leave.
         tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative
     };
-    let mut study = Ladder::new(renderer.arithmetic(), sun_grid);
+    let mut study = Ladder::new(renderer.arithmetic(), sun_grid, shadow_grid);
     let mut previous: Option<T> = None;
     let mut last = None;
     for k in ladder() {
         settings.shading.samples_per_axis = k;
         if sun_grid {
             settings.shading.sun_samples_per_axis = k;
+        }
+        if shadow_grid {
+            settings.shading.shadow_samples_per_axis = k;
         }
         let image = render(settings).map_err(TrialError::Render)?;
         study.push(k, previous.as_ref().map(&image_of), image_of(&image));
@@ -217,7 +250,7 @@ pub fn reference_within_tolerance(
     options: &ReferenceOptions,
     asked: Shadows,
     scene_can_occlude: bool,
-    tolerance: Option<f64>,
+    tolerance: Option<Tolerance>,
 ) -> Result<(Image, Prediction), String> {
     let render = |s: &RenderSettings| Ok::<_, Infallible>(cpu::render(scene, s, options));
     let r = Renderer::Reference;

@@ -262,9 +262,19 @@ pub struct SceneArgs {
     /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
     /// and kept within REL beside the models'. Refused: light of disk lights and the sky through occluders, the
     /// device's interpolation, and `--shadows map` (`auto` casts shadow rays, on a device without ray queries by
-    /// the shader's walk of the scene's BVH; `--shadows none` measures against the unshadowed truth).
+    /// the shader's walk of the scene's BVH; `--shadows none` measures against the unshadowed truth). Where the
+    /// scene shadows itself the promise holds outside the sun's penumbrae (`-v` names them as not bounded);
+    /// `--tolerance-in-penumbrae` extends it to them.
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
+
+    /// With --tolerance: hold it in penumbrae too. The shadow rays' grids (overriding --shadow-samples) go on the
+    /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
+    /// refinement, its order taken as at most 1 (a jump's: a penumbra converges at first order). Light of disk
+    /// lights and the sky through occluders is then estimated instead of refused. Costly, and often refused: in
+    /// the dark end of a penumbra the visible fraction must be right to T/100 of the peak (the diff's floor).
+    #[arg(help_heading = "Quality", long, requires = "tolerance")]
+    pub tolerance_in_penumbrae: bool,
 
     /// Shadows: `auto` (shadow rays where the device has ray queries, else shadow maps; none where nothing can
     /// occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk lights, any
@@ -308,6 +318,12 @@ pub fn per_axis(samples: u32) -> u32 {
 }
 
 impl SceneArgs {
+    /// What `--tolerance` (and `--tolerance-in-penumbrae`) promise, if asked.
+    pub fn tolerance(&self) -> Option<crate::accuracy::trial::Tolerance> {
+        self.tolerance
+            .map(|t| crate::accuracy::trial::Tolerance { max_relative: t, in_penumbrae: self.tolerance_in_penumbrae })
+    }
+
     /// Refuses flags that mean nothing together.
     pub fn check(&self) -> Result<(), super::CliError> {
         self.daylight.check().map_err(super::CliError::Usage)?;

@@ -70,7 +70,7 @@ pub(super) fn tolerance_rows(
             predicted,
             settings.shading.shadows,
             can_occlude,
-            Some(tolerance),
+            Some(crate::accuracy::trial::Tolerance::outside_penumbrae(tolerance)),
             reference,
             |s| {
                 let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;

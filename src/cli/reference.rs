@@ -88,7 +88,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         let (image, record) = converged_image(&scene, &mut settings, &options, a);
         (image, None, Some(record))
     } else {
-        let (asked, tolerance) = (a.scene.shadows, a.scene.tolerance);
+        let (asked, tolerance) = (a.scene.shadows, a.scene.tolerance());
         let (image, prediction) =
             reference_within_tolerance(&scene, &mut settings, &options, asked, scene_can_occlude, tolerance)
                 .map_err(CliError::Usage)?;

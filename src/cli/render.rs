@@ -142,7 +142,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     // The reference mirroring the device, for the bound of f32 interpolation.
     let reference = device_reference_options(r.device_info(), a);
-    let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance);
+    let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance());
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
     let done = render_within_tolerance(
@@ -167,9 +167,12 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         // A grid the study went on to that the device cannot run (`settings` holds the grids of the render that
         // failed): no setting it can render meets the tolerance.
         (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
-            "--tolerance {t:e}: the next render of its study ({}² lobe grids, {}² sun samples) is beyond this \
-             device: {why}",
-            settings.shading.samples_per_axis, settings.shading.sun_samples_per_axis
+            "--tolerance {:e}: the next render of its study ({}² lobe grids, {}² sun samples, {}² shadow rays) is \
+             beyond this device: {why}",
+            t.max_relative,
+            settings.shading.samples_per_axis,
+            settings.shading.sun_samples_per_axis,
+            settings.shading.shadow_samples_per_axis
         )),
         (TrialError::Render(e), _) => CliError::from(e),
     })?;
