@@ -527,22 +527,36 @@ pub(crate) fn choose_sun_within(
     ))
 }
 
+/// What `--tolerance`'s choice and a render's prediction are for: the scene, the renderer whose error is
+/// predicted, the shadows asked for, and whether anything in the scene can occlude a light.
+#[derive(Clone, Copy)]
+pub struct Request<'a> {
+    pub scene: &'a Scene,
+    pub renderer: Renderer,
+    pub asked: Shadows,
+    pub scene_can_occlude: bool,
+}
+
+impl Request<'_> {
+    /// Whether the truth the render is measured against has shadows: something can occlude a light and shadows
+    /// are asked for (with `--shadows none` the truth is unshadowed too).
+    pub fn can_occlude(&self) -> bool {
+        self.asked != Shadows::None && self.scene_can_occlude
+    }
+}
+
 /// The models of a render and their predicted error: `--tolerance`'s choice where one is asked
 /// (`settings.shading` updated, shadows already resolved), then [`predict`] for the models used.
-/// `scene_can_occlude`: whether something in the scene can occlude a light; with `--shadows none` asked for
-/// (`asked`), the truth the bound is against is unshadowed too.
 /// `delta_peak`: the peak of a delta-sun render of the scene made for the choice ([`delta_worth_trying`]), also
 /// the prediction's where the delta sun is chosen.
 pub fn choose_and_predict(
-    scene: &Scene,
+    request: Request,
     settings: &mut RenderSettings,
-    renderer: Renderer,
-    asked: Shadows,
-    scene_can_occlude: bool,
     tolerance: Option<f64>,
     delta_peak: Option<f64>,
 ) -> Result<Prediction, String> {
-    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    let Request { scene, renderer, .. } = request;
+    let can_occlude = request.can_occlude();
     if let Some(tolerance) = tolerance {
         settings.shading =
             choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, delta_peak)?;
@@ -552,15 +566,8 @@ pub fn choose_and_predict(
 }
 
 /// Whether `choose_and_predict` should be given a delta render's peak: `--tolerance` asked, and
-/// [`delta_worth_trying`] (the same `asked` shadows rule).
-pub fn delta_trial(
-    scene: &Scene,
-    settings: &RenderSettings,
-    renderer: Renderer,
-    asked: Shadows,
-    scene_can_occlude: bool,
-    tolerance: Option<f64>,
-) -> bool {
-    let can_occlude = asked != Shadows::None && scene_can_occlude;
-    tolerance.is_some_and(|t| delta_worth_trying(scene, settings, renderer, can_occlude, t))
+/// [`delta_worth_trying`].
+pub fn delta_trial(request: Request, settings: &RenderSettings, tolerance: Option<f64>) -> bool {
+    let can_occlude = request.can_occlude();
+    tolerance.is_some_and(|t| delta_worth_trying(request.scene, settings, request.renderer, can_occlude, t))
 }

@@ -14,7 +14,7 @@ use std::convert::Infallible;
 use super::interpolation::f32_interpolation_bound;
 use super::predicted::{
     choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, penumbrae_need_study, predict_with_peak,
-    sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer,
+    sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer, Request,
 };
 use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
@@ -61,28 +61,23 @@ pub enum TrialError<E> {
     Render(E),
 }
 
-/// Renders `scene` with `--tolerance`'s models (`settings.shading` updated to them) by `render` (whose result holds
-/// an image, `image_of`), and predicts its error; `renderer` whose error is predicted, `asked` the shadows asked
-/// for, `scene_can_occlude` whether anything in the scene can occlude a light. A delta render, asked for or
-/// chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or the sky
+/// Renders the request's scene with `--tolerance`'s models (`settings.shading` updated to them) by `render` (whose
+/// result holds an image, `image_of`), and predicts its error for the request's renderer. A delta render, asked
+/// for or chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or the sky
 /// with a tolerance: [`lobe_study`]. On a GPU with f32 barycentrics, the bound they add
 /// (`accuracy::interpolation`) is computed by the reference with `reference` (mirroring the device) and kept
 /// within the tolerance beside the models'.
-#[allow(clippy::too_many_arguments)]
 pub fn render_within_tolerance<T, E>(
-    scene: &Scene,
+    request: Request,
     settings: &mut RenderSettings,
-    renderer: Renderer,
-    asked: Shadows,
-    scene_can_occlude: bool,
     tolerance: Option<Tolerance>,
     reference: &ReferenceOptions,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
-    let f32_barycentrics = renderer == Renderer::Gpu { barycentrics: Barycentrics::F32 };
+    let f32_barycentrics = request.renderer == Renderer::Gpu { barycentrics: Barycentrics::F32 };
     let Some(Tolerance { max_relative: tolerance, in_penumbrae }) = tolerance.filter(|_| f32_barycentrics) else {
-        return models_within(scene, settings, renderer, asked, scene_can_occlude, tolerance, render, image_of);
+        return models_within(request, settings, tolerance, render, image_of);
     };
     // f32 barycentrics: the models chosen for what their bound leaves, which is known only for the models
     // chosen; first for all of the tolerance, then, where the bound does not fit beside them, once more for what
@@ -93,9 +88,8 @@ pub fn render_within_tolerance<T, E>(
     for _ in 0..2 {
         *settings = initial.clone();
         let within = Tolerance { max_relative: tolerance - reserve, in_penumbrae };
-        let mut done =
-            models_within(scene, settings, renderer, asked, scene_can_occlude, Some(within), &mut render, &image_of)?;
-        bound = f32_interpolation_bound(scene, settings, reference);
+        let mut done = models_within(request, settings, Some(within), &mut render, &image_of)?;
+        bound = f32_interpolation_bound(request.scene, settings, reference);
         if done.prediction.max_relative + bound <= tolerance {
             done.prediction.add_f32_bound(bound);
             return Ok(done);
@@ -114,26 +108,22 @@ pub fn render_within_tolerance<T, E>(
 
 /// What [`render_within_tolerance`] does besides f32 interpolation's bound: the models by their bounds, the delta
 /// trial, the grids' study.
-#[allow(clippy::too_many_arguments)]
 fn models_within<T, E>(
-    scene: &Scene,
+    request: Request,
     settings: &mut RenderSettings,
-    renderer: Renderer,
-    asked: Shadows,
-    scene_can_occlude: bool,
     tolerance: Option<Tolerance>,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
-    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    let Request { scene, renderer, .. } = request;
+    let can_occlude = request.can_occlude();
     let penumbrae = tolerance.is_some_and(|t| t.in_penumbrae) && penumbrae_need_study(settings, can_occlude);
     let study = lobes_need_study(scene, settings) || sun_needs_study(scene, settings) || penumbrae;
     if let Some(t) = tolerance.filter(|_| study) {
-        let tolerance = t.max_relative;
-        return lobe_study(scene, settings, renderer, asked, scene_can_occlude, tolerance, penumbrae, render, image_of);
+        return lobe_study(request, settings, t.max_relative, penumbrae, render, image_of);
     }
     let tolerance = tolerance.map(|t| t.max_relative);
-    let trial = if delta_trial(scene, settings, renderer, asked, scene_can_occlude, tolerance) {
+    let trial = if delta_trial(request, settings, tolerance) {
         let mut delta = settings.clone();
         delta.shading.sun = SunModel::Delta;
         Some(render(&delta).map_err(TrialError::Render)?)
@@ -141,8 +131,7 @@ fn models_within<T, E>(
         None
     };
     let peak = trial.as_ref().map(|t| image_peak(image_of(t)));
-    let mut prediction = choose_and_predict(scene, settings, renderer, asked, scene_can_occlude, tolerance, peak)
-        .map_err(TrialError::Tolerance)?;
+    let mut prediction = choose_and_predict(request, settings, tolerance, peak).map_err(TrialError::Tolerance)?;
     let kept = match trial {
         Some(delta) if settings.shading.sun == SunModel::Delta => delta,
         trial => {
@@ -173,19 +162,16 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 /// specular penumbra). Refused as [`techniques_within`] refuses (light of disk lights and the sky through
 /// occluders without `shadow_grids`, the device's interpolation, shadows other than rays), where the sun's bound
 /// cannot meet three quarters of the tolerance, or where the ladder's finest grid does not meet it.
-#[allow(clippy::too_many_arguments)]
 fn lobe_study<T, E>(
-    scene: &Scene,
+    request: Request,
     settings: &mut RenderSettings,
-    renderer: Renderer,
-    asked: Shadows,
-    scene_can_occlude: bool,
     tolerance: f64,
     shadow_grid: bool,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
-    let can_occlude = asked != Shadows::None && scene_can_occlude;
+    let Request { scene, renderer, .. } = request;
+    let can_occlude = request.can_occlude();
     let sun_grid = settings.lights.sun.is_some() && (sun_needs_study(scene, settings) || shadow_grid);
     let budget = if sun_grid || settings.lights.sun.is_none() {
         // No sun's bound to choose: the sun's grid is on the ladder too (the disk sun; the estimate covers it), or
@@ -253,8 +239,8 @@ pub fn reference_within_tolerance(
     tolerance: Option<Tolerance>,
 ) -> Result<(Image, Prediction), String> {
     let render = |s: &RenderSettings| Ok::<_, Infallible>(cpu::render(scene, s, options));
-    let r = Renderer::Reference;
-    match render_within_tolerance(scene, settings, r, asked, scene_can_occlude, tolerance, options, render, |i| i) {
+    let request = Request { scene, renderer: Renderer::Reference, asked, scene_can_occlude };
+    match render_within_tolerance(request, settings, tolerance, options, render, |i| i) {
         Ok(done) => Ok((done.kept, done.prediction)),
         Err(TrialError::Tolerance(why)) => Err(why),
         Err(TrialError::Render(never)) => match never {},

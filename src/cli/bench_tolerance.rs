@@ -11,7 +11,8 @@ use super::CliError;
 use crate::accuracy::converged::Converged;
 use crate::accuracy::error::image_error;
 use crate::accuracy::predicted::Renderer as Predicted;
-use crate::accuracy::trial::{render_within_tolerance, TrialError};
+use crate::accuracy::predicted::Request;
+use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
 use crate::cpu::ReferenceOptions;
 use crate::gpu::{GpuScene, Renderer};
 use crate::scene::Scene;
@@ -64,13 +65,12 @@ pub(super) fn tolerance_rows(
         }
         let mut s = settings.clone();
         let (mut spent, mut renders) = (Duration::ZERO, 0u32);
+        let request =
+            Request { scene, renderer: predicted, asked: settings.shading.shadows, scene_can_occlude: can_occlude };
         let done = render_within_tolerance(
-            scene,
+            request,
             &mut s,
-            predicted,
-            settings.shading.shadows,
-            can_occlude,
-            Some(crate::accuracy::trial::Tolerance::outside_penumbrae(tolerance)),
+            Some(Tolerance::outside_penumbrae(tolerance)),
             reference,
             |s| {
                 let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;

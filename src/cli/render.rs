@@ -142,15 +142,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     // The reference mirroring the device, for the bound of f32 interpolation.
     let reference = device_reference_options(r.device_info(), a);
-    let (asked, can_occlude, tolerance) = (a.scene.shadows, gpu_scene.can_occlude(), a.scene.tolerance());
+    let request = predicted::Request {
+        scene: scene_data,
+        renderer: predicted_for,
+        asked: a.scene.shadows,
+        scene_can_occlude: gpu_scene.can_occlude(),
+    };
+    let tolerance = a.scene.tolerance();
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
     let done = render_within_tolerance(
-        scene_data,
+        request,
         &mut settings,
-        predicted_for,
-        asked,
-        can_occlude,
         tolerance,
         &reference,
         |s| {
