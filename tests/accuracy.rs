@@ -62,6 +62,29 @@ fn the_converged_reference_meets_its_claim_by_one_more_doubling() {
     assert!(c.unconverged.iter().all(|u| u.change >= accuracy / 10.0));
 }
 
+/// Grids that agree by chance: on overcast.glb with shadow rays, one pixel is identical on every grid from 8² to 51²
+/// (no ray meets the occluder a finer grid finds; 5.5% darker from 73² on), so it passes two doublings early. The
+/// final check (every pixel that stopped early, rendered once more with the finest grids reached) reports it, and
+/// every pixel left as converged is within the claim of a render with every grid at 256² (an independent, finer
+/// render; without the check one was 5.2e-2 from it).
+#[test]
+fn the_final_check_reports_grids_that_agree_by_chance() {
+    let scene = common::load(std::path::Path::new("models/overcast.glb"));
+    let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
+    s.shading.shadows = Shadows::Ray;
+    let reference = ReferenceOptions::default();
+    let accuracy = 1e-3;
+    let c = render_converged(&scene, &s, &reference, &ConvergenceOptions { accuracy, max_refinements: 7 });
+    assert!(c.unconverged.iter().any(|u| (u.x, u.y) == (36, 15)), "{}", c.summary());
+    let mut fine = s.clone();
+    fine.shading.samples_per_axis = 256;
+    fine.shading.shadow_samples_per_axis = 256;
+    let fine = cpu::render(&scene, &fine, &reference);
+    let e = sunshade::accuracy::error::image_error(&c.image, &fine, Some(&c.unconverged_mask())).unwrap();
+    eprintln!("{}: converged pixels against 256²: {:.2e}", c.summary(), e.max_rel);
+    assert!(e.max_rel < accuracy, "{:.2e}", e.max_rel);
+}
+
 #[test]
 fn pixels_that_do_not_converge_are_reported() {
     let dir = common::TempDir::new("unconverged");

@@ -356,7 +356,9 @@ fn occlusion_and_arithmetic(
             }
             Shadows::Map => p.unbounded.push("the shadow maps".into()),
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
-            _ => p.unbounded.push("penumbrae (the shadow rays' visible fractions)".into()),
+            _ => p
+                .unbounded
+                .push("penumbrae (the shadow rays' visible fractions: --tolerance-in-penumbrae estimates them)".into()),
         }
     }
     if let Renderer::Gpu { barycentrics } = renderer {
