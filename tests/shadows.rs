@@ -778,8 +778,9 @@ fn gpu_ray_queries_pass_light_through_alpha_masked_cutouts() {
 /// `--tolerance T` on the reference where the scene shadows itself: the grids, shadow rays' included, are
 /// estimated by refinement, and an image kept meets T against the circular segment's exact penumbra of a
 /// straight edge (relative with the diff's floor: 1% of the image's peak, so that in the penumbra's dark end the
-/// visible fraction must be right to `T/100`), or the study refuses. The real sun (0.53°), its penumbra resolved by 56 pixels or by 2; edges along the grid's
-/// axis and at 30° to it (the concentric map's cells meet an axis-aligned edge row by row). A refusal may be
+/// visible fraction must be right to `T/100`), or the study refuses. The real sun (0.53°), its penumbra spread over
+/// 56 pixels, 2, or half a pixel; edges along the grid's axis and at 30° to it (the concentric map's cells meet an
+/// axis-aligned edge row by row). A refusal may be
 /// conservative (the estimate's order is cut to a jump's 1): the finest grid's measured error is reported.
 #[test]
 fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
@@ -798,7 +799,7 @@ fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
             let (across, along) = (DVec3::new(c, 0.0, -s), DVec3::new(s, 0.0, c));
             let roof = quad((DVec3::Y - 5.0 * across).as_vec3(), (5.0 * across).as_vec3(), (5.0 * along).as_vec3());
             let scene = scene(&[floor(1.0), roof]);
-            // The image spans `span` penumbrae (±tan σ under an edge 1 m up): resolved by 56 pixels, or by 2.
+            // The image spans `span` penumbrae (±tan σ under an edge 1 m up): 56 pixels each, 2, or half a pixel.
             let camera = camera_down(DVec3::ZERO, span * half_angle.tan() / 12.0, 5.0);
             let base = settings(96, 8, camera, sun_lights(DVec3::Y, diameter), Shadows::Ray, 8);
             let mut exact = Image::new(base.width, base.height);

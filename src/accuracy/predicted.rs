@@ -4,12 +4,13 @@
 //! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
 //! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
 //! than bounded, where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular
-//! surfaces, a measured material's grids, the sun's included, and in a scene that shadows itself every grid with
-//! the shadow rays' (penumbrae) ([`super::refinement`]). What is not, and is named in [`Prediction::unbounded`]
-//! instead of being silently left out: those grids without the study (on Lambertian surfaces the closed forms of
-//! disk lights and the sky are exact; the small-source estimate is unbounded), shadow maps, the device's interpolation (f32
-//! barycentrics are bounded where `--tolerance` computes it: `super::interpolation`), and shadows turned off in a
-//! scene that can shadow itself (there the error is up to 100%). An irradiance image has no lobes: its lights'
+//! surfaces, a measured material's grids, the sun's included, and with `--tolerance-in-penumbrae` in a scene that
+//! shadows itself every grid with the shadow rays' ([`super::refinement`]). What is not, and is named in
+//! [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on Lambertian
+//! surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is unbounded),
+//! penumbrae without that study, shadow maps, the device's interpolation (f32 barycentrics are bounded where
+//! `--tolerance` computes it: `super::interpolation`), and shadows turned off in a scene that can shadow itself
+//! (there the error is up to 100%). An irradiance image has no lobes: its lights'
 //! closed forms are exact ([`predict_irradiance`]).
 
 use crate::scene::{Brdf, Scene};

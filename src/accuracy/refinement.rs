@@ -13,8 +13,8 @@
 //! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
 //! only by their lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has
 //! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
-//! Where the scene shadows itself (shadow rays), every grid is refined on the rungs, the visible fractions'
-//! shadow-ray grids too (`shadow_grid`): the penumbrae (below).
+//! With `--tolerance-in-penumbrae` in a scene that shadows itself (shadow rays), every grid is refined on the
+//! rungs, the visible fractions' shadow-ray grids too (`shadow_grid`): the penumbrae (below).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
 //! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding,
@@ -40,9 +40,10 @@
 //! as `1/k`, their errors partly cancel (`k^−1.5` for an edge at a random angle), and a rung can agree with the
 //! next by chance. The max over the image's pixels is steadier than any one pixel (many pixels, many edge
 //! positions), and its observed order on the models' penumbrae reads 0.8 to 2 (docs/accuracy.md,
-//! "Penumbrae"). The order used is at most 1 there ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case, which
-//! doubles the estimate of an order-2 reading), and an order under [`MIN_ORDER`] sends the ladder on. Still an estimate: `tests/accuracy.rs` checks it against the
-//! converged reference on the models' penumbrae and against the exact circular segment of a straight edge.
+//! "Penumbrae"). The order used is at most 1 there ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case: 2.4
+//! times the estimate of an order-2 reading on rungs √2 apart), and an order under [`MIN_ORDER`] sends the ladder
+//! on. Still an estimate: `tests/shadows.rs` checks it against the exact circular segment of a straight edge's
+//! penumbra, `tests/accuracy.rs` against a 181² render of sunset.glb on the GPU.
 
 use crate::compare::{image_peak, pixel_difference, DiffOptions};
 use crate::film::Image;

@@ -63,10 +63,10 @@ pub enum TrialError<E> {
 
 /// Renders the request's scene with `--tolerance`'s models (`settings.shading` updated to them) by `render` (whose
 /// result holds an image, `image_of`), and predicts its error for the request's renderer. A delta render, asked
-/// for or chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or the sky
-/// with a tolerance: [`lobe_study`]. On a GPU with f32 barycentrics, the bound they add
-/// (`accuracy::interpolation`) is computed by the reference with `reference` (mirroring the device) and kept
-/// within the tolerance beside the models'.
+/// for or chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or
+/// the sky, measured materials, and penumbrae where the tolerance is to hold there: [`lobe_study`]. On a GPU with
+/// f32 barycentrics, the bound they add (`accuracy::interpolation`) is computed by the reference with `reference`
+/// (mirroring the device) and kept within the tolerance beside the models'.
 pub fn render_within_tolerance<T, E>(
     request: Request,
     settings: &mut RenderSettings,
