@@ -135,29 +135,48 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     return true;
 }
 
-// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE); any_hit tests them unrolled.
-#define BVH_LEAF_SIZE 4u
+// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
+#define BVH_LEAF_SIZE 1u
 // The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
 #define BVH_STACK_SIZE 96
-// Leaf slot s of `node` in any_hit: its triangle, if the leaf has that many, met by the ray and blocking it.
-#define LEAF_TRIANGLE(s) \
-    if ((s) < node.count) { \
-        uvec4 tri = occluder_triangles[node.first + (s)]; \
+// The triangle of the leaf node `leaf`: where the ray meets it and it blocks the ray, any_hit returns true.
+#define LEAF_TEST(leaf) \
+    { \
+        uvec4 tri = occluder_triangles[(leaf).first]; \
         vec2 bary; \
         if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary) \
             && blocks(tri, bary)) { \
             return true; \
         } \
     }
+// Child `c` of an inner node, if the ray meets its box: a leaf tested at once, an inner node stacked.
+#define VISIT_CHILD(c) \
+    { \
+        BvhNode child = bvh_nodes[c]; \
+        if (slab(child, r.origin, d, inv, t_max)) { \
+            if (child.count == 0u) { \
+                stack[top] = (c); \
+                top += 1u; \
+            } else LEAF_TEST(child) \
+        } \
+    }
 
 // Whether the ray meets, with 0 < t < t_max, a triangle that blocks it: the tree walked from the root with an
 // explicit stack (at most one pending sibling a level of a tree fewer than 78 levels deep). Each node taken from
-// the stack is one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes
-// and stacks only those the ray meets: the walk's iterations are the nodes it enters, not the boxes it tests.
+// the stack is one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes,
+// tests at once the triangle of a child leaf the ray meets, and stacks only the inner children it meets: the
+// walk's iterations are the inner nodes it enters, not the boxes or triangles it tests. (One triangle a leaf:
+// on lavapipe a SIMD group runs a leaf's tests whenever one lane is at a leaf; visibility::bvh's LEAF_SIZE.)
 bool any_hit(WatertightRay r, float t_max) {
     vec3 d = r.direction;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 0.0, d.y != 0.0 ? 1.0 / d.y : 0.0, d.z != 0.0 ? 1.0 / d.z : 0.0);
-    if (!slab(bvh_nodes[0], r.origin, d, inv, t_max)) {
+    BvhNode root = bvh_nodes[0];
+    if (!slab(root, r.origin, d, inv, t_max)) {
+        return false;
+    }
+    if (root.count > 0u) {
+        // A tree of one leaf (a scene of one triangle, or none: gpu::shadow_bvh's degenerate record).
+        LEAF_TEST(root)
         return false;
     }
     uint stack[BVH_STACK_SIZE];
@@ -166,22 +185,8 @@ bool any_hit(WatertightRay r, float t_max) {
     while (top > 0u) {
         top -= 1u;
         BvhNode node = bvh_nodes[stack[top]];
-        if (node.count == 0u) {
-            if (slab(bvh_nodes[node.first], r.origin, d, inv, t_max)) {
-                stack[top] = node.first;
-                top += 1u;
-            }
-            if (slab(bvh_nodes[node.first + 1u], r.origin, d, inv, t_max)) {
-                stack[top] = node.first + 1u;
-                top += 1u;
-            }
-            continue;
-        }
-        // A leaf's triangles (at most BVH_LEAF_SIZE), unrolled: each loop iteration spends llvmpipe's budget.
-        LEAF_TRIANGLE(0u)
-        LEAF_TRIANGLE(1u)
-        LEAF_TRIANGLE(2u)
-        LEAF_TRIANGLE(3u)
+        VISIT_CHILD(node.first)
+        VISIT_CHILD(node.first + 1u)
     }
     return false;
 }

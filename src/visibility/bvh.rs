@@ -26,8 +26,14 @@ pub const STACK_SIZE: usize = 96;
 /// Bins per axis of the split search.
 const BINS: usize = 16;
 
-/// Triangles per leaf at most (`BVH_LEAF_SIZE` in shaders/occluders.glsl, whose walk tests a leaf unrolled).
-pub const LEAF_SIZE: usize = 4;
+/// Triangles per leaf at most (`BVH_LEAF_SIZE` in shaders/occluders.glsl, whose walk tests a child leaf's triangle
+/// in its parent's iteration). One: on lavapipe a SIMD group runs a leaf's tests whenever one of its lanes is at a
+/// leaf, so leaves of four cost the shader's walk 1.6 to 2 times as much (`render --shadows ray`, 256²: teapot.glb
+/// 7.6 s against 4.2–5.2 s, sunset.glb 11.3–12.5 s against 6.3–6.5 s; brdfs.glb at 96 × 72: 7.0–7.5 s against
+/// 3.5–3.7 s; docs/accuracy.md), while the reference's time did not change. (Each leaf its own loop iteration was
+/// faster still, 2.8 s and 4.3 s, but spent llvmpipe's loop budget on leaves: measured materials with a ray per
+/// lobe sample at 6² ran out.)
+pub const LEAF_SIZE: usize = 1;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
