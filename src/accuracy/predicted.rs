@@ -239,7 +239,7 @@ pub fn predict_with_peak(
     lobes: Option<&LobeEstimate>,
 ) -> Prediction {
     if settings.shading.quantity == Quantity::Irradiance {
-        return predict_irradiance(settings, renderer, can_occlude, lobes);
+        return predict_irradiance(settings, renderer, can_occlude);
     }
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let lights = &settings.lights;
@@ -306,14 +306,9 @@ pub fn predict_with_peak(
 /// closed form (the disk sun's, partly set disk included; an exact disk light's projected solid angle; the sky's
 /// `π L (1 + cos t)/2`), exact but for the arithmetic. Left unbounded: the delta sun where its disk would
 /// straddle a surface's horizon (absolute error up to `(2/(3π)) r E⊥`, which no floor relates to the image's
-/// peak without knowing it), the small-source estimate, and occlusion as for radiance (penumbrae estimated where
-/// `--tolerance` made the study: `shadows`).
-fn predict_irradiance(
-    settings: &RenderSettings,
-    renderer: Renderer,
-    can_occlude: bool,
-    shadows: Option<&LobeEstimate>,
-) -> Prediction {
+/// peak without knowing it), the small-source estimate, and occlusion as for radiance (`--tolerance`, which
+/// studies penumbrae, is for radiance only).
+fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude: bool) -> Prediction {
     let mut p = Prediction { max_relative: 0.0, terms: Vec::new(), unbounded: Vec::new() };
     let (lights, shading) = (&settings.lights, &settings.shading);
     if lights.sun.is_some() {
@@ -331,11 +326,7 @@ fn predict_irradiance(
     if lights.sky.is_some() {
         p.terms.push(("irradiance of the sky (closed form):".into(), 0.0));
     }
-    if let Some(estimate) = shadows.filter(|e| e.shadow_grid) {
-        p.terms.push((estimate.term(), estimate.gci));
-        p.max_relative += estimate.gci;
-    }
-    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, shadows);
+    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, None);
     p
 }
 

@@ -622,8 +622,9 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs.
-                let buffers = [
+                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
+                // 12 the occluders' BVH for the pipelines whose shadow rays walk it.
+                let mut buffers = vec![
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
                     (2, ib.buffer),
@@ -633,8 +634,13 @@ impl Renderer {
                     (10, scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, records)| records.buffer)),
                     (11, scene.measured.buffer),
                 ];
-                let infos = buffers
-                    .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]));
+                if self.pipeline.rays_walk_bvh() {
+                    buffers.push((12, scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer)));
+                }
+                let infos: Vec<_> = buffers
+                    .into_iter()
+                    .map(|(b, buffer)| (b, [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }]))
+                    .collect();
                 let writes: Vec<_> = infos
                     .iter()
                     .map(|(b, info)| {
@@ -672,17 +678,6 @@ impl Renderer {
                     .image_info(infos)
             });
             d.update_descriptor_sets(&writes, &[]);
-            // Binding 12: the occluders' BVH, for the pipelines whose shadow rays walk it.
-            if self.pipeline.rays_walk_bvh() {
-                let buffer = scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer);
-                let info = [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];
-                let write = vk::WriteDescriptorSet::default()
-                    .dst_set(self.pipeline.descriptor_set)
-                    .dst_binding(12)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .buffer_info(&info);
-                d.update_descriptor_sets(&[write], &[]);
-            }
             // Binding 4: the top-level acceleration structure, for the pipelines with shadow rays.
             if let Some(accel) = &scene.accel {
                 let structures = [accel.top_level()];
