@@ -114,50 +114,276 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
     return cos_r > 0.0 && cos_d > 0.0 ? cos_r * cos_d / dist2 : 0.0;
 }
 
-// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]).
-float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
-    float radius = tan(0.5 * angular_diameter);
-    vec3 t = orthonormal_to(l);
-    vec3 b = cross(l, t);
+// The largest k of the located grid (grid_fraction keeps two columns of k + 1 corners); the renderer refuses more.
+#define MAX_LOCATED_GRID 256u
+// What a visible-fraction grid samples (VisibilityLight.kind).
+#define GRID_LIGHT_SUN 0u
+#define GRID_LIGHT_DISK 1u
+// grid_fraction's stages at a corner: its own ray, the bisection along v to the corner below, along u to the one
+// before.
+#define GRID_CORNER 0u
+#define GRID_ALONG_V 1u
+#define GRID_ALONG_U 2u
+#define GRID_NEXT_RAY 0u
+#define GRID_NEXT_V 1u
+#define GRID_NEXT_U 2u
+#define GRID_NEXT_SQUARE 3u
+
+// A located grid's light and the receiving point's frame (GridLight in the Rust). Sun: normal n, direction c,
+// frame (a, b) about it, radius tan(sigma). Disk light: seen from x with normal n; centre c [m], emission
+// direction d, frame (a, b), radius [m].
+struct VisibilityLight {
+    uint kind;
+    vec3 x;
+    vec3 n;
+    vec3 c;
+    vec3 d;
+    vec3 a;
+    vec3 b;
+    float radius;
+};
+
+// The weight and shadow ray (a direction, or a point on a disk light) of the point xy of the unit disk.
+float light_sample(VisibilityLight L, vec2 xy, out vec3 ray) {
+    if (L.kind == GRID_LIGHT_SUN) {
+        return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
+    }
+    return disk_sample(L.x, L.n, L.c, L.d, L.a, L.b, L.radius, xy, ray);
+}
+
+// Whether a grid sample's shadow ray reaches its light.
+bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
+    return L.kind == GRID_LIGHT_DISK ? visible_to(origin, ray) : visible_along(origin, ray);
+}
+
+// Bisection steps that place a visibility edge between two neighbouring corners: ceil(log2 k), at least 1.
+uint edge_bisections(uint k) {
+    return max(uint(findMSB(max(k, 1u) - 1u) + 1), 1u);
+}
+
+// How many edge crossings one grid locates (2k); past them a crossing is its side's midpoint, without rays.
+uint max_located_crossings(uint k) {
+    return 2u * k;
+}
+
+// Where a visibility edge crosses the segment from the grid point `from` to `from + along` (grid units; the unit
+// square is k wide), by `steps` bisections: its parameter in (0, 1) from the first point, whose state is first_seen.
+float locate_edge(vec3 origin, VisibilityLight L, uint steps, bool first_seen, vec2 from, vec2 along, float kf) {
+    float lo = 0.0;
+    float hi = 1.0;
+    for (uint s = 0u; s < steps; ++s) {
+        float mid = 0.5 * (lo + hi);
+        vec2 uv = from + mid * along;
+        vec3 ray;
+        light_sample(L, concentric_disk(uv.x / kf, uv.y / kf), ray);
+        if (sample_visible(origin, L, ray) == first_seen) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return 0.5 * (lo + hi);
+}
+
+// The visible share of the square between four grid corners (0,0), (1,0), (1,1), (0,1) (seen0..3), the edge
+// drawn straight between its crossings on the sides whose corners disagree (bottom and top at x = their value,
+// right and left at y = theirs): the marching-squares polygon, its area by the shoelace formula.
+float cell_visible_area(bvec4 seen, float bottom, float right, float top, float left) {
+    if (all(seen)) {
+        return 1.0;
+    }
+    if (!any(seen)) {
+        return 0.0;
+    }
+    vec2 corners[4] = vec2[4](vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(1.0, 1.0), vec2(0.0, 1.0));
+    vec2 crossings[4] = vec2[4](vec2(bottom, 0.0), vec2(1.0, right), vec2(top, 1.0), vec2(0.0, left));
+    bool s[4] = bool[4](seen.x, seen.y, seen.z, seen.w);
+    vec2 points[8];
+    uint count = 0u;
+    for (uint c = 0u; c < 4u; ++c) {
+        if (s[c]) {
+            points[count] = corners[c];
+            count += 1u;
+        }
+        if (s[c] != s[(c + 1u) % 4u]) {
+            points[count] = crossings[c];
+            count += 1u;
+        }
+    }
+    float twice = 0.0;
+    for (uint p = 0u; p < count; ++p) {
+        vec2 a = points[p];
+        vec2 b = points[(p + 1u) % count];
+        twice += a.x * b.y - b.x * a.y;
+    }
+    return 0.5 * twice;
+}
+
+// sum(w V) / sum(w) over the unit square mapped to the light by the concentric map: k = 1, the light's centre
+// alone; otherwise the (k + 1)^2 corners of a k x k grid of squares, each square its corners' mean weight times
+// its visible share, the edges between disagreeing corners located by bisection (grid_fraction in the Rust, the
+// same rays and the same sums in the same order).
+//
+// Scheduled as one ray a loop iteration (a small state machine: a corner's ray, then the bisections of the edge
+// below it along v and before it along u, then its square), not as the Rust's nested loops with the bisections
+// inside: a fragment's SIMD group runs a branch whenever one of its lanes takes it, so bisections nested at a
+// corner would run once for every corner where any lane meets an edge (the group paying for the union of its
+// lanes' edges), and llvmpipe's loop budget (src/gpu/loop_budget.rs) ran out on sunset.glb at 5^2 shadow rays.
+// Here the lanes cast their rays side by side and a group pays for its busiest lane.
+//
+// Two columns of corners are kept (weights signed by visibility: w > 0 seen, w < 0 blocked, 0 no weight, and the
+// crossings along v), alternating in one array so that no loop copies them.
+float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
+    if (k <= 1u) {
+        vec3 ray;
+        float w = light_sample(L, vec2(0.0), ray);
+        return fraction(w > 0.0 && sample_visible(origin, L, ray) ? w : 0.0, w);
+    }
+    float kf = float(k);
+    uint steps = edge_bisections(k);
+    uint left = max_located_crossings(k);
     float visible = 0.0;
     float total = 0.0;
-    for (uint i = 0u; i < k; ++i) {
-        for (uint j = 0u; j < k; ++j) {
-            vec3 omega;
-            float w = sun_sample(n, l, t, b, radius, disk_grid_point(i, j, k), omega);
-            if (w > 0.0) {
-                total += w;
-                if (visible_along(origin, omega)) {
-                    visible += w;
+    float column_w[2u * (MAX_LOCATED_GRID + 1u)];
+    float column_up[2u * (MAX_LOCATED_GRID + 1u)];
+    // The corner (i, j) and what is being done at it: GRID_CORNER its ray, GRID_ALONG_V / GRID_ALONG_U a bisection
+    // (step of steps, bracket [lo, hi]); w and seen its weight and state; across the crossing along u into it,
+    // across_below the one into the corner below.
+    uint i = 0u;
+    uint j = 0u;
+    uint stage = GRID_CORNER;
+    uint step = 0u;
+    float lo = 0.0;
+    float hi = 1.0;
+    float w = 0.0;
+    bool seen = false;
+    float across = 0.0;
+    float across_below = 0.0;
+    while (i <= k) {
+        uint cur = (i & 1u) * (MAX_LOCATED_GRID + 1u);
+        uint prev = MAX_LOCATED_GRID + 1u - cur;
+        float mid = 0.5 * (lo + hi);
+        vec2 uv = stage == GRID_CORNER ? vec2(float(i), float(j))
+                : stage == GRID_ALONG_V ? vec2(float(i), float(j) - 1.0 + mid)
+                                        : vec2(float(i) - 1.0 + mid, float(j));
+        vec3 ray;
+        float weight = light_sample(L, concentric_disk(uv.x / kf, uv.y / kf), ray);
+        // The iteration's one ray (a corner of no weight casts none).
+        bool ray_seen = (stage != GRID_CORNER || weight > 0.0) && sample_visible(origin, L, ray);
+        // What comes next at this corner: GRID_NEXT_V / GRID_NEXT_U, whether its side along v (to the corner below)
+        // / along u (to the one before) needs a crossing; GRID_NEXT_RAY, a bisection goes on; GRID_NEXT_SQUARE, its
+        // square. A crossing past the grid's allowance is the side's midpoint, without rays.
+        uint next = GRID_NEXT_RAY;
+        if (stage == GRID_CORNER) {
+            w = weight;
+            seen = ray_seen;
+            column_w[cur + j] = seen ? w : -w;
+            across = 0.0;
+            next = GRID_NEXT_V;
+        } else {
+            // The bracket's lo end keeps the first (earlier) corner's state, the opposite of this one's.
+            if (ray_seen != seen) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            step += 1u;
+            if (step == steps) {
+                float edge = 0.5 * (lo + hi);
+                if (stage == GRID_ALONG_V) {
+                    column_up[cur + j - 1u] = edge;
+                    next = GRID_NEXT_U;
+                } else {
+                    across = edge;
+                    next = GRID_NEXT_SQUARE;
                 }
+            }
+        }
+        if (next == GRID_NEXT_V) {
+            next = GRID_NEXT_U;
+            float below = j > 0u ? column_w[cur + j - 1u] : 0.0;
+            if (w > 0.0 && below != 0.0 && seen != (below > 0.0)) {
+                if (left > 0u) {
+                    left -= 1u;
+                    stage = GRID_ALONG_V;
+                    next = GRID_NEXT_RAY;
+                    lo = 0.0;
+                    hi = 1.0;
+                    step = 0u;
+                } else {
+                    column_up[cur + j - 1u] = 0.5;
+                }
+            }
+        }
+        if (next == GRID_NEXT_U) {
+            next = GRID_NEXT_SQUARE;
+            float before = i > 0u ? column_w[prev + j] : 0.0;
+            if (w > 0.0 && before != 0.0 && seen != (before > 0.0)) {
+                if (left > 0u) {
+                    left -= 1u;
+                    stage = GRID_ALONG_U;
+                    next = GRID_NEXT_RAY;
+                    lo = 0.0;
+                    hi = 1.0;
+                    step = 0u;
+                } else {
+                    across = 0.5;
+                }
+            }
+        }
+        bool corner_done = next == GRID_NEXT_SQUARE;
+        if (corner_done) {
+            if (i > 0u && j > 0u) {
+                // The square with corners (i-1, j-1), (i, j-1), (i, j), (i-1, j), counter-clockwise in (u, v).
+                vec4 signed_w = vec4(column_w[prev + j - 1u], column_w[cur + j - 1u], column_w[cur + j], column_w[prev + j]);
+                vec4 ws = abs(signed_w);
+                bvec4 seen4 = greaterThan(signed_w, vec4(0.0));
+                if (all(greaterThan(ws, vec4(0.0)))) {
+                    float mean = 0.25 * (ws.x + ws.y + ws.z + ws.w);
+                    total += mean;
+                    visible += mean * cell_visible_area(seen4, across_below, column_up[cur + j - 1u], across,
+                                                        column_up[prev + j - 1u]);
+                } else {
+                    for (uint c = 0u; c < 4u; ++c) {
+                        if (ws[c] > 0.0) {
+                            total += 0.25 * ws[c];
+                            if (seen4[c]) {
+                                visible += 0.25 * ws[c];
+                            }
+                        }
+                    }
+                }
+            }
+            across_below = across;
+            stage = GRID_CORNER;
+            j += 1u;
+            if (j > k) {
+                j = 0u;
+                i += 1u;
+                across_below = 0.0;
             }
         }
     }
     return fraction(visible, total);
+}
+
+// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]).
+float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
+    vec3 t = orthonormal_to(l);
+    VisibilityLight L = VisibilityLight(GRID_LIGHT_SUN, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
+                                        tan(0.5 * angular_diameter));
+    return grid_fraction(origin, k, L);
 }
 
 // The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
 float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     vec3 a = orthonormal_to(d);
-    vec3 b = cross(d, a);
-    float visible = 0.0;
-    float total = 0.0;
-    for (uint i = 0u; i < k; ++i) {
-        for (uint j = 0u; j < k; ++j) {
-            vec3 y;
-            float w = disk_sample(x, n, center, d, a, b, radius, disk_grid_point(i, j, k), y);
-            if (w > 0.0) {
-                total += w;
-                if (visible_to(origin, y)) {
-                    visible += w;
-                }
-            }
-        }
-    }
-    return fraction(visible, total);
+    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius);
+    return grid_fraction(origin, k, L);
 }
 
-// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n.
+// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: the
+// plain count of the k x k midpoint grid (not located: see sky_visible_fraction in the Rust).
 float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
     vec3 t = orthonormal_to(n);
     vec3 b = cross(n, t);

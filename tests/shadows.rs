@@ -347,7 +347,9 @@ fn the_sun_at_the_horizon_throws_long_shadows() {
 #[test]
 fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
     // Every scene of models/ with its own lights, shadows by ray queries against the f64 reference, to the
-    // tolerance of `render --check`.
+    // tolerance of `render --check`, differences allowed only at fragile rays (the located grids bisect towards
+    // the shadows' edges, so a pixel of a penumbra may cast a ray that f32 and f64 answer otherwise), and those a
+    // handful.
     let mut gpu = common::shadow_ray_renderer();
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     let mut checked = 0;
@@ -363,9 +365,11 @@ fn gpu_ray_queries_agree_with_the_reference_on_every_model() {
         .unwrap();
         s.shading.shadows = Shadows::Ray;
         let g = gpu.render(&scene, &s);
-        let c = cpu::render(&scene, &s, &gpu.reference_options());
+        let (c, fragile) = cpu::render_with_fragile_pixels(&scene, &s, &gpu.reference_options());
+        let (over, flagged) = over_tolerance_and_fragile(&g, &c, &fragile);
         let (report, _) = compare::diff(&g, &c, &DiffOptions::default()).unwrap();
-        assert!(report.pass, "{name}: {}", report.text("gpu", "reference"));
+        assert_eq!(over, flagged, "{name}: {}", report.text("gpu", "reference"));
+        assert!(over <= 8, "{name}: {over} fragile pixels over the tolerance");
         checked += 1;
     }
     assert_eq!(checked, 7);
@@ -526,7 +530,10 @@ fn gpu_ray_query_differences_lie_at_fragile_rays() {
     let camera = camera_down(DVec3::ZERO, 1.2, 6.0);
     let mut lights = sun_lights(DVec3::new(0.4, 1.0, 0.2), 2.0);
     lights.sky = Some([100.0; 3]);
-    let s = settings(160, 160, camera, lights, Shadows::Ray, 6);
+    // 4² shadow rays: the sun's located grid casts up to (4 + 1)² + 2·4·2 = 41 rays a pixel through the soup's
+    // edges, and at 6² (85 a pixel) and 5² (66) thousands of pixels ran past llvmpipe's loop budget on the
+    // shader's BVH walk (Mesa 22.3; the plain count of 6², 36 rays, had fitted).
+    let s = settings(160, 160, camera, lights, Shadows::Ray, 4);
     let g = gpu.render(&sc, &s);
     let (c, fragile) = cpu::render_with_fragile_pixels(&sc, &s, &gpu.reference_options());
     let (over, flagged) = over_tolerance_and_fragile(&g, &c, &fragile);

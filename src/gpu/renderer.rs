@@ -442,6 +442,15 @@ impl Renderer {
                 self.dev.info.name
             )));
         }
+        let k = settings.shading.shadow_samples_per_axis;
+        if choice.technique == Shadows::Ray && k > crate::shading::visibility::MAX_LOCATED_GRID {
+            return Err(GpuError::Unsupported(format!(
+                "{k}² shadow rays a light: the GPU's visible-fraction grid keeps a column of corners, at most {}² \
+                 (--shadow-samples {})",
+                crate::shading::visibility::MAX_LOCATED_GRID,
+                crate::shading::visibility::MAX_LOCATED_GRID * crate::shading::visibility::MAX_LOCATED_GRID
+            )));
+        }
         if choice.technique == Shadows::Ray && self.pipeline.rays_walk_bvh() {
             choice.reason += " (the device has no ray queries: the fragment shader walks the occluders' BVH)";
         }
