@@ -35,15 +35,17 @@
 //! what `tests/accuracy.rs` measures against the converged reference on every scene of models/ and the BRDF chart
 //! under disk lights and the sky.
 //!
-//! **Penumbrae.** A shadow-ray grid's visible fraction has a jump where an occluder's edge crosses the light, so
-//! a penumbra pixel converges at first order or slower, erratically: the share of the cells the edge cuts shrinks
-//! as `1/k`, their errors partly cancel (`k^−1.5` for an edge at a random angle), and a rung can agree with the
-//! next by chance. The max over the image's pixels is steadier than any one pixel (many pixels, many edge
-//! positions), and its observed order on the models' penumbrae reads 0.8 to 2 (docs/accuracy.md,
-//! "Penumbrae"). The order used is at most 1 there ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case: 2.4
-//! times the estimate of an order-2 reading on rungs √2 apart), and an order under [`MIN_ORDER`] sends the ladder
-//! on. Still an estimate: `tests/shadows.rs` checks it against the exact circular segment of a straight edge's
-//! penumbra, `tests/accuracy.rs` against a 181² render of sunset.glb on the GPU.
+//! **Penumbrae.** Where an occluder's edge crosses a light, a count of rays jumps: the sky's visible fraction
+//! (a count of the grid's midpoints) and the lobe grids' samples, which cast a ray each, converge at first order
+//! or slower, erratically: the share of the cells the edge cuts shrinks as `1/k`, their errors partly cancel
+//! (`k^−1.5` for an edge at a random angle), and a rung can agree with the next by chance. The sun's and disk
+//! lights' visible fractions locate the edges (`shading::visibility::grid_fraction`) and converge at second order,
+//! but a study cannot tell which part of a pixel's error comes from which. The max over the image's pixels is
+//! steadier than any one pixel (many pixels, many edge positions). The order used is at most 1 there
+//! ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case: 2.4 times the estimate of an order-2 reading on rungs √2
+//! apart), and an order under [`MIN_ORDER`] sends the ladder on. Still an estimate: `tests/shadows.rs` checks it
+//! against the exact circular segment of a straight edge's penumbra, `tests/accuracy.rs` against a 181² render of
+//! sunset.glb on the GPU.
 
 use crate::compare::{image_peak, pixel_difference, DiffOptions};
 use crate::film::Image;
@@ -57,7 +59,7 @@ pub const MIN_ORDER: f64 = 0.5;
 /// The highest order used: the midpoint rule's on a smooth integrand.
 pub const MAX_ORDER: f64 = 2.0;
 /// The highest order used where the shadow rays' grids are refined: a jump's (an occluder's edge across a
-/// light), whose midpoint grid errs by `O(1/k)` at worst (module text, "Penumbrae").
+/// light), whose count of rays errs by `O(1/k)` at worst (module text, "Penumbrae").
 pub const MAX_ORDER_WITH_PENUMBRAE: f64 = 1.0;
 /// Roache's factor of safety for a study of three grids.
 pub const SAFETY_FACTOR: f64 = 1.25;
