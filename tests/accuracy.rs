@@ -72,6 +72,10 @@ fn the_final_check_reports_grids_that_agree_by_chance() {
     let scene = common::load(std::path::Path::new("models/overcast.glb"));
     let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
     s.shading.shadows = Shadows::Ray;
+    // The case as found: the ladder from 8² (8, 12, 17, 25, 36, 51, 73, 104). From today's default 6² (6, 9, 13,
+    // 19, 27, 39, 56, 80) another pixel agrees by chance and is kept 2.7e-3 from the 256² render: the check
+    // narrows the chance, it cannot close it (docs/accuracy.md, "The converged reference").
+    s.shading.shadow_samples_per_axis = 8;
     let reference = ReferenceOptions::default();
     let accuracy = 1e-3;
     let c = render_converged(&scene, &s, &reference, &ConvergenceOptions { accuracy, max_refinements: 7 });

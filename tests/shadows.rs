@@ -856,5 +856,7 @@ fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
         }
     }
     eprintln!("{report}");
-    assert!(kept >= 2, "{report}");
+    // The sun's located edges (second order) keep 13 of the 18 cases (measured 2026-12-03); the count of points
+    // before them kept 5, refusing the widest penumbra even at 1e-2.
+    assert!(kept >= 10, "{kept} kept:\n{report}");
 }
