@@ -166,6 +166,12 @@ uint max_located_crossings(uint k) {
     return 2u * k;
 }
 
+// Whether the side from a neighbouring corner (its weight signed by its state: > 0 seen, < 0 blocked, 0 none) to a
+// corner of weight w and state seen needs its crossing: both have weight and they disagree.
+bool disagrees(float w, bool seen, float neighbour) {
+    return w > 0.0 && neighbour != 0.0 && seen != (neighbour > 0.0);
+}
+
 // Where a visibility edge crosses the segment from the grid point `from` to `from + along` (grid units; the unit
 // square is k wide), by `steps` bisections: its parameter in (0, 1) from the first point, whose state is first_seen.
 float locate_edge(vec3 origin, VisibilityLight L, uint steps, bool first_seen, vec2 from, vec2 along, float kf) {
@@ -299,37 +305,36 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
                 }
             }
         }
+        // A side that needs its crossing starts a bisection while the grid's allowance lasts.
+        bool start = false;
         if (next == GRID_NEXT_V) {
             next = GRID_NEXT_U;
-            float below = j > 0u ? column_w[cur + j - 1u] : 0.0;
-            if (w > 0.0 && below != 0.0 && seen != (below > 0.0)) {
+            if (disagrees(w, seen, j > 0u ? column_w[cur + j - 1u] : 0.0)) {
                 if (left > 0u) {
-                    left -= 1u;
                     stage = GRID_ALONG_V;
-                    next = GRID_NEXT_RAY;
-                    lo = 0.0;
-                    hi = 1.0;
-                    step = 0u;
+                    start = true;
                 } else {
                     column_up[cur + j - 1u] = 0.5;
                 }
             }
         }
-        if (next == GRID_NEXT_U) {
+        if (next == GRID_NEXT_U && !start) {
             next = GRID_NEXT_SQUARE;
-            float before = i > 0u ? column_w[prev + j] : 0.0;
-            if (w > 0.0 && before != 0.0 && seen != (before > 0.0)) {
+            if (disagrees(w, seen, i > 0u ? column_w[prev + j] : 0.0)) {
                 if (left > 0u) {
-                    left -= 1u;
                     stage = GRID_ALONG_U;
-                    next = GRID_NEXT_RAY;
-                    lo = 0.0;
-                    hi = 1.0;
-                    step = 0u;
+                    start = true;
                 } else {
                     across = 0.5;
                 }
             }
+        }
+        if (start) {
+            left -= 1u;
+            next = GRID_NEXT_RAY;
+            lo = 0.0;
+            hi = 1.0;
+            step = 0u;
         }
         bool corner_done = next == GRID_NEXT_SQUARE;
         if (corner_done) {

@@ -299,6 +299,12 @@ pub fn max_located_crossings(k: u32) -> u32 {
     2 * k
 }
 
+/// Whether the side between two neighbouring corners needs its crossing: both have weight and they disagree.
+/// (The shader passes the neighbour's weight signed by its state.)
+fn disagrees(w: f64, seen: bool, neighbour_w: f64, neighbour_seen: bool) -> bool {
+    w > 0.0 && neighbour_w > 0.0 && seen != neighbour_seen
+}
+
 /// Where a visibility edge crosses the segment from one grid sample to its neighbour, found by `steps` bisections:
 /// its parameter in (0, 1) from the first sample. `visible_at(t)` casts the ray of the segment's point `t`;
 /// `first_seen` is the first sample's state.
@@ -402,11 +408,11 @@ fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
             let seen = w > 0.0 && sample_visible(s, ray);
             cur_w[j] = w;
             cur_seen[j] = seen;
-            if j > 0 && w > 0.0 && cur_w[j - 1] > 0.0 && seen != cur_seen[j - 1] {
+            if j > 0 && disagrees(w, seen, cur_w[j - 1], cur_seen[j - 1]) {
                 cur_up[j - 1] = locate(cur_seen[j - 1], &|t| ray_at(u, v - 1.0 + t));
             }
             let mut across = 0.0;
-            if i > 0 && w > 0.0 && prev_w[j] > 0.0 && seen != prev_seen[j] {
+            if i > 0 && disagrees(w, seen, prev_w[j], prev_seen[j]) {
                 across = locate(prev_seen[j], &|t| ray_at(u - 1.0 + t, v));
             }
             if i > 0 && j > 0 {
