@@ -268,6 +268,8 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     while (i <= k) {
         uint cur = (i & 1u) * (MAX_LOCATED_GRID + 1u);
         uint prev = MAX_LOCATED_GRID + 1u - cur;
+        // Exact in f32: the bracket's ends are dyadic with at most edge_bisections(256) + 1 = 9 bits, added to a
+        // grid index of at most 256, so uv is the Rust's point to the bit before the map divides by k.
         float mid = 0.5 * (lo + hi);
         vec2 uv = stage == GRID_CORNER ? vec2(float(i), float(j))
                 : stage == GRID_ALONG_V ? vec2(float(i), float(j) - 1.0 + mid)
