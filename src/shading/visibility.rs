@@ -299,6 +299,15 @@ pub fn max_located_crossings(k: u32) -> u32 {
     2 * k
 }
 
+/// A corner of a located grid: its weight, whether its ray got through, and the crossing along v to the corner
+/// above it (its parameter from this corner; read only where the two disagree).
+#[derive(Clone, Copy, Default)]
+struct Corner {
+    w: f64,
+    seen: bool,
+    up: f64,
+}
+
 /// Whether the side between two neighbouring corners needs its crossing: both have weight and they disagree.
 /// (The shader passes the neighbour's weight signed by its state.)
 fn disagrees(w: f64, seen: bool, neighbour_w: f64, neighbour_seen: bool) -> bool {
@@ -394,10 +403,8 @@ fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
         locate_edge(steps, first_seen, at)
     };
     let (mut visible, mut total) = (0.0, 0.0);
-    // The previous column of corners' weights, states and crossings along v (from corner j to j + 1), and this
-    // column's.
-    let (mut prev_w, mut prev_seen, mut prev_up) = (vec![0.0; k + 1], vec![false; k + 1], vec![0.0; k + 1]);
-    let (mut cur_w, mut cur_seen, mut cur_up) = (vec![0.0; k + 1], vec![false; k + 1], vec![0.0; k + 1]);
+    // The previous column of corners and this one's.
+    let (mut prev, mut cur) = (vec![Corner::default(); k + 1], vec![Corner::default(); k + 1]);
     for i in 0..=k {
         let u = i as f64;
         // The crossing along u from the previous column's corner j − 1 to this column's.
@@ -406,39 +413,34 @@ fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
             let v = j as f64;
             let (w, ray) = light.light_sample(concentric_disk(u / kf, v / kf));
             let seen = w > 0.0 && sample_visible(s, ray);
-            cur_w[j] = w;
-            cur_seen[j] = seen;
-            if j > 0 && disagrees(w, seen, cur_w[j - 1], cur_seen[j - 1]) {
-                cur_up[j - 1] = locate(cur_seen[j - 1], &|t| ray_at(u, v - 1.0 + t));
+            cur[j] = Corner { w, seen, up: 0.0 };
+            if j > 0 && disagrees(w, seen, cur[j - 1].w, cur[j - 1].seen) {
+                cur[j - 1].up = locate(cur[j - 1].seen, &|t| ray_at(u, v - 1.0 + t));
             }
             let mut across = 0.0;
-            if i > 0 && disagrees(w, seen, prev_w[j], prev_seen[j]) {
-                across = locate(prev_seen[j], &|t| ray_at(u - 1.0 + t, v));
+            if i > 0 && disagrees(w, seen, prev[j].w, prev[j].seen) {
+                across = locate(prev[j].seen, &|t| ray_at(u - 1.0 + t, v));
             }
             if i > 0 && j > 0 {
                 // The square with corners (i − 1, j − 1), (i, j − 1), (i, j), (i − 1, j), counter-clockwise in (u, v).
-                let ws = [prev_w[j - 1], cur_w[j - 1], w, prev_w[j]];
-                let seen4 = [prev_seen[j - 1], cur_seen[j - 1], seen, prev_seen[j]];
-                if ws.iter().all(|&x| x > 0.0) {
-                    let mean = 0.25 * (ws[0] + ws[1] + ws[2] + ws[3]);
+                let corners = [prev[j - 1], cur[j - 1], cur[j], prev[j]];
+                if corners.iter().all(|c| c.w > 0.0) {
+                    let mean = 0.25 * (corners[0].w + corners[1].w + corners[2].w + corners[3].w);
                     total += mean;
-                    visible += mean * cell_visible_area(seen4, across_below, cur_up[j - 1], across, prev_up[j - 1]);
+                    let seen4 = corners.map(|c| c.seen);
+                    visible += mean * cell_visible_area(seen4, across_below, cur[j - 1].up, across, prev[j - 1].up);
                 } else {
-                    for (wc, sc) in ws.into_iter().zip(seen4) {
-                        if wc > 0.0 {
-                            total += 0.25 * wc;
-                            if sc {
-                                visible += 0.25 * wc;
-                            }
+                    for c in corners.iter().filter(|c| c.w > 0.0) {
+                        total += 0.25 * c.w;
+                        if c.seen {
+                            visible += 0.25 * c.w;
                         }
                     }
                 }
             }
             across_below = across;
         }
-        std::mem::swap(&mut prev_w, &mut cur_w);
-        std::mem::swap(&mut prev_seen, &mut cur_seen);
-        std::mem::swap(&mut prev_up, &mut cur_up);
+        std::mem::swap(&mut prev, &mut cur);
     }
     fraction(visible, total)
 }
