@@ -143,8 +143,10 @@ struct VisibilityLight {
     float radius;
 };
 
-// The weight and shadow ray (a direction, or a point on a disk light) of the point xy of the unit disk.
-float light_sample(VisibilityLight L, vec2 xy, out vec3 ray) {
+// The weight and shadow ray (a direction, or a point on a disk light) of the point uv of the unit square, mapped
+// to the light's disk by the concentric map.
+float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
+    vec2 xy = concentric_disk(uv.x, uv.y);
     if (L.kind == GRID_LIGHT_SUN) {
         return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
     }
@@ -181,7 +183,7 @@ float locate_edge(vec3 origin, VisibilityLight L, uint steps, bool first_seen, v
         float mid = 0.5 * (lo + hi);
         vec2 uv = from + mid * along;
         vec3 ray;
-        light_sample(L, concentric_disk(uv.x / kf, uv.y / kf), ray);
+        light_sample(L, uv / kf, ray);
         if (sample_visible(origin, L, ray) == first_seen) {
             lo = mid;
         } else {
@@ -225,7 +227,7 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
     return 0.5 * twice;
 }
 
-// sum(w V) / sum(w) over the unit square mapped to the light by the concentric map: k = 1, the light's centre
+// sum(w V) / sum(w) over the unit square mapped to the light (light_sample): k = 1, the light's centre
 // alone; otherwise the (k + 1)^2 corners of a k x k grid of squares, each square its corners' mean weight times
 // its visible share, the edges between disagreeing corners located by bisection (grid_fraction in the Rust, the
 // same rays and the same sums in the same order).
@@ -242,7 +244,7 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
 float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     if (k <= 1u) {
         vec3 ray;
-        float w = light_sample(L, vec2(0.0), ray);
+        float w = light_sample(L, vec2(0.5), ray);
         return fraction(w > 0.0 && sample_visible(origin, L, ray) ? w : 0.0, w);
     }
     float kf = float(k);
@@ -275,7 +277,7 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
                 : stage == GRID_ALONG_V ? vec2(float(i), float(j) - 1.0 + mid)
                                         : vec2(float(i) - 1.0 + mid, float(j));
         vec3 ray;
-        float weight = light_sample(L, concentric_disk(uv.x / kf, uv.y / kf), ray);
+        float weight = light_sample(L, vec2(uv.x / kf, uv.y / kf), ray);
         // The iteration's one ray (a corner of no weight casts none).
         bool ray_seen = (stage != GRID_CORNER || weight > 0.0) && sample_visible(origin, L, ray);
         // What comes next at this corner: GRID_NEXT_V / GRID_NEXT_U, whether its side along v (to the corner below)

@@ -262,15 +262,16 @@ enum GridLight {
 }
 
 impl GridLight {
-    /// The weight and shadow ray of the point `(x, y)` of the unit disk.
-    fn light_sample(&self, (x, y): (f64, f64)) -> (f64, SampleRay) {
+    /// The weight and shadow ray of the point `(u, v)` of the unit square, mapped to the light's disk by
+    /// [`concentric_disk`].
+    fn light_sample(&self, (u, v): (f64, f64)) -> (f64, SampleRay) {
         match *self {
             GridLight::Sun { n, l, t, b, radius } => {
-                let (omega, w) = sun_sample(n, l, t, b, radius, (x, y));
+                let (omega, w) = sun_sample(n, l, t, b, radius, concentric_disk(u, v));
                 (w, SampleRay::Along(omega))
             }
             GridLight::Disk { x: at, n, center, d, a, b, radius } => {
-                let (target, w) = disk_sample(at, n, center, d, a, b, radius, (x, y));
+                let (target, w) = disk_sample(at, n, center, d, a, b, radius, concentric_disk(u, v));
                 (w, SampleRay::To(target))
             }
         }
@@ -366,7 +367,7 @@ pub fn cell_visible_area(seen: [bool; 4], bottom: f64, right: f64, top: f64, lef
     0.5 * twice
 }
 
-/// `∫ w V / ∫ w` over the unit square mapped to the light by [`concentric_disk`] (equal-area) ([`fraction`]):
+/// `∫ w V / ∫ w` over the unit square mapped to the light ([`GridLight::light_sample`]) ([`fraction`]):
 /// `w` a direction's weight, `V` its ray's visibility. `k = 1`: the ray through the light's centre alone, a hard
 /// shadow. Otherwise the `(k + 1)²` corners of a `k × k` grid of squares cast their rays (none where the weight is
 /// not positive), and each square adds the mean of its corners' weights times its visible share.
@@ -387,12 +388,12 @@ pub fn cell_visible_area(seen: [bool; 4], bottom: f64, right: f64, top: f64, lef
 fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
     let k = s.samples_per_axis as usize;
     if k <= 1 {
-        let (w, ray) = light.light_sample((0.0, 0.0));
+        let (w, ray) = light.light_sample((0.5, 0.5));
         return fraction(if w > 0.0 && sample_visible(s, ray) { w } else { 0.0 }, w);
     }
     let kf = k as f64;
     let steps = edge_bisections(s.samples_per_axis);
-    let ray_at = |u: f64, v: f64| sample_visible(s, light.light_sample(concentric_disk(u / kf, v / kf)).1);
+    let ray_at = |u: f64, v: f64| sample_visible(s, light.light_sample((u / kf, v / kf)).1);
     // Crossings left to locate; past them a crossing is the side's midpoint.
     let mut left = max_located_crossings(s.samples_per_axis);
     let mut locate = |first_seen: bool, at: &dyn Fn(f64) -> bool| {
@@ -411,7 +412,7 @@ fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
         let mut across_below = 0.0;
         for j in 0..=k {
             let v = j as f64;
-            let (w, ray) = light.light_sample(concentric_disk(u / kf, v / kf));
+            let (w, ray) = light.light_sample((u / kf, v / kf));
             let seen = w > 0.0 && sample_visible(s, ray);
             cur[j] = Corner { w, seen, up: 0.0 };
             if j > 0 && disagrees(w, seen, cur[j - 1].w, cur[j - 1].seen) {
