@@ -1,5 +1,6 @@
-// Visibility of the lights. Mirrors src/shading/visibility.rs name for name: the same sample grids (Shirley &
-// Chiu's concentric map of a k x k midpoint grid), the same weights, ray origins (Hanika's terminator offset, then
+// Visibility of the lights. Mirrors src/shading/visibility.rs name for name: the same sample grids (the corners of
+// k x k squares, mapped to the sun's and disk lights' disks by Shirley & Chiu's concentric map, to the sky's lune
+// by its angles), the same weights, ray origins (Hanika's terminator offset, then
 // the push along the face normal) and ray extents, so that the GPU's ray queries and the reference's f64 rays
 // differ only at rays that graze an occluder's edge. See the Rust for the derivations.
 #ifndef SUNSHADE_VISIBILITY_GLSL
@@ -119,6 +120,7 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
 // What a visible-fraction grid samples (VisibilityLight.kind).
 #define GRID_LIGHT_SUN 0u
 #define GRID_LIGHT_DISK 1u
+#define GRID_LIGHT_SKY 2u
 // grid_fraction's stages at a corner: its own ray, the bisection along v to the corner below, along u to the one
 // before.
 #define GRID_CORNER 0u
@@ -131,7 +133,8 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
 
 // A located grid's light and the receiving point's frame (GridLight in the Rust). Sun: normal n, direction c,
 // frame (a, b) about it, radius tan(sigma). Disk light: seen from x with normal n; centre c [m], emission
-// direction d, frame (a, b), radius [m].
+// direction d, frame (a, b), radius [m]. Sky (SkyLune in the Rust): the lune's axis a, the horizontal b towards
+// which the normal leans, radius the lune's width pi - tilt [rad], tilt the surface's tilt from up [rad].
 struct VisibilityLight {
     uint kind;
     vec3 x;
@@ -141,11 +144,37 @@ struct VisibilityLight {
     vec3 a;
     vec3 b;
     float radius;
+    float tilt;
 };
 
-// The weight and shadow ray (a direction, or a point on a disk light) of the point uv of the unit square, mapped
-// to the light's disk by the concentric map.
+// The sky's lune above a surface of unit normal n (sky_lune in the Rust): the tilt as atan2(|n - n_y y|, n_y),
+// a floor's lune the whole hemisphere about a = x cross y.
+VisibilityLight sky_lune(vec3 n) {
+    vec3 across = vec3(n.x, 0.0, n.z);
+    float len = length(across);
+    vec3 e = len > 0.0 ? across / len : vec3(1.0, 0.0, 0.0);
+    float tilt = atan2_accurate(len, n.y);
+    return VisibilityLight(GRID_LIGHT_SKY, vec3(0.0), n, vec3(0.0), vec3(0.0), cross(e, vec3(0.0, 1.0, 0.0)), e,
+                           PI - tilt, tilt);
+}
+
+// The sky's sample at the point uv of the unit square: the direction omega(beta = pi v, psi = width u) of its lune
+// and the weight sin^2(beta) sin(psi + tilt), the sines taken of the smaller of their two equal-sine arguments so
+// that they are exactly 0 on the surface's horizon and at the lune's ends (sky_sample in the Rust).
+float sky_sample(vec3 a, vec3 e, float tilt, float width, vec2 uv, out vec3 omega) {
+    float sin_b = sin(PI * min(uv.y, 1.0 - uv.y));
+    float cos_b = cos(PI * uv.y);
+    float psi = width * uv.x;
+    omega = cos_b * a + sin_b * (cos(psi) * e + sin(psi) * vec3(0.0, 1.0, 0.0));
+    return sin_b * sin_b * sin(min(psi + tilt, width * (1.0 - uv.x)));
+}
+
+// The weight and shadow ray (a direction, or a point on a disk light) of the point uv of the unit square: the
+// sun's and disk lights' through the concentric map, the sky's through its lune.
 float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
+    if (L.kind == GRID_LIGHT_SKY) {
+        return sky_sample(L.a, L.b, L.tilt, L.radius, uv, ray);
+    }
     vec2 xy = concentric_disk(uv.x, uv.y);
     if (L.kind == GRID_LIGHT_SUN) {
         return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
@@ -380,38 +409,21 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
 float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
     vec3 t = orthonormal_to(l);
     VisibilityLight L = VisibilityLight(GRID_LIGHT_SUN, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
-                                        tan(0.5 * angular_diameter));
+                                        tan(0.5 * angular_diameter), 0.0);
     return grid_fraction(origin, k, L);
 }
 
 // The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
 float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     vec3 a = orthonormal_to(d);
-    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius);
+    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius, 0.0);
     return grid_fraction(origin, k, L);
 }
 
 // The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: the
-// plain count of the k x k midpoint grid (not located: see sky_visible_fraction in the Rust).
+// located grid over the sky's lune (sky_visible_fraction in the Rust).
 float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
-    vec3 t = orthonormal_to(n);
-    vec3 b = cross(n, t);
-    float visible = 0.0;
-    float total = 0.0;
-    for (uint i = 0u; i < k; ++i) {
-        for (uint j = 0u; j < k; ++j) {
-            vec2 xy = disk_grid_point(i, j, k);
-            float z = sqrt(max(1.0 - xy.x * xy.x - xy.y * xy.y, 0.0));
-            vec3 omega = xy.x * t + xy.y * b + z * n;
-            if (omega.y > 0.0) {
-                total += 1.0;
-                if (visible_along(origin, omega)) {
-                    visible += 1.0;
-                }
-            }
-        }
-    }
-    return fraction(visible, total);
+    return grid_fraction(origin, k, sky_lune(n));
 }
 
 // The push along the face normal: 2^-16 max |p_i|_inf.

@@ -35,12 +35,13 @@
 //! what `tests/accuracy.rs` measures against the converged reference on every scene of models/ and the BRDF chart
 //! under disk lights and the sky.
 //!
-//! **Penumbrae.** Where an occluder's edge crosses a light, a count of rays jumps: the sky's visible fraction
-//! (a count of the grid's midpoints) and the lobe grids' samples, which cast a ray each, converge at first order
-//! or slower, erratically: the share of the cells the edge cuts shrinks as `1/k`, their errors partly cancel
-//! (`k^−1.5` for an edge at a random angle), and a rung can agree with the next by chance. The sun's and disk
-//! lights' visible fractions locate the edges (`shading::visibility::grid_fraction`) and converge at second order,
-//! but a study cannot tell which part of a pixel's error comes from which. The max over the image's pixels is
+//! **Penumbrae.** Where an occluder's edge crosses a light, a count of rays jumps: the lobe grids' samples, which
+//! cast a ray each, converge at first order or slower, erratically: the share of the cells the edge cuts shrinks
+//! as `1/k`, their errors partly cancel (`k^−1.5` for an edge at a random angle), and a rung can agree with the
+//! next by chance. The sun's, disk lights' and the sky's visible fractions locate the edges
+//! (`shading::visibility::grid_fraction`) and converge at second order once the grid resolves the occluders (an
+//! occluder thinner than the spacing is missed, then found: a jump), but a study cannot tell which part of a
+//! pixel's error comes from which. The max over the image's pixels is
 //! steadier than any one pixel (many pixels, many edge positions). The order used is at most 1 there
 //! ([`MAX_ORDER_WITH_PENUMBRAE`], the jump's worst case: 2.4 times the estimate of an order-2 reading on rungs √2
 //! apart), and an order under [`MIN_ORDER`] sends the ladder on. Still an estimate: `tests/shadows.rs` checks it

@@ -270,8 +270,8 @@ pub struct SceneArgs {
 
     /// With --tolerance: hold it in penumbrae too. The shadow rays' grids (overriding --shadow-samples) go on the
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
-    /// refinement, its order taken as at most 1 (the sky's count of rays and the lobe samples' rays converge at
-    /// first order through a penumbra, the sun's and disk lights' located edges at second). Light of disk lights
+    /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
+    /// penumbra, the lights' located edges at second). Light of disk lights
     /// and the sky through occluders is then estimated instead of refused. Costly, and refused where the ladder
     /// cannot reach T: in the dark end of a penumbra the visible fraction must be right to T/100 of the peak (the
     /// diff's floor).
@@ -299,9 +299,9 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub accumulation: AccumulationArgs,
 
-    /// The visible fractions' grid over each light, k² = N rounded up to a square: the sun and disk lights cast
-    /// rays at its (k + 1)² corners and locate their shadows' edges by bisection, the sky at its k² midpoints
-    /// (1: the light's centre alone, a hard shadow).
+    /// The visible fractions' grid over each light, k² = N rounded up to a square: the sun, disk lights and the
+    /// sky cast rays at its (k + 1)² corners (the sky's over its lune above both horizons) and locate their
+    /// shadows' edges by bisection (1: the light's centre alone, a hard shadow).
     #[arg(help_heading = "Shadows", long, default_value_t = DEFAULT_SHADOW_SAMPLES_PER_AXIS * DEFAULT_SHADOW_SAMPLES_PER_AXIS, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub shadow_samples: u32,
 
