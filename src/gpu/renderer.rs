@@ -24,6 +24,7 @@ use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{surface_flags, SURFACE_ALPHA_MASK};
+use crate::shading::visibility::MAX_LOCATED_GRID;
 use crate::shading::Shadows;
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
@@ -443,12 +444,11 @@ impl Renderer {
             )));
         }
         let k = settings.shading.shadow_samples_per_axis;
-        if choice.technique == Shadows::Ray && k > crate::shading::visibility::MAX_LOCATED_GRID {
+        if choice.technique == Shadows::Ray && k > MAX_LOCATED_GRID {
             return Err(GpuError::Unsupported(format!(
-                "{k}² shadow rays a light: the GPU's visible-fraction grid keeps a column of corners, at most {}² \
-                 (--shadow-samples {})",
-                crate::shading::visibility::MAX_LOCATED_GRID,
-                crate::shading::visibility::MAX_LOCATED_GRID * crate::shading::visibility::MAX_LOCATED_GRID
+                "{k}² shadow rays a light: the GPU's visible-fraction grid keeps a column of corners, at most \
+                 {MAX_LOCATED_GRID}² (--shadow-samples {})",
+                MAX_LOCATED_GRID * MAX_LOCATED_GRID
             )));
         }
         if choice.technique == Shadows::Ray && self.pipeline.rays_walk_bvh() {

@@ -553,9 +553,11 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 /// the sky's lune ([`SkyLune`], [`sky_sample`]).
 ///
 /// The grid covers the lune and nothing else, so neither horizon is an edge inside it: the ground's is the grid's
-/// side `u = 0`, the surface's the side `u = 1` (weight 0, no rays). An earlier attempt located edges on the
-/// cosine-weighted disk of the whole hemisphere (Malley's method), where the ground's horizon is a curve near the
-/// rim: crossings on both it and the occluders ran past the grid's allowance, and its rim's rays graze the surface.
+/// side `u = 0`, the surface's the side `u = 1` (weight 0, no rays). Located on the cosine-weighted disk of the
+/// whole hemisphere instead (Malley's method, the count's grid before), the edges converged at first order on the
+/// roofs of the tests (5.1e-2, 2.7e-2, 1.3e-2 at 8², 16², 32² over a floor): the rim's rays graze the surface (a
+/// floor's rim is its horizon, and rounding decides what its rays meet), and for a tilted surface the ground's
+/// horizon is a curve inside the grid, near its rim, whose crossings use up the grid's allowance.
 /// The squares at the lune's ends and along the surface's horizon have corners of weight 0 and count their corners
 /// (first order), but their weight is itself of the order of the spacing there (`sin²β`, `sin(width − ψ)`), so
 /// their error is second order with the rest. The rays along the ground's horizon (`u = 0`) are horizontal: they
