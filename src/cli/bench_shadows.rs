@@ -134,11 +134,11 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             refinement.max,
             refinement.mean
         );
-        out += "| technique | rays (or filter samples) per light and pixel | GPU frame [ms] | CPU reference [ms] | max error | mean error | px > 1e-2 | px > 1e-3 | GPU vs CPU rays, px over tolerance |\n";
+        out += "| technique | grid k² per light (rays at its (k + 1)² corners, more in penumbrae; a map: its filter's taps) | GPU frame [ms] | CPU reference [ms] | max error | mean error | px > 1e-2 | px > 1e-3 | GPU vs CPU rays, px over tolerance |\n";
         out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         let gpu_scene = renderer.upload(&scene)?;
-        // (technique, samples per axis, map size, filter): none; rays at 1 to 256 per light; the sun's map at 512²
-        // to 4096² with the default 8² samples for its PCSS filter, and at 2048² with the nearest texel alone.
+        // (technique, samples per axis, map size, filter): none; ray grids of 1² to 16² per light; the sun's map at
+        // 512² to 4096² with the default grid for its PCSS filter, and at 2048² with the nearest texel alone.
         let mut rows: Vec<(Shadows, u32, u32, ShadowMapFilter)> = vec![(Shadows::None, 1, 0, ShadowMapFilter::Pcss)];
         rows.extend([1u32, 2, 4, 8, 16].map(|k| (Shadows::Ray, k, 0, ShadowMapFilter::Pcss)));
         rows.extend(
