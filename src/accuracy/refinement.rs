@@ -60,7 +60,7 @@ pub const MIN_ORDER: f64 = 0.5;
 /// The highest order used: the midpoint rule's on a smooth integrand.
 pub const MAX_ORDER: f64 = 2.0;
 /// The highest order used where the shadow rays' grids are refined: a jump's (an occluder's edge across a
-/// light), whose count of rays errs by `O(1/k)` at worst (module text, "Penumbrae").
+/// light), whose count of rays (the lobe samples') errs by `O(1/k)` at worst (module text, "Penumbrae").
 pub const MAX_ORDER_WITH_PENUMBRAE: f64 = 1.0;
 /// Roache's factor of safety for a study of three grids.
 pub const SAFETY_FACTOR: f64 = 1.25;
