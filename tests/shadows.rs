@@ -901,10 +901,7 @@ fn gpu_ray_queries_keep_the_sky_through_occluders_under_tolerance() {
     .unwrap();
     s.shading.shadows = Shadows::Ray;
     s.shading.shadow_samples_per_axis = 128;
-    let fine = cpu::render(&scene, &s, &ReferenceOptions::default());
-    let image = sunshade::film::read_image(&out).unwrap();
-    let measured = sunshade::accuracy::error::image_error(&image, &fine, None).unwrap().max_rel;
-    let line = e.lines().find(|l| l.contains("predicted max relative error")).unwrap_or_default();
+    let (measured, line) = common::error_against_fine(&out, &scene, &s, &e);
     eprintln!("overcast.glb on the GPU, T = 1e-2 in penumbrae: measured {measured:.2e} against 128²; {line}");
     assert!(measured <= 1e-2, "{measured:.3e} over 1e-2\n{e}");
 }

@@ -126,3 +126,20 @@ pub fn error_against_converged(
     let e = sunshade::accuracy::error::image_error(image, &truth.image, Some(&truth.unconverged_mask())).unwrap();
     (e.max_rel, truth.unconverged.len())
 }
+
+/// How far the image `--tolerance` wrote to `out` is from the reference of `scene` with `settings` (a fixed fine
+/// grid, chosen by the test): its max relative error (the diff's floor), and the `predicted max relative error`
+/// line of the render's `stderr`, for the test's report.
+#[allow(dead_code)]
+pub fn error_against_fine(
+    out: &Path,
+    scene: &Scene,
+    settings: &sunshade::settings::RenderSettings,
+    stderr: &str,
+) -> (f64, String) {
+    let fine = sunshade::cpu::render(scene, settings, &sunshade::cpu::ReferenceOptions::default());
+    let image = sunshade::film::read_image(out).unwrap();
+    let measured = sunshade::accuracy::error::image_error(&image, &fine, None).unwrap().max_rel;
+    let line = stderr.lines().find(|l| l.contains("predicted max relative error")).unwrap_or_default();
+    (measured, line.to_string())
+}
