@@ -203,25 +203,6 @@ bool disagrees(float w, bool seen, float neighbour) {
     return w > 0.0 && neighbour != 0.0 && seen != (neighbour > 0.0);
 }
 
-// Where a visibility edge crosses the segment from the grid point `from` to `from + along` (grid units; the unit
-// square is k wide), by `steps` bisections: its parameter in (0, 1) from the first point, whose state is first_seen.
-float locate_edge(vec3 origin, VisibilityLight L, uint steps, bool first_seen, vec2 from, vec2 along, float kf) {
-    float lo = 0.0;
-    float hi = 1.0;
-    for (uint s = 0u; s < steps; ++s) {
-        float mid = 0.5 * (lo + hi);
-        vec2 uv = from + mid * along;
-        vec3 ray;
-        light_sample(L, uv / kf, ray);
-        if (sample_visible(origin, L, ray) == first_seen) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    return 0.5 * (lo + hi);
-}
-
 // The visible share of the square between four grid corners (0,0), (1,0), (1,1), (0,1) (seen0..3), the edge
 // drawn straight between its crossings on the sides whose corners disagree (bottom and top at x = their value,
 // right and left at y = theirs): the marching-squares polygon, its area by the shoelace formula.
@@ -266,7 +247,8 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
 // inside: a fragment's SIMD group runs a branch whenever one of its lanes takes it, so bisections nested at a
 // corner would run once for every corner where any lane meets an edge (the group paying for the union of its
 // lanes' edges), and llvmpipe's loop budget (src/gpu/loop_budget.rs) ran out on sunset.glb at 5^2 shadow rays.
-// Here the lanes cast their rays side by side and a group pays for its busiest lane.
+// Here the lanes cast their rays side by side and a group pays for its busiest lane. The Rust's locate_edge is the
+// GRID_ALONG_V / GRID_ALONG_U stages.
 //
 // Two columns of corners are kept (weights signed by visibility: w > 0 seen, w < 0 blocked, 0 no weight, and the
 // crossings along v), alternating in one array so that no loop copies them.
