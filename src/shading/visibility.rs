@@ -516,8 +516,13 @@ pub struct SkyLune {
     pub e: DVec3,
     /// The surface's tilt from up [rad].
     pub tilt: f64,
+}
+
+impl SkyLune {
     /// The lune's width `π − tilt` [rad].
-    pub width: f64,
+    pub fn width(&self) -> f64 {
+        PI - self.tilt
+    }
 }
 
 /// The sky's lune above a surface of unit normal `n` ([`SkyLune`]). The tilt is `atan2(|n − n_y ŷ|, n_y)`, which
@@ -528,7 +533,7 @@ pub fn sky_lune(n: DVec3) -> SkyLune {
     let len = across.length();
     let e = if len > 0.0 { across / len } else { DVec3::X };
     let tilt = len.atan2(n.y);
-    SkyLune { a: e.cross(DVec3::Y), e, tilt, width: PI - tilt }
+    SkyLune { a: e.cross(DVec3::Y), e, tilt }
 }
 
 /// The sky's sample at the point `(u, v)` of the unit square: the direction `ω(β = πv, ψ = width·u)` of its lune and
@@ -542,10 +547,11 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
     // sin β as sin(π min(v, 1 − v)), exactly 0 at both ends (sin(π) would be 1.2e-16).
     let sin_b = (PI * v.min(1.0 - v)).sin();
     let cos_b = (PI * v).cos();
-    let psi = lune.width * u;
+    let width = lune.width();
+    let psi = width * u;
     let (sin_p, cos_p) = psi.sin_cos();
     let omega = cos_b * lune.a + sin_b * (cos_p * lune.e + sin_p * DVec3::Y);
-    (omega, sin_b * sin_b * (psi + lune.tilt).min(lune.width * (1.0 - u)).sin())
+    (omega, sin_b * sin_b * (psi + lune.tilt).min(width * (1.0 - u)).sin())
 }
 
 /// The visible fraction of the sky (the directions with `ω_y > 0`), cosine-weighted, from a point with unit
