@@ -644,6 +644,7 @@ fn bench_pareto_measures_each_setting_against_the_converged_reference() {
         "--json",
         "--plot",
         s(&plot),
+        "--tolerance-in-penumbrae",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -655,10 +656,13 @@ fn bench_pareto_measures_each_setting_against_the_converged_reference() {
     assert!(disk < delta, "disk {disk:e}, delta {delta:e}");
     assert!(rows.iter().any(|r| r["front (max)"] == "★"));
     assert!(rows.iter().all(|r| r["GPU frame [ms]"].as_f64().unwrap() > 0.0));
-    // What `--tolerance` chose at 1e-2, 1e-3, 1e-4 (a sphere cannot shadow itself): each kept image meets its T
-    // against the same truth, and so does its prediction.
+    // What `--tolerance` chose at 1e-2, 1e-3, 1e-4 (a sphere cannot shadow itself, so in penumbrae or not is the
+    // same promise): each kept image meets its T against the same truth, and so does its prediction.
     let tolerance = json["tables"][1]["rows"].as_array().unwrap();
     assert_eq!(tolerance.len(), 3, "{}", json["tables"][1]);
+    // Asked to hold T in penumbrae too (`--tolerance-in-penumbrae`), the table says so.
+    let caption = json["tables"][1]["caption"].as_str().unwrap();
+    assert!(caption.contains("--tolerance T --tolerance-in-penumbrae"), "{caption}");
     for r in tolerance {
         let t = r["T"].as_f64().unwrap();
         assert!(r["max rel"].as_f64().unwrap() <= t, "{r}");

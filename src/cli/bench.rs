@@ -89,6 +89,10 @@ pub struct BenchArgs {
     /// into this PNG, one chart per scene.
     #[arg(long, value_name = "PNG", requires = "pareto")]
     pub plot: Option<PathBuf>,
+    /// With --pareto: its `--tolerance` table holds each T in the sun's penumbrae too, as `render --tolerance T
+    /// --tolerance-in-penumbrae` does (the shadow rays' grids join the study; costly), instead of outside them.
+    #[arg(long, requires = "pareto")]
+    pub tolerance_in_penumbrae: bool,
     /// With --pareto: the accuracy the converged reference claims (relative).
     #[arg(long, value_name = "REL", default_value_t = 1e-4, value_parser = parse_positive)]
     pub accuracy: f64,

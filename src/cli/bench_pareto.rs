@@ -113,6 +113,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             &reference,
             &truth,
             a.repeat,
+            a.tolerance_in_penumbrae,
         )?;
         let mut rows = Vec::new();
         for setting in sweep(&relevance, default_mode, &modes) {
@@ -167,7 +168,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             );
         }
         out += "\n";
-        out += &tolerance_table(&name, &tolerance_rows);
+        out += &tolerance_table(&name, &tolerance_rows, a.tolerance_in_penumbrae);
         costs.push((name.clone(), exactness_cost(&rows)));
         for (metric, fronts, value) in [
             ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),

@@ -39,7 +39,8 @@ struct Kept {
 
 /// The table's rows for one scene: `settings` as resolved (default models, shadows as the truth has them),
 /// rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat` warm frames;
-/// `truth` the converged reference, its unconverged pixels left out. A scene that can shadow itself on a device
+/// `truth` the converged reference, its unconverged pixels left out; `in_penumbrae`: each T is held in the sun's
+/// penumbrae too (`--tolerance-in-penumbrae`), else outside them. A scene that can shadow itself on a device
 /// without ray queries is refused without a render (only shadow rays have a known error).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tolerance_rows(
@@ -51,6 +52,7 @@ pub(super) fn tolerance_rows(
     reference: &ReferenceOptions,
     truth: &Converged,
     repeat: u32,
+    in_penumbrae: bool,
 ) -> Result<Vec<ToleranceRow>, CliError> {
     let can_occlude = settings.shading.shadows != Shadows::None;
     let excluded = truth.unconverged_mask();
@@ -70,7 +72,7 @@ pub(super) fn tolerance_rows(
         let done = render_within_tolerance(
             request,
             &mut s,
-            Some(Tolerance::outside_penumbrae(tolerance)),
+            Some(if in_penumbrae { Tolerance::everywhere(tolerance) } else { Tolerance::outside_penumbrae(tolerance) }),
             reference,
             |s| {
                 let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;
@@ -102,12 +104,13 @@ pub(super) fn tolerance_rows(
     Ok(rows)
 }
 
-/// The Markdown table of one scene's rows.
-pub(super) fn tolerance_table(name: &str, rows: &[ToleranceRow]) -> String {
+/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`).
+pub(super) fn tolerance_table(name: &str, rows: &[ToleranceRow], in_penumbrae: bool) -> String {
+    let flags = if in_penumbrae { "render --tolerance T --tolerance-in-penumbrae" } else { "render --tolerance T" };
     let mut out = format!(
-        "`render --tolerance T` on {name} (the same truth; GPU time: the sum of the median warm frames of every \
-         render it made):\n\n| T | models chosen | renders | GPU time [ms] | max rel | predicted |\n\
-         |---:|---|---:|---:|---:|---:|\n"
+        "`{flags}` on {name} (the same truth; GPU time: the sum of the median warm frames of every render it made; \
+         max rel over every pixel, penumbrae included):\n\n| T | models chosen | renders | GPU time [ms] | max rel | \
+         predicted |\n|---:|---|---:|---:|---:|---:|\n"
     );
     for r in rows {
         out += &match &r.outcome {
