@@ -123,7 +123,8 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
     uvec4 counts;   // x: number of disk lights; y unused; z: LOOP_PROBE_ITERATIONS (fragment.glsl); w: samples per axis (disks, sky)
-    uvec4 sampling; // x: samples per axis over the sun's disk; y: shadow samples per axis (visible fractions);
+    uvec4 sampling; // x: samples per axis over the sun's disk (the render's; each draw reads its material's from
+                    // pc.sun_samples); y: shadow samples per axis (visible fractions);
                     // z: shadow-map filter, 1 PCSS, 2 nearest
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
     vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 0 none, 1 PCSS, 2 nearest
@@ -210,6 +211,7 @@ layout(push_constant) uniform PushConstants {
     uint material;          // index into materials[]
     uint first_index;       // this draw's first index in indices[]
     int vertex_offset;      // added to every index of this draw
+    uint sun_samples;       // grid side over the sun's disk for this draw's material (RenderSettings::shading_for)
 } pc;
 
 #endif

@@ -492,7 +492,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
             float radius = tan(0.5 * delta);
-            SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, lights.sampling.x,
+            SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
                 SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
             vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
             // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the

@@ -9,7 +9,7 @@ use crate::scene::{BoundingSphere, Camera, DiskLight, Lights, Projection, Scene,
 use crate::shading::radiometry::{
     degrees_to_radians, sun_irradiance_from_radiance, DEFAULT_SUN_IRRADIANCE, SUN_ANGULAR_DIAMETER_DEGREES,
 };
-use crate::shading::ShadingOptions;
+use crate::shading::{ShadingOptions, SunChoice};
 
 /// Default image size [pixels].
 pub const DEFAULT_WIDTH: u32 = 512;
@@ -26,12 +26,31 @@ pub struct RenderSettings {
     pub lights: Lights,
     /// How the sun and disk lights are evaluated.
     pub shading: ShadingOptions,
+    /// Per material (by index): the sun's model and grid for that material's surfaces where `--tolerance` chose
+    /// them material by material (`accuracy::predicted::choose_sun_within`); `None` or past the end: `shading`'s.
+    pub sun_per_material: Vec<Option<SunChoice>>,
 }
 
 impl RenderSettings {
     /// Settings with the default light models.
     pub fn new(width: u32, height: u32, camera: Camera, lights: Lights) -> Self {
-        Self { width, height, camera, lights, shading: ShadingOptions::default() }
+        Self { width, height, camera, lights, shading: ShadingOptions::default(), sun_per_material: Vec::new() }
+    }
+
+    /// Whether some material is rendered with sun model `sun` (the render's, or a material's own).
+    pub fn shading_for_any(&self, sun: crate::shading::SunModel) -> bool {
+        self.shading.sun == sun || self.sun_per_material.iter().flatten().any(|c| c.sun == sun)
+    }
+
+    /// The shading options of material `material`'s surfaces: [`Self::shading`] with the material's own sun model
+    /// and grid where it has one ([`Self::sun_per_material`]).
+    pub fn shading_for(&self, material: usize) -> ShadingOptions {
+        let mut shading = self.shading;
+        if let Some(Some(choice)) = self.sun_per_material.get(material) {
+            shading.sun = choice.sun;
+            shading.sun_samples_per_axis = choice.sun_samples_per_axis;
+        }
+        shading
     }
 
     /// Width / height.
@@ -160,7 +179,7 @@ pub fn resolve_with(
     }
     let unlit = lights.sun.is_none() && lights.disks.is_empty() && lights.sky.is_none();
     lights.sun = resolve_sun(scene.lights.sun, unlit, &light_options.sun)?;
-    Ok(RenderSettings { width, height, camera, lights, shading: light_options.shading })
+    Ok(RenderSettings { width, height, camera, lights, shading: light_options.shading, sun_per_material: Vec::new() })
 }
 
 fn resolve_camera(scene: &Scene, aspect: f64, opts: &CameraOptions) -> Result<Camera, SettingsError> {

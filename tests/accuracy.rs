@@ -326,7 +326,8 @@ fn tolerance_meets_itself_on_the_gpu() {
                 }
             };
             let mut t = s.clone();
-            t.shading = chosen;
+            let samples = chosen.sun_samples_per_axis();
+            chosen.apply(&mut t);
             let image = gpu.render(&scene, &t);
             let truth = render_converged(
                 &scene,
@@ -335,11 +336,92 @@ fn tolerance_meets_itself_on_the_gpu() {
                 &ConvergenceOptions { accuracy: tolerance / 10.0, max_refinements: 5 },
             );
             let e = image_error(&image, &truth.image, Some(&truth.unconverged_mask())).unwrap();
-            println!("{name}, T = {tolerance:e}: sun {}², GPU measured {:.2e}", chosen.sun_samples_per_axis, e.max_rel);
+            println!("{name}, T = {tolerance:e}: sun {samples}², GPU measured {:.2e}", e.max_rel);
             assert!(e.max_rel <= tolerance, "{name}: GPU {:.2e} over T = {tolerance:e}", e.max_rel);
             assert_eq!(e.coverage_mismatches, 0);
         }
     }
+}
+
+/// `--tolerance` chooses the sun's model material by material: on brdfs.glb (unshadowed) at 1e-4 each lobe gets
+/// the smallest grid its own bound allows (one sample less a side and its bound is over T), so the wide lobes take
+/// fewer samples than the anisotropic Ward's. At 1e-3 `render --tolerance` renders each material with its own on
+/// the GPU: `--check` (validation on) agrees with the reference rendered with the same choices, which differs
+/// from one grid for all (so the agreement is the choices'), and the image meets T against the converged
+/// reference.
+#[test]
+fn tolerance_chooses_the_sun_per_material() {
+    use sunshade::accuracy::error::image_error;
+    use sunshade::accuracy::predicted::{choose_for_tolerance, predict, Barycentrics, Renderer};
+    use sunshade::shading::SunModel;
+    // As the GPU renders it (its f32 arithmetic in every bound), with f64 barycentrics (lavapipe's default).
+    let renderer = Renderer::Gpu { barycentrics: Barycentrics::F64 };
+    let scene = common::load(std::path::Path::new("models/brdfs.glb"));
+    let (w, h) = (48, 48);
+    let mut s = settings::resolve_with(&scene, w, h, &CameraOptions::default(), &LightOptions::default()).unwrap();
+    s.shading.shadows = Shadows::None;
+    let used: Vec<usize> =
+        (0..scene.materials.len()).filter(|&i| scene.meshes.iter().any(|m| m.material == i)).collect();
+    let chosen = |tolerance: f64| {
+        let mut t = s.clone();
+        choose_for_tolerance(&scene, &s, renderer, false, tolerance).unwrap().apply(&mut t);
+        let grids: Vec<u32> = used.iter().map(|&i| t.shading_for(i).sun_samples_per_axis).collect();
+        (t, grids)
+    };
+    let (t, grids) = chosen(1e-4);
+    assert!(used.iter().all(|&i| t.shading_for(i).sun == SunModel::Disk), "{grids:?}");
+    let (fewest, most) = (grids.iter().min().unwrap(), grids.iter().max().unwrap());
+    assert!(fewest < most, "one grid for every material: {grids:?}");
+    assert_eq!(*most, t.shading.sun_samples_per_axis);
+    let prediction = predict(&scene, &t, renderer, false);
+    assert!(prediction.max_relative <= 1e-4, "{}", prediction.line());
+    for &i in &used {
+        let k = t.shading_for(i).sun_samples_per_axis;
+        if k > 4 && !scene.materials[i].brdf.is_lambert() {
+            let mut coarser = t.clone();
+            coarser.sun_per_material[i].as_mut().unwrap().sun_samples_per_axis = k - 1;
+            let p = predict(&scene, &coarser, renderer, false);
+            assert!(p.max_relative > 1e-4, "{}: {}² would do: {}", scene.materials[i].name, k - 1, p.line());
+        }
+    }
+    // The GPU at 1e-3: `-v` names each material's grid, `--check` agrees with the reference of the same choices.
+    let tolerance = 1e-3;
+    let (t, grids) = chosen(tolerance);
+    let dir = common::TempDir::new("sun-per-material");
+    let out = dir.path("brdfs.exr");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
+        .args(["render", "models/brdfs.glb", "--width", &w.to_string(), "--height", &h.to_string()])
+        .args(["--shadows", "none", "--tolerance", "1e-3", "--check", "-v", "-o", out.to_str().unwrap()])
+        .env("SUNSHADE_VALIDATION", "1")
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
+        return; // a device without f64 interpolation has no bound to keep
+    }
+    assert!(o.status.success(), "{e}");
+    let line = e.lines().find(|l| l.starts_with("sunshade: sun: ")).unwrap();
+    assert!(line.starts_with("sunshade: sun: per material: "), "{line}");
+    for (&i, k) in used.iter().zip(&grids) {
+        let want = format!("{} disk, {k}² samples", scene.materials[i].name);
+        assert!(line.contains(&want), "{want} not in {line}");
+    }
+    let image = sunshade::film::read_image(&out).unwrap();
+    // One grid for all (the finest chosen) is another image: the check's agreement was with the choices.
+    let reference = ReferenceOptions::default();
+    let mut uniform = t.clone();
+    uniform.sun_per_material.clear();
+    let one_grid = image_error(&image, &cpu::render(&scene, &uniform, &reference), None).unwrap().max_rel;
+    assert!(
+        one_grid > 2e-5,
+        "per material {grids:?} and {}² for all agree to {one_grid:.1e}",
+        t.shading.sun_samples_per_axis
+    );
+    let (measured, _) = common::error_against_converged(&scene, &s, &image, tolerance / 10.0, &reference);
+    eprintln!(
+        "brdfs.glb, T = 1e-3, sun per material {grids:?}: GPU measured {measured:.2e}, {one_grid:.1e} from one grid"
+    );
+    assert!(measured <= tolerance, "GPU {measured:.3e} over T = 1e-3");
 }
 
 /// The delta sun's trial: on brdfs.glb at 96² (unshadowed), the floor-based horizon term (9.8e-2) keeps the delta
@@ -377,7 +459,7 @@ fn the_delta_trial_keeps_the_delta_sun_where_its_image_peak_allows() {
                 tolerance,
             )
             .unwrap();
-            assert_eq!(floor_based.sun, SunModel::Disk);
+            assert_eq!(floor_based.shading.sun, SunModel::Disk);
         }
     }
 }

@@ -1,5 +1,5 @@
-//! The predicted error of a render, from the bounds of its models ([`super::bounds`]), and `--tolerance`: the
-//! cheapest sun model whose bound meets a tolerance.
+//! The predicted error of a render, from the bounds of its models ([`super::bounds`]), and `--tolerance`: for each
+//! material, the cheapest sun model whose bound for its lobe meets a tolerance ([`Choice`]).
 //!
 //! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
 //! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
@@ -15,7 +15,7 @@
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, Quantity, ShadingOptions, Shadows, SunModel};
+use crate::shading::{DiskModel, Quantity, ShadingOptions, Shadows, SunChoice, SunModel};
 
 use super::refinement::LobeEstimate;
 
@@ -185,6 +185,22 @@ fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
     v
 }
 
+/// The shading options the surfaces of a lobe of [`scene_lobes`] are rendered with: those of the first material
+/// some mesh uses whose sharpest lobe it is (`--tolerance` chooses the same for every material of a lobe).
+fn lobe_shading(scene: &Scene, settings: &RenderSettings, lobe: &Brdf) -> ShadingOptions {
+    let name = brdf_name(lobe);
+    scene
+        .meshes
+        .iter()
+        .map(|m| m.material)
+        .find(|&i| {
+            scene.materials.get(i).is_some_and(|m| {
+                !matches!(m.brdf, Brdf::Measured { .. }) && brdf_name(&sharpest_brdf(m, scene)) == name
+            })
+        })
+        .map_or(settings.shading, |i| settings.shading_for(i))
+}
+
 /// The delta sun's horizon term per lobe of the scene (in [`scene_lobes`]' order) given the peak `rendered` of a
 /// delta render of it [W/(m²·sr)]: each lobe's absolute horizon error (`bounds::horizon_error`) over the floor of
 /// the truth's peak, that peak bounded below by `bounds::peak_lower_bound`; never more than the floor-based
@@ -250,24 +266,25 @@ pub fn predict_with_peak(
         let l = sun.direction.as_dvec3();
         let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
         let arithmetic = renderer.arithmetic();
-        let horizons = match shading.sun {
-            SunModel::Delta => horizon_terms(scene, settings, arithmetic, rendered),
-            SunModel::Disk => None,
-        };
-        let model = match (shading.sun, rendered.is_some() && horizons.is_some()) {
+        // Each lobe with the sun model of its materials (`RenderSettings::shading_for`).
+        let brdfs = scene_brdfs(scene);
+        let models: Vec<ShadingOptions> = brdfs.iter().map(|b| lobe_shading(scene, settings, b)).collect();
+        let any_delta = models.iter().any(|m| m.sun == SunModel::Delta);
+        let horizons = if any_delta { horizon_terms(scene, settings, arithmetic, rendered) } else { None };
+        let model = |m: &ShadingOptions| match (m.sun, rendered.is_some() && horizons.is_some()) {
             (SunModel::Delta, false) => "delta sun".to_string(),
             (SunModel::Delta, true) => {
                 format!("delta sun (horizon against the image's peak, {:.3e})", rendered.unwrap_or(0.0))
             }
-            (SunModel::Disk, _) => format!("disk sun {}²", shading.sun_samples_per_axis),
+            (SunModel::Disk, _) => format!("disk sun {}²", m.sun_samples_per_axis),
         };
-        for (i, brdf) in scene_brdfs(scene).iter().enumerate() {
+        for (i, (brdf, m)) in brdfs.iter().zip(&models).enumerate() {
             let horizon = horizons.as_ref().map_or(0.0, |h| h[i]);
-            let b = sun_bound(brdf, shading, r, horizon, angles);
-            p.terms.push((format!("{model}, {}:", brdf_name(brdf)), b));
+            let b = sun_bound(brdf, m, r, horizon, angles);
+            p.terms.push((format!("{}, {}:", model(m), brdf_name(brdf)), b));
             p.max_relative = p.max_relative.max(b);
         }
-        if shading.sun == SunModel::Delta && can_occlude && shading.shadows != Shadows::None {
+        if any_delta && can_occlude && shading.shadows != Shadows::None {
             p.terms.push(("delta sun's hard shadow edge across the penumbra:".into(), 1.0));
             p.max_relative = 1.0;
         }
@@ -364,16 +381,43 @@ fn occlusion_and_arithmetic(
     }
 }
 
-/// `--tolerance`: the cheapest sun model for `scene` whose predicted error (with the GPU's arithmetic on the
-/// GPU) is at most `tolerance`: the delta sun, else the smallest disk grid from 4² up to 64². `Err` says why no
-/// setting can promise it: lights or techniques without a bound, or a lobe too sharp for 64².
+/// `--tolerance`'s models: the render's shading options and, where the materials' lobes chose differently, each
+/// material's own sun model and grid (`RenderSettings::sun_per_material`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Choice {
+    pub shading: ShadingOptions,
+    pub sun_per_material: Vec<Option<SunChoice>>,
+}
+
+impl Choice {
+    /// The same models for every material.
+    fn uniform(shading: ShadingOptions) -> Self {
+        Self { shading, sun_per_material: Vec::new() }
+    }
+
+    /// Renders with these models from now on.
+    pub fn apply(self, settings: &mut RenderSettings) {
+        settings.shading = self.shading;
+        settings.sun_per_material = self.sun_per_material;
+    }
+
+    /// The sun's grid side of the material of the finest grid (the render's `sun_samples_per_axis`).
+    pub fn sun_samples_per_axis(&self) -> u32 {
+        self.shading.sun_samples_per_axis
+    }
+}
+
+/// `--tolerance`: for each lobe of `scene` (each material, by its sharpest lobe) the cheapest sun model whose
+/// predicted error (with the GPU's arithmetic on the GPU) is at most `tolerance`: the delta sun, else the smallest
+/// disk grid from 4² up to 64² ([`choose_sun_within`]). `Err` says why no setting can promise it: lights or
+/// techniques without a bound, or a lobe too sharp for 64².
 pub fn choose_for_tolerance(
     scene: &Scene,
     settings: &RenderSettings,
     renderer: Renderer,
     can_occlude: bool,
     tolerance: f64,
-) -> Result<ShadingOptions, String> {
+) -> Result<Choice, String> {
     choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, None)
 }
 
@@ -393,7 +437,7 @@ pub fn delta_worth_trying(
         return false;
     }
     let Ok(choice) = choose_for_tolerance(scene, settings, renderer, can_occlude, tolerance) else { return false };
-    if choice.sun == SunModel::Delta {
+    if choice.shading.sun == SunModel::Delta {
         return false;
     }
     let r = 0.5 * sun.angular_diameter as f64;
@@ -415,7 +459,7 @@ pub fn choose_for_tolerance_with_peak(
     can_occlude: bool,
     tolerance: f64,
     delta_peak: Option<f64>,
-) -> Result<ShadingOptions, String> {
+) -> Result<Choice, String> {
     let lights = &settings.lights;
     if lobes_need_study(scene, settings) && !has_measured(scene) {
         return Err(format!(
@@ -469,6 +513,12 @@ pub(crate) fn techniques_within(
 /// [`choose_for_tolerance_with_peak`] but for the lobe grids under disk lights and the sky on specular surfaces,
 /// which the caller estimates by refinement ([`super::trial`]): the sun's models for `tolerance`, and what the
 /// other techniques refuse.
+///
+/// The sun's model is chosen per lobe, each the cheapest that its own bound allows: a pixel's error is that of
+/// its own material's terms (`super::bounds`), so a wide lobe or a Lambertian surface need not pay for the
+/// sharpest lobe's grid (on brdfs.glb at 1e-4 the anisotropic Ward's 16² against the isotropic Ward's 6²). The
+/// render's own `sun` is the delta sun only where every lobe took it, and its `sun_samples_per_axis` the finest
+/// grid chosen; where the lobes chose alike no material gets its own.
 pub(crate) fn choose_sun_within(
     scene: &Scene,
     settings: &RenderSettings,
@@ -476,7 +526,7 @@ pub(crate) fn choose_sun_within(
     can_occlude: bool,
     tolerance: f64,
     delta_peak: Option<f64>,
-) -> Result<ShadingOptions, String> {
+) -> Result<Choice, String> {
     if has_measured(scene) {
         return Err(format!(
             "--tolerance {tolerance:e}: measured BRDFs have no derived error bound; their grids are estimated by \
@@ -487,38 +537,54 @@ pub(crate) fn choose_sun_within(
     let mut shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
     let lights = &settings.lights;
     let arithmetic = renderer.arithmetic();
-    let Some(sun) = &lights.sun else { return Ok(shading) };
+    let Some(sun) = &lights.sun else { return Ok(Choice::uniform(shading)) };
     let r = 0.5 * sun.angular_diameter as f64;
     let l = sun.direction.as_dvec3();
     let angles = SunViewAngles::of(&settings.camera, settings.aspect(), l);
     let horizons = horizon_terms(scene, settings, arithmetic, delta_peak);
     let brdfs = scene_brdfs(scene);
-    let worst = |s: &ShadingOptions| {
-        brdfs
-            .iter()
-            .enumerate()
-            .map(|(i, b)| sun_bound(b, s, r, horizons.as_ref().map_or(0.0, |h| h[i]), angles))
-            .fold(0.0, f64::max)
-    };
-    let meets = |s: &ShadingOptions| worst(s) + arithmetic <= tolerance;
-    // Where the scene shadows itself the delta sun's single shadow ray draws a hard edge across the penumbra
-    // (pixels up to 100% off), so only the disk is considered there.
-    shading.sun = SunModel::Delta;
-    if !can_occlude && meets(&shading) {
-        return Ok(shading);
-    }
-    shading.sun = SunModel::Disk;
-    for k in MIN_GRID_FOR_BOUND..=MAX_TOLERANCE_SUN_GRID {
-        shading.sun_samples_per_axis = k;
-        if meets(&shading) {
-            return Ok(shading);
+    let mut chosen = Vec::with_capacity(brdfs.len());
+    for (i, brdf) in brdfs.iter().enumerate() {
+        let bound =
+            |s: &ShadingOptions| sun_bound(brdf, s, r, horizons.as_ref().map_or(0.0, |h| h[i]), angles) + arithmetic;
+        // Where the scene shadows itself the delta sun's single shadow ray draws a hard edge across the penumbra
+        // (pixels up to 100% off), so only the disk is considered there.
+        let mut s = ShadingOptions { sun: SunModel::Delta, ..shading };
+        if !can_occlude && bound(&s) <= tolerance {
+            chosen.push(SunChoice { sun: SunModel::Delta, sun_samples_per_axis: shading.sun_samples_per_axis });
+            continue;
         }
+        s.sun = SunModel::Disk;
+        let grid = (MIN_GRID_FOR_BOUND..=MAX_TOLERANCE_SUN_GRID).find(|&k| {
+            s.sun_samples_per_axis = k;
+            bound(&s) <= tolerance
+        });
+        let Some(k) = grid else {
+            return Err(format!(
+                "--tolerance {tolerance:e}: the sun's bound for {} is {:.1e} at {MAX_TOLERANCE_SUN_GRID}² samples, \
+                 over the tolerance (the lobe is too narrow for the sun's grid; docs/accuracy.md, \"Error bounds\")",
+                brdf_name(brdf),
+                bound(&s)
+            ));
+        };
+        chosen.push(SunChoice { sun: SunModel::Disk, sun_samples_per_axis: k });
     }
-    Err(format!(
-        "--tolerance {tolerance:e}: the sun's bound is {:.1e} at {MAX_TOLERANCE_SUN_GRID}² samples, over the \
-         tolerance (the sharpest lobe is too narrow for the sun's grid; docs/accuracy.md, \"Error bounds\")",
-        worst(&shading) + arithmetic
-    ))
+    let disks = chosen.iter().filter(|c| c.sun == SunModel::Disk);
+    shading.sun = if disks.clone().next().is_some() { SunModel::Disk } else { SunModel::Delta };
+    shading.sun_samples_per_axis = disks.map(|c| c.sun_samples_per_axis).max().unwrap_or(shading.sun_samples_per_axis);
+    if chosen.windows(2).all(|w| w[0] == w[1]) {
+        return Ok(Choice::uniform(shading));
+    }
+    // Each material gets its lobe's choice.
+    let sun_per_material = scene
+        .materials
+        .iter()
+        .map(|m| {
+            let name = brdf_name(&sharpest_brdf(m, scene));
+            brdfs.iter().position(|b| brdf_name(b) == name).map(|i| chosen[i])
+        })
+        .collect();
+    Ok(Choice { shading, sun_per_material })
 }
 
 /// What `--tolerance`'s choice and a render's prediction are for: the scene, the renderer whose error is
@@ -552,10 +618,11 @@ pub fn choose_and_predict(
     let Request { scene, renderer, .. } = request;
     let can_occlude = request.can_occlude();
     if let Some(tolerance) = tolerance {
-        settings.shading =
-            choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, delta_peak)?;
+        choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, delta_peak)?.apply(settings);
     }
-    let peak = delta_peak.filter(|_| settings.shading.sun == SunModel::Delta);
+    // A delta render's peak bounds the truth's peak below whichever image is kept: it serves every lobe that took
+    // the delta sun.
+    let peak = delta_peak.filter(|_| settings.shading_for_any(SunModel::Delta));
     Ok(predict_with_peak(scene, settings, renderer, can_occlude, peak, None))
 }
 

@@ -126,6 +126,7 @@ fn models_within<T, E>(
     let trial = if delta_trial(request, settings, tolerance) {
         let mut delta = settings.clone();
         delta.shading.sun = SunModel::Delta;
+        delta.sun_per_material.clear();
         Some(render(&delta).map_err(TrialError::Render)?)
     } else {
         None
@@ -178,6 +179,7 @@ fn lobe_study<T, E>(
         // there is no sun.
         settings.shading = techniques_within(settings, renderer, can_occlude, shadow_grid, tolerance)
             .map_err(TrialError::Tolerance)?;
+        settings.sun_per_material.clear();
         if sun_grid {
             settings.shading.sun = SunModel::Disk;
         }
@@ -190,7 +192,7 @@ fn lobe_study<T, E>(
                 break;
             }
         }
-        settings.shading = sun.map_err(TrialError::Tolerance)?;
+        sun.map_err(TrialError::Tolerance)?.apply(settings);
         // What the sun's terms and the arithmetic leave.
         tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative
     };

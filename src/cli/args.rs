@@ -251,8 +251,8 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
 
-    /// Choose the cheapest sun model (delta, or the disk with the fewest samples) whose derived error bound, with
-    /// the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
+    /// Choose for each material the cheapest sun model (delta, or the disk with the fewest samples) whose derived
+    /// error bound for its lobe, with the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
     /// the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
     /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
     /// (exact) and the sky on Lambertian surfaces by their closed forms. Specular surfaces under disk lights or a

@@ -8,6 +8,7 @@ use serde_json::json;
 
 use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
+use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
 
@@ -44,6 +45,11 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "height": settings.height,
         "sun_model": match sh.sun { SunModel::Disk => "disk", SunModel::Delta => "delta" },
         "sun_samples": sh.sun_samples_per_axis * sh.sun_samples_per_axis,
+        // Where `--tolerance` chose the sun per material: by material index (null: the render's).
+        "sun_per_material": settings.sun_per_material.iter().map(|c| c.map(|c| json!({
+            "sun_model": match c.sun { SunModel::Disk => "disk", SunModel::Delta => "delta" },
+            "sun_samples": c.sun_samples_per_axis * c.sun_samples_per_axis,
+        }))).collect::<Vec<_>>(),
         "disk_model": match sh.disk { DiskModel::Exact => "exact", DiskModel::SmallSource => "small-source" },
         "samples": sh.samples_per_axis * sh.samples_per_axis,
         "shadows": sh.shadows.name(),
@@ -91,13 +97,28 @@ pub fn measured_materials(scene: &crate::scene::Scene) -> Option<(String, String
     (!list.is_empty()).then(|| ("sunshadeMeasured".to_string(), serde_json::Value::Array(list).to_string()))
 }
 
-/// The sun model of a render in words, for `-v`: "sun: disk, 8² samples".
-pub fn sun_model_line(settings: &RenderSettings) -> String {
-    match (settings.lights.sun.is_some(), settings.shading.sun) {
-        (false, _) => "sun: none".into(),
-        (true, SunModel::Delta) => "sun: delta (a single direction)".into(),
-        (true, SunModel::Disk) => format!("sun: disk, {}² samples", settings.shading.sun_samples_per_axis),
+/// The sun model of a render in words, for `-v`: "sun: disk, 8² samples"; where `--tolerance` chose per material
+/// (`RenderSettings::sun_per_material`), each material's (by its name, "material 'floor'" or "material 2"):
+/// "sun: per material: material 'floor' delta (a single direction); material 'Ward' disk, 6² samples".
+pub fn sun_model_line(settings: &RenderSettings, scene: &Scene) -> String {
+    let model = |sun: SunModel, k: u32| match sun {
+        SunModel::Delta => "delta (a single direction)".to_string(),
+        SunModel::Disk => format!("disk, {k}² samples"),
+    };
+    if settings.lights.sun.is_none() {
+        return "sun: none".into();
     }
+    if settings.sun_per_material.is_empty() {
+        return format!("sun: {}", model(settings.shading.sun, settings.shading.sun_samples_per_axis));
+    }
+    let each: Vec<String> = (0..scene.materials.len())
+        .filter(|&i| scene.meshes.iter().any(|m| m.material == i))
+        .map(|i| {
+            let s = settings.shading_for(i);
+            format!("{} {}", scene.materials[i].name, model(s.sun, s.sun_samples_per_axis))
+        })
+        .collect();
+    format!("sun: per material: {}", each.join("; "))
 }
 
 /// The lobe grids of a render in words, for `-v`, where it has disk lights or a sky: "lobes under disk lights and

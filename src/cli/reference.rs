@@ -116,7 +116,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             image.covered_count()
         );
         eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
-        eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings));
+        eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings, &scene));
         if let Some(line) = super::metadata::lobe_model_line(&settings) {
             eprintln!("sunshade: {line}");
         }

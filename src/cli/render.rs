@@ -304,6 +304,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();
+        let sun_line = super::metadata::sun_model_line(&job.settings, session.scene_ref(job.scene));
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
         let info = renderer.device_info();
@@ -323,7 +324,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             job.image.covered_count()
         );
         eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
-        eprintln!("sunshade: {}", super::metadata::sun_model_line(&job.settings));
+        eprintln!("sunshade: {sun_line}");
         if let Some(line) = super::metadata::lobe_model_line(&job.settings) {
             eprintln!("sunshade: {line}");
         }

@@ -90,12 +90,14 @@ pub(super) fn shade(
     }
     let emits = t.surface & SURFACE_EMISSION != 0;
     let add_emission = |r: [f64; 3]| if emits { [0, 1, 2].map(|c| r[c] + emission[c]) } else { r };
-    let irradiance = settings.shading.quantity == Quantity::Irradiance;
+    // The material's own sun model and grid where `--tolerance` chose them per material.
+    let shading = settings.shading_for(t.material);
+    let irradiance = shading.quantity == Quantity::Irradiance;
     let Some((occluders, lights)) = shadow_rays else {
         if irradiance {
-            return irradiance_visible(&point, &settings.lights, &settings.shading, None);
+            return irradiance_visible(&point, &settings.lights, &shading, None);
         }
-        return add_emission(radiance_out(&brdf, &point, &settings.lights, &settings.shading));
+        return add_emission(radiance_out(&brdf, &point, &settings.lights, &shading));
     };
     let shadow = Shadowing {
         origin: shadow_origin(t, w, position, normal),
@@ -104,9 +106,9 @@ pub(super) fn shade(
         lights,
     };
     if irradiance {
-        return irradiance_visible(&point, &settings.lights, &settings.shading, Some(&shadow));
+        return irradiance_visible(&point, &settings.lights, &shading, Some(&shadow));
     }
-    add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &settings.shading, Some(&shadow)))
+    add_emission(radiance_out_visible(&brdf, &point, &settings.lights, &shading, Some(&shadow)))
 }
 
 /// The shadow rays' origin for the point `position` with barycentrics `w` and interpolated unit normal `normal`

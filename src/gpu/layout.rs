@@ -181,7 +181,9 @@ pub struct PushConstants {
     pub material: u32,
     pub first_index: u32,
     pub vertex_offset: i32,
-    pub _pad: [u32; 3],
+    /// Grid side over the sun's disk for this draw's material (`RenderSettings::shading_for`).
+    pub sun_samples_per_axis: u32,
+    pub _pad: [u32; 2],
 }
 
 /// The measured buffer's floats (binding 11): each distinct table the materials use once (materials naming the
@@ -381,7 +383,8 @@ pub fn push_constants(settings: &RenderSettings, material: u32, first_index: u32
         material,
         first_index,
         vertex_offset,
-        _pad: [0; 3],
+        sun_samples_per_axis: settings.shading_for(material as usize).sun_samples_per_axis,
+        _pad: [0; 2],
     }
 }
 
@@ -470,6 +473,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<PushConstants>(), 112);
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
         assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
+        assert_eq!(std::mem::offset_of!(PushConstants, sun_samples_per_axis), 100);
         assert_eq!(std::mem::size_of::<Vertex>(), 40);
         assert_eq!(std::mem::size_of::<SurfaceVertex>(), 32);
     }

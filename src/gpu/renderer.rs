@@ -535,12 +535,16 @@ impl Renderer {
             Shadows::Map if any_map => SHADOWS_MAP,
             _ => SHADOWS_NONE,
         };
-        // The pipeline variant of each draw, created now if this is its first frame.
+        // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
+        // if this is its first frame.
         let t_pipelines = Instant::now();
         let variants: Vec<ShaderVariant> = scene
             .draws
             .iter()
-            .map(|draw| ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &settings.shading, shadows))
+            .map(|draw| {
+                let shading = settings.shading_for(draw.material as usize);
+                ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &shading, shadows)
+            })
             .collect();
         self.pipeline.prepare_variants(&variants)?;
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());

@@ -21,8 +21,8 @@ pub use quantity::Quantity;
 pub use shade::{
     disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, lobe_about_z, lobe_width,
     normalized_lobe_integral, orthonormal_to, radiance_out, radiance_out_visible, safe_normalize, sky_lobe_integral,
-    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunModel, SurfacePoint, DEFAULT_SAMPLES_PER_AXIS,
-    DEFAULT_SUN_SAMPLES_PER_AXIS,
+    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunChoice, SunModel, SurfacePoint,
+    DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{
     Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,

@@ -57,6 +57,16 @@ pub enum DiskModel {
     SmallSource,
 }
 
+/// The sun's model and grid for one material's surfaces (`RenderSettings::sun_per_material`): `--tolerance`
+/// chooses the cheapest that meets its bound for each material's lobe, so that a wide lobe or a Lambertian surface
+/// does not pay for the sharpest lobe's grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SunChoice {
+    pub sun: SunModel,
+    /// Grid side over the sun's disk (`SunModel::Disk`).
+    pub sun_samples_per_axis: u32,
+}
+
 /// Default sample counts (per axis of the stratified grids).
 pub const DEFAULT_SUN_SAMPLES_PER_AXIS: u32 = 8;
 pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 16;
