@@ -122,7 +122,8 @@ layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present
-    uvec4 counts;   // x: number of disk lights; y unused; z: LOOP_PROBE_ITERATIONS (fragment.glsl); w: samples per axis (disks, sky)
+    uvec4 counts;   // x: number of disk lights; y unused; z: LOOP_PROBE_ITERATIONS (fragment.glsl); w: samples per axis
+                    // (disks, sky: the render's; each draw reads its material's from pc.lobe_samples)
     uvec4 sampling; // x: samples per axis over the sun's disk (the render's; each draw reads its material's from
                     // pc.sun_samples); y: shadow samples per axis (visible fractions);
                     // z: shadow-map filter, 1 PCSS, 2 nearest
@@ -212,6 +213,7 @@ layout(push_constant) uniform PushConstants {
     uint first_index;       // this draw's first index in indices[]
     int vertex_offset;      // added to every index of this draw
     uint sun_samples;       // grid side over the sun's disk for this draw's material (RenderSettings::shading_for)
+    uint lobe_samples;      // side of its lobe grids under disk lights and the sky
 } pc;
 
 #endif

@@ -516,7 +516,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         } else {
             // The grid's sum as it is (see disk_lobe_integral in the Rust).
             integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
-                d.center_radius.w, lights.counts.w, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).lobe;
+                d.center_radius.w, pc.lobe_samples, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).lobe;
         }
         if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
             integral *= disk_map_fraction[i];
@@ -524,7 +524,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         specular += integral * d.radiance.rgb;
     }
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
-        specular += sky_lobe_integral_visible(material, p, lights.counts.w, SHADOWS_ON) * lights.sky.rgb;
+        specular += sky_lobe_integral_visible(material, p, pc.lobe_samples, SHADOWS_ON) * lights.sky.rgb;
     }
     return radiance + material.ks.rgb * specular;
 }

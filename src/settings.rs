@@ -29,12 +29,23 @@ pub struct RenderSettings {
     /// Per material (by index): the sun's model and grid for that material's surfaces where `--tolerance` chose
     /// them material by material (`accuracy::predicted::choose_sun_within`); `None` or past the end: `shading`'s.
     pub sun_per_material: Vec<Option<SunChoice>>,
+    /// Per material (by index): the side of its lobe grids under disk lights and the sky where `--tolerance`'s
+    /// study kept them material by material (`accuracy::trial`); `None` or past the end: `shading`'s.
+    pub lobes_per_material: Vec<Option<u32>>,
 }
 
 impl RenderSettings {
     /// Settings with the default light models.
     pub fn new(width: u32, height: u32, camera: Camera, lights: Lights) -> Self {
-        Self { width, height, camera, lights, shading: ShadingOptions::default(), sun_per_material: Vec::new() }
+        Self {
+            width,
+            height,
+            camera,
+            lights,
+            shading: ShadingOptions::default(),
+            sun_per_material: Vec::new(),
+            lobes_per_material: Vec::new(),
+        }
     }
 
     /// Whether some material is rendered with sun model `sun` (the render's, or a material's own).
@@ -43,12 +54,15 @@ impl RenderSettings {
     }
 
     /// The shading options of material `material`'s surfaces: [`Self::shading`] with the material's own sun model
-    /// and grid where it has one ([`Self::sun_per_material`]).
+    /// and grid ([`Self::sun_per_material`]) and lobe grids ([`Self::lobes_per_material`]) where it has them.
     pub fn shading_for(&self, material: usize) -> ShadingOptions {
         let mut shading = self.shading;
         if let Some(Some(choice)) = self.sun_per_material.get(material) {
             shading.sun = choice.sun;
             shading.sun_samples_per_axis = choice.sun_samples_per_axis;
+        }
+        if let Some(Some(k)) = self.lobes_per_material.get(material) {
+            shading.samples_per_axis = *k;
         }
         shading
     }
@@ -179,7 +193,15 @@ pub fn resolve_with(
     }
     let unlit = lights.sun.is_none() && lights.disks.is_empty() && lights.sky.is_none();
     lights.sun = resolve_sun(scene.lights.sun, unlit, &light_options.sun)?;
-    Ok(RenderSettings { width, height, camera, lights, shading: light_options.shading, sun_per_material: Vec::new() })
+    Ok(RenderSettings {
+        width,
+        height,
+        camera,
+        lights,
+        shading: light_options.shading,
+        sun_per_material: Vec::new(),
+        lobes_per_material: Vec::new(),
+    })
 }
 
 fn resolve_camera(scene: &Scene, aspect: f64, opts: &CameraOptions) -> Result<Camera, SettingsError> {

@@ -492,7 +492,8 @@ fn render_tolerance_keeps_the_gpu_delta_trial() {
 
 /// `render --tolerance` on the GPU (validation on) where the lobe grids need their study: brdfs.glb under sun,
 /// sky and a disk light, unshadowed, at T = 1e-2 and 1e-3: `-v` names the study and the grid it kept (a finer one
-/// at the tighter T), and each image meets T against the converged reference.
+/// at the tighter T; per material, `accuracy::material_study`), `--check` finds the reference of the same grids
+/// in agreement (each draw reads its material's grid), and each image meets T against the converged reference.
 #[test]
 fn render_tolerance_studies_the_lobe_grids_on_the_gpu() {
     use sunshade::scene::DiskLight;
@@ -521,12 +522,13 @@ fn render_tolerance_studies_the_lobe_grids_on_the_gpu() {
         let out = dir.path(&format!("lobes-{tolerance:e}.exr"));
         let flags = format!(
             "models/brdfs.glb --width 64 --height 64 --shadows none --sun-elevation 40 --sun-azimuth 30 \
-             --sun-irradiance 1000 --sky-radiance 100 --disk-light 0,3,1.5:0,-1,0:0.6:500 --tolerance {tolerance} -v"
+             --sun-irradiance 1000 --sky-radiance 100 --disk-light 0,3,1.5:0,-1,0:0.6:500 --tolerance {tolerance} -v \
+             --check"
         );
         let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
         };
-        assert!(e.contains("estimated by refinement"), "{e}");
+        assert!(e.contains("estimated by refinement") && e.contains("(per material: "), "{e}");
         let grid: u32 = e
             .split("lobes under disk lights and the sky: ")
             .nth(1)
@@ -626,6 +628,59 @@ fn tolerance_estimates_the_lobe_grids_by_refinement_on_the_reference() {
     }
     eprintln!("{report}");
     assert!(measured_cases >= 16, "{report}");
+}
+
+/// The lobe grids' study per material (`accuracy::material_study`): brdfs.glb under the sun and the sky,
+/// unshadowed, `--tolerance 1e-2` on the reference. Its specular materials keep different grids (the Phong and
+/// Blinn-Phong spheres coarser than the Ward ones), `-v`'s terms give each its estimate, and on each material's
+/// own pixels (`cpu::material_map`, which covers exactly what the render covers) the error against the converged
+/// reference is at most that material's estimate.
+#[test]
+fn the_lobe_study_keeps_a_grid_per_material() {
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let scene = common::load(std::path::Path::new("models/brdfs.glb"));
+    let sun = SunOptions { elevation_degrees: Some(40.0), azimuth_degrees: Some(30.0), ..Default::default() };
+    let lights = LightOptions { sun, sky: Some([100.0; 3]), ..Default::default() };
+    let mut s = settings::resolve_with(&scene, 48, 48, &CameraOptions::default(), &lights).unwrap();
+    s.shading.shadows = Shadows::None;
+    let reference = ReferenceOptions::default();
+    let mut t = s.clone();
+    let tolerance = 1e-2;
+    let (image, prediction) = reference_within_tolerance(
+        &scene,
+        &mut t,
+        &reference,
+        Shadows::None,
+        true,
+        Some(Tolerance::outside_penumbrae(tolerance)),
+    )
+    .unwrap();
+    let map = cpu::material_map(&scene, &t, &reference);
+    assert_eq!(map.len(), image.pixels().len());
+    for (m, p) in map.iter().zip(image.pixels()) {
+        assert_eq!(m.is_some(), p[3] > 0.0, "the map covers what the render covers");
+    }
+    let grid = |name: &str| {
+        let i = scene.materials.iter().position(|m| m.name.contains(name)).unwrap();
+        (i, t.lobes_per_material.get(i).copied().flatten().unwrap_or_else(|| panic!("{name}: no grid of its own")))
+    };
+    let (phong, ward) = (grid("Phong e=80"), grid("Ward α=0.15"));
+    assert!(phong.1 < ward.1, "Phong {}², Ward {}²: {}", phong.1, ward.1, prediction.line());
+    assert!(prediction.max_relative <= tolerance, "{}", prediction.line());
+    let truth = render_converged(&scene, &s, &reference, &ConvergenceOptions { accuracy: 1e-3, max_refinements: 5 });
+    let unconverged = truth.unconverged_mask();
+    for (i, k) in t.lobes_per_material.iter().enumerate() {
+        let Some(k) = k else { continue };
+        let name = &scene.materials[i].name;
+        let term = format!("of {name} {k}², estimated by refinement");
+        let estimate = prediction.terms.iter().find(|(w, _)| w.contains(&term)).map(|(_, e)| *e);
+        let estimate = estimate.unwrap_or_else(|| panic!("no term {term}: {}", prediction.line()));
+        // Its own pixels only: every other pixel left out as the unconverged ones are.
+        let others: Vec<bool> = map.iter().zip(&unconverged).map(|(m, &u)| u || *m != Some(i)).collect();
+        let measured = sunshade::accuracy::error::image_error(&image, &truth.image, Some(&others)).unwrap().max_rel;
+        eprintln!("{name}: {k}², measured {measured:.2e} on its pixels, estimated {estimate:.2e}");
+        assert!(measured <= estimate, "{name}: measured {measured:.2e} over its estimate {estimate:.2e}");
+    }
 }
 
 /// f32 interpolation's bound (`accuracy::interpolation`) against the GPU's own f32 barycentrics (validation on):

@@ -12,6 +12,8 @@
 //! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models;
 //! - [`refinement`]: the lobe grids' error under disk lights and the sky estimated from a ladder of grids
 //!   (Richardson extrapolation with the observed order, Roache's GCI), where no bound is derived;
+//! - [`material_study`]: that ladder run per material, each keeping the coarsest grid that meets the tolerance on
+//!   its own pixels;
 //! - [`trial`]: `--tolerance` on any renderer, with the delta sun tried first where its own image's peak decides,
 //!   and the lobe grids' ladder where they need it.
 //!
@@ -21,6 +23,7 @@ pub mod bounds;
 pub mod converged;
 pub mod error;
 pub mod interpolation;
+pub mod material_study;
 pub mod pareto;
 pub mod predicted;
 pub mod refinement;

@@ -82,13 +82,20 @@ pub fn ladder() -> Vec<u32> {
 /// The max relative difference of two renders of the same view (the diff's floor from the finer one's peak),
 /// over the pixels either covers; a NaN or an infinity counts as infinite.
 pub fn max_difference(coarse: &Image, fine: &Image) -> f64 {
+    max_difference_where(coarse, fine, None)
+}
+
+/// [`max_difference`] over the pixels `mask` flags only (row-major; `None`: all), the floor still the whole
+/// image's: a part of the image measured as the diff measures the whole.
+pub fn max_difference_where(coarse: &Image, fine: &Image, mask: Option<&[bool]>) -> f64 {
     let floor = DiffOptions::default().floor_fraction * image_peak(fine);
     coarse
         .pixels()
         .iter()
         .zip(fine.pixels())
-        .filter(|(a, b)| a[3] > 0.0 || b[3] > 0.0)
-        .map(|(&a, &b)| pixel_difference(a, b, floor).rel)
+        .enumerate()
+        .filter(|&(i, (a, b))| (a[3] > 0.0 || b[3] > 0.0) && mask.is_none_or(|m| m[i]))
+        .map(|(_, (&a, &b))| pixel_difference(a, b, floor).rel)
         .fold(0.0, f64::max)
 }
 
@@ -142,8 +149,18 @@ impl LobeEstimate {
     /// For the prediction's terms: "lobe grids under disk lights and the sky 19², estimated by refinement
     /// (observed order 1.80, Roache's GCI):".
     pub fn term(&self) -> String {
+        self.term_of("")
+    }
+
+    /// [`Self::term`] of one material's study: "lobe grids under disk lights and the sky of material 'Ward' 27²,
+    /// estimated by refinement (...):".
+    pub fn term_for(&self, material: &str) -> String {
+        self.term_of(&format!(" of {material}"))
+    }
+
+    fn term_of(&self, whose: &str) -> String {
         format!(
-            "{} {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
+            "{}{whose} {}², estimated by refinement (observed order {:.2}, Roache's GCI):",
             match (self.sun_grid, self.shadow_grid) {
                 (_, true) => "every grid (the sun's, the lobes', the shadow rays': penumbrae included)",
                 (true, false) => "the sun's grid and the lobe grids",
@@ -186,8 +203,13 @@ impl Ladder {
 
     /// Records the image of grid `k` given the previous rung's image (`None` for the first).
     pub fn push(&mut self, k: u32, previous: Option<&Image>, image: &Image) {
+        self.push_where(k, previous, image, None);
+    }
+
+    /// [`Self::push`] measuring only the pixels `mask` flags (one material's: a study per material).
+    pub fn push_where(&mut self, k: u32, previous: Option<&Image>, image: &Image, mask: Option<&[bool]>) {
         if let Some(prev) = previous {
-            self.differences.push((max_difference(prev, image) - self.noise).max(0.0));
+            self.differences.push((max_difference_where(prev, image, mask) - self.noise).max(0.0));
         }
         self.grids.push(k);
     }

@@ -12,6 +12,7 @@
 use std::convert::Infallible;
 
 use super::interpolation::f32_interpolation_bound;
+use super::material_study::{specular_materials, study_per_material};
 use super::predicted::{
     choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, penumbrae_need_study, predict_with_peak,
     sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer, Request,
@@ -77,7 +78,7 @@ pub fn render_within_tolerance<T, E>(
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
     let f32_barycentrics = request.renderer == Renderer::Gpu { barycentrics: Barycentrics::F32 };
     let Some(Tolerance { max_relative: tolerance, in_penumbrae }) = tolerance.filter(|_| f32_barycentrics) else {
-        return models_within(request, settings, tolerance, render, image_of);
+        return models_within(request, settings, tolerance, reference, render, image_of);
     };
     // f32 barycentrics: the models chosen for what their bound leaves, which is known only for the models
     // chosen; first for all of the tolerance, then, where the bound does not fit beside them, once more for what
@@ -88,7 +89,7 @@ pub fn render_within_tolerance<T, E>(
     for _ in 0..2 {
         *settings = initial.clone();
         let within = Tolerance { max_relative: tolerance - reserve, in_penumbrae };
-        let mut done = models_within(request, settings, Some(within), &mut render, &image_of)?;
+        let mut done = models_within(request, settings, Some(within), reference, &mut render, &image_of)?;
         bound = f32_interpolation_bound(request.scene, settings, reference);
         if done.prediction.max_relative + bound <= tolerance {
             done.prediction.add_f32_bound(bound);
@@ -112,6 +113,7 @@ fn models_within<T, E>(
     request: Request,
     settings: &mut RenderSettings,
     tolerance: Option<Tolerance>,
+    reference: &ReferenceOptions,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
@@ -120,7 +122,7 @@ fn models_within<T, E>(
     let penumbrae = tolerance.is_some_and(|t| t.in_penumbrae) && penumbrae_need_study(settings, can_occlude);
     let study = lobes_need_study(scene, settings) || sun_needs_study(scene, settings) || penumbrae;
     if let Some(t) = tolerance.filter(|_| study) {
-        return lobe_study(request, settings, t.max_relative, penumbrae, render, image_of);
+        return lobe_study(request, settings, (t.max_relative, penumbrae), reference, render, image_of);
     }
     let tolerance = tolerance.map(|t| t.max_relative);
     let trial = if delta_trial(request, settings, tolerance) {
@@ -166,8 +168,8 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 fn lobe_study<T, E>(
     request: Request,
     settings: &mut RenderSettings,
-    tolerance: f64,
-    shadow_grid: bool,
+    (tolerance, shadow_grid): (f64, bool),
+    reference: &ReferenceOptions,
     mut render: impl FnMut(&RenderSettings) -> Result<T, E>,
     image_of: impl Fn(&T) -> &Image,
 ) -> Result<WithinTolerance<T>, TrialError<E>> {
@@ -196,6 +198,13 @@ fn lobe_study<T, E>(
         // What the sun's terms and the arithmetic leave.
         tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative
     };
+    // The lobe grids alone, over several specular materials: a study per material (`super::material_study`).
+    if !sun_grid && !shadow_grid {
+        let materials = specular_materials(request, settings, reference);
+        if materials.len() > 1 {
+            return study_per_material(request, settings, (tolerance, budget), materials, render, image_of);
+        }
+    }
     let mut study = Ladder::new(renderer.arithmetic(), sun_grid, shadow_grid);
     let mut previous: Option<T> = None;
     let mut last = None;

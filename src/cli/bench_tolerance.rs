@@ -87,7 +87,7 @@ pub(super) fn tolerance_rows(
                 let error = image_error(&done.kept, &truth.image, Some(&excluded))
                     .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
                 let models: Vec<String> =
-                    [Some(sun_model_line(&s, scene)), lobe_model_line(&s)].into_iter().flatten().collect();
+                    [Some(sun_model_line(&s, scene)), lobe_model_line(&s, scene)].into_iter().flatten().collect();
                 Ok(Kept {
                     models: models.join("; "),
                     gpu_ms: ms(spent),

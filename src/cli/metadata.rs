@@ -52,6 +52,8 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         }))).collect::<Vec<_>>(),
         "disk_model": match sh.disk { DiskModel::Exact => "exact", DiskModel::SmallSource => "small-source" },
         "samples": sh.samples_per_axis * sh.samples_per_axis,
+        // Where `--tolerance`'s study kept the lobe grids per material: by material index (null: the render's).
+        "samples_per_material": settings.lobes_per_material.iter().map(|k| k.map(|k| k * k)).collect::<Vec<_>>(),
         "shadows": sh.shadows.name(),
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
         "shadow_map_size": sh.shadow_map_size,
@@ -122,10 +124,23 @@ pub fn sun_model_line(settings: &RenderSettings, scene: &Scene) -> String {
 }
 
 /// The lobe grids of a render in words, for `-v`, where it has disk lights or a sky: "lobes under disk lights and
-/// the sky: 16² samples".
-pub fn lobe_model_line(settings: &RenderSettings) -> Option<String> {
-    (!settings.lights.disks.is_empty() || settings.lights.sky.is_some())
-        .then(|| format!("lobes under disk lights and the sky: {}² samples", settings.shading.samples_per_axis))
+/// the sky: 16² samples"; where `--tolerance`'s study kept them per material (`RenderSettings::lobes_per_material`),
+/// the finest and then each material's: "... 27² samples (per material: material 'Phong' 13²; material 'Ward' 27²)".
+pub fn lobe_model_line(settings: &RenderSettings, scene: &Scene) -> Option<String> {
+    if settings.lights.disks.is_empty() && settings.lights.sky.is_none() {
+        return None;
+    }
+    let mut line = format!("lobes under disk lights and the sky: {}² samples", settings.shading.samples_per_axis);
+    let each: Vec<String> = settings
+        .lobes_per_material
+        .iter()
+        .enumerate()
+        .filter_map(|(i, k)| Some(format!("{} {}²", scene.materials.get(i)?.name, (*k)?)))
+        .collect();
+    if !each.is_empty() {
+        line += &format!(" (per material: {})", each.join("; "));
+    }
+    Some(line)
 }
 
 /// `sunshadeDaylight`: where the sun of `--time` stood and the clear sky it gave, when the render has one.

@@ -117,7 +117,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
         );
         eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings, &scene));
-        if let Some(line) = super::metadata::lobe_model_line(&settings) {
+        if let Some(line) = super::metadata::lobe_model_line(&settings, &scene) {
             eprintln!("sunshade: {line}");
         }
         if let Some(p) = &prediction {

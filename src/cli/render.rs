@@ -305,6 +305,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();
         let sun_line = super::metadata::sun_model_line(&job.settings, session.scene_ref(job.scene));
+        let lobe_line = super::metadata::lobe_model_line(&job.settings, session.scene_ref(job.scene));
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
         let info = renderer.device_info();
@@ -325,7 +326,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         );
         eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
         eprintln!("sunshade: {sun_line}");
-        if let Some(line) = super::metadata::lobe_model_line(&job.settings) {
+        if let Some(line) = lobe_line {
             eprintln!("sunshade: {line}");
         }
         eprintln!("sunshade: {}", job.prediction.line());

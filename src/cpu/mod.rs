@@ -199,6 +199,16 @@ pub fn render_selected(
     render_inner(scene, settings, options, Some(selected), &shader).0
 }
 
+/// For each pixel, the material of the surface it sees (`None` where it sees none), by the rasterization and
+/// visibility of [`render`] (the device's rules, so the GPU's image covers the same pixels with the same
+/// triangles); no shading. `--tolerance`'s study measures each material's pixels with it.
+pub fn material_map(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Vec<Option<usize>> {
+    // The material's index as the "radiance" (exact in f32 for any count of materials a scene can hold).
+    let shader = |t: &Prepared, _: (u32, u32), _: [f64; 3]| ([t.material as f64, 0.0, 0.0], false);
+    let (image, _) = render_inner(scene, settings, options, None, &shader);
+    image.pixels().iter().map(|p| (p[3] > 0.0).then_some(p[0] as usize)).collect()
+}
+
 /// For each pixel, its radiance as [`render`] gives it (with `settings`' shadows), and per channel the largest
 /// change of that radiance when its barycentrics move to one of the six corners `l ± r eᵢ` of the ball
 /// `Σ|δlᵢ| ≤ r`, `r = radius(clip-space vertices, pixel NDC)` (`accuracy::interpolation` takes the largest change

@@ -183,7 +183,9 @@ pub struct PushConstants {
     pub vertex_offset: i32,
     /// Grid side over the sun's disk for this draw's material (`RenderSettings::shading_for`).
     pub sun_samples_per_axis: u32,
-    pub _pad: [u32; 2],
+    /// Side of its lobe grids under disk lights and the sky.
+    pub lobe_samples_per_axis: u32,
+    pub _pad: u32,
 }
 
 /// The measured buffer's floats (binding 11): each distinct table the materials use once (materials naming the
@@ -376,6 +378,7 @@ pub fn lights_bytes(
 
 /// Push constants of one draw: the view, and where the draw's triangles start in the index and vertex buffers.
 pub fn push_constants(settings: &RenderSettings, material: u32, first_index: u32, vertex_offset: i32) -> PushConstants {
+    let shading = settings.shading_for(material as usize);
     PushConstants {
         clip_from_world: settings.clip_from_world().to_cols_array(),
         viewer: settings.viewer().to_array(),
@@ -383,8 +386,9 @@ pub fn push_constants(settings: &RenderSettings, material: u32, first_index: u32
         material,
         first_index,
         vertex_offset,
-        sun_samples_per_axis: settings.shading_for(material as usize).sun_samples_per_axis,
-        _pad: [0; 2],
+        sun_samples_per_axis: shading.sun_samples_per_axis,
+        lobe_samples_per_axis: shading.samples_per_axis,
+        _pad: 0,
     }
 }
 
@@ -474,6 +478,7 @@ mod tests {
         assert_eq!(std::mem::offset_of!(PushConstants, framebuffer_size), 80);
         assert_eq!(std::mem::offset_of!(PushConstants, vertex_offset), 96);
         assert_eq!(std::mem::offset_of!(PushConstants, sun_samples_per_axis), 100);
+        assert_eq!(std::mem::offset_of!(PushConstants, lobe_samples_per_axis), 104);
         assert_eq!(std::mem::size_of::<Vertex>(), 40);
         assert_eq!(std::mem::size_of::<SurfaceVertex>(), 32);
     }
