@@ -4,8 +4,9 @@
 //! kept when the delta sun then meets the tolerance; otherwise the choice falls back to the disk sun's grid and the
 //! trial's time is the price of asking. Where grids have no derived bound (the lobe grids of specular surfaces
 //! under disk lights or the sky; the sun's grid on measured materials), the image is rendered on a ladder of grids
-//! instead and the finest one's error estimated by refinement ([`super::refinement`]). The reference
-//! (`reference_within_tolerance`) and `sunshade render` (the GPU, `cli::render`) both go through
+//! instead and the finest one's error estimated by refinement ([`super::refinement`]; a ladder per material where
+//! several specular materials share the image, [`super::material_study`]). The sun's models are chosen material
+//! by material (`predicted::choose_sun_within`). The reference (`reference_within_tolerance`) and `sunshade render` (the GPU, `cli::render`) both go through
 //! [`render_within_tolerance`]; every render it makes is the caller's `render`, so a caller that sums their times
 //! has the cost of asking.
 
@@ -158,7 +159,8 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 /// scene shadows itself: the sun's models chosen by their bounds for a quarter of the tolerance (or a half, or
 /// three quarters: [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on
 /// the lobe grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits
-/// what the sun's bound and the arithmetic leave. With a measured material under the sun, the disk sun's grid is
+/// what the sun's bound and the arithmetic leave; over several specular materials, a ladder per material, each
+/// staying on the rung that fits its own pixels ([`super::material_study`]). With a measured material under the sun, the disk sun's grid is
 /// refined on the same rungs instead, and the estimate gets all of the tolerance but the arithmetic; where the
 /// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]),
 /// the shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a

@@ -252,13 +252,14 @@ pub struct SceneArgs {
     pub sun_samples: Option<u32>,
 
     /// Choose for each material the cheapest sun model (delta, or the disk with the fewest samples) whose derived
-    /// error bound for its lobe, with the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of 1% of the peak); `-v` prints
-    /// the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
+    /// error bound for its lobe, with the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of
+    /// 1% of the peak); `-v` prints the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
     /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
     /// (exact) and the sky on Lambertian surfaces by their closed forms. Specular surfaces under disk lights or a
     /// sky: the image is rendered on a ladder of lobe grids (4² up to 162², overriding --samples) until the
     /// finest one's error, estimated by refinement (Roache's grid convergence index), fits what the sun's bound
-    /// leaves; measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
+    /// leaves (with several specular materials, a ladder per material: each keeps the coarsest rung that fits its
+    /// own pixels); measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
     /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
     /// and kept within REL beside the models'. Refused: light of disk lights and the sky through occluders, the
     /// device's interpolation, and `--shadows map` (`auto` casts shadow rays, on a device without ray queries by
