@@ -409,7 +409,7 @@ impl Choice {
 
 /// `--tolerance`: for each lobe of `scene` (each material, by its sharpest lobe) the cheapest sun model whose
 /// predicted error (with the GPU's arithmetic on the GPU) is at most `tolerance`: the delta sun, else the smallest
-/// disk grid from 4² up to 64² ([`choose_sun_within`]). `Err` says why no setting can promise it: lights or
+/// disk grid from 4² up to 64² (`choose_sun_within`). `Err` says why no setting can promise it: lights or
 /// techniques without a bound, or a lobe too sharp for 64².
 pub fn choose_for_tolerance(
     scene: &Scene,
