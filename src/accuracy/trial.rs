@@ -196,7 +196,15 @@ fn lobe_study<T, E>(
                 break;
             }
         }
-        sun.map_err(TrialError::Tolerance)?.apply(settings);
+        // The message names the share it was refused at: say whose share it is.
+        let last = SUN_SHARES[SUN_SHARES.len() - 1];
+        sun.map_err(|e| {
+            TrialError::Tolerance(format!(
+                "{e} (the sun's share, {:.0}% of --tolerance {tolerance:e}: the lobe grids' study needs the rest)",
+                100.0 * last
+            ))
+        })?
+        .apply(settings);
         // What the sun's terms and the arithmetic leave.
         tolerance - predict_with_peak(scene, settings, renderer, can_occlude, None, None).max_relative
     };
