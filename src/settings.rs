@@ -49,7 +49,7 @@ impl RenderSettings {
     }
 
     /// Whether some material is rendered with sun model `sun` (the render's, or a material's own).
-    pub fn shading_for_any(&self, sun: crate::shading::SunModel) -> bool {
+    pub fn uses_sun_model(&self, sun: crate::shading::SunModel) -> bool {
         self.shading.sun == sun || self.sun_per_material.iter().flatten().any(|c| c.sun == sun)
     }
 

@@ -622,7 +622,7 @@ pub fn choose_and_predict(
     }
     // A delta render's peak bounds the truth's peak below whichever image is kept: it serves every lobe that took
     // the delta sun.
-    let peak = delta_peak.filter(|_| settings.shading_for_any(SunModel::Delta));
+    let peak = delta_peak.filter(|_| settings.uses_sun_model(SunModel::Delta));
     Ok(predict_with_peak(scene, settings, renderer, can_occlude, peak, None))
 }
 
