@@ -167,11 +167,11 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     )
     .map_err(|e| match (e, tolerance) {
         (TrialError::Tolerance(why), _) => CliError::Usage(why),
-        // A grid the study went on to that the device cannot run (`settings` holds the grids of the render that
-        // failed): no setting it can render meets the tolerance.
+        // A render the device cannot run (`settings` holds its grids, the finest of any material's): the models
+        // chosen, or a grid the study went on to; no setting it can render meets the tolerance.
         (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
-            "--tolerance {:e}: the next render of its study ({}² lobe grids, {}² sun samples, {}² shadow rays) is \
-             beyond this device: {why}",
+            "--tolerance {:e}: a render it needs (at most {}² lobe grids, {}² sun samples, {}² shadow rays; the \
+             next rung where it studies its grids) is beyond this device: {why}",
             t.max_relative,
             settings.shading.samples_per_axis,
             settings.shading.sun_samples_per_axis,
