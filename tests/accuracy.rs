@@ -326,7 +326,7 @@ fn tolerance_meets_itself_on_the_gpu() {
                 }
             };
             let mut t = s.clone();
-            let samples = chosen.sun_samples_per_axis();
+            let samples = chosen.shading.sun_samples_per_axis;
             chosen.apply(&mut t);
             let image = gpu.render(&scene, &t);
             let truth = render_converged(

@@ -18,6 +18,7 @@ use super::trial::{TrialError, WithinTolerance};
 use crate::compare::image_peak;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
+use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::SunModel;
 
@@ -30,11 +31,10 @@ pub struct MaterialPixels {
 /// The specular materials the image shows and each one's pixels; fewer than two: one study for the image does the
 /// same work.
 pub fn specular_materials(
-    request: Request,
+    scene: &Scene,
     settings: &RenderSettings,
     reference: &ReferenceOptions,
 ) -> Vec<MaterialPixels> {
-    let scene = request.scene;
     let map = cpu::material_map(scene, settings, reference);
     let specular = |m: &Option<usize>| m.filter(|&m| scene.materials.get(m).is_some_and(|m| !m.brdf.is_lambert()));
     let mut materials: Vec<usize> = map.iter().filter_map(specular).collect();

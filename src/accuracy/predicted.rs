@@ -185,19 +185,22 @@ fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
     v
 }
 
-/// The shading options the surfaces of a lobe of [`scene_lobes`] are rendered with: those of the first material
+/// The index in `lobes` (from [`scene_brdfs`]) of material `material`'s sharpest lobe; `None` for a measured
+/// material, which has none there.
+fn lobe_of(scene: &Scene, lobes: &[Brdf], material: usize) -> Option<usize> {
+    let m = scene.materials.get(material).filter(|m| !matches!(m.brdf, Brdf::Measured { .. }))?;
+    let name = brdf_name(&sharpest_brdf(m, scene));
+    lobes.iter().position(|b| brdf_name(b) == name)
+}
+
+/// The shading options the surfaces of lobe `lobe` of `lobes` are rendered with: those of the first material
 /// some mesh uses whose sharpest lobe it is (`--tolerance` chooses the same for every material of a lobe).
-fn lobe_shading(scene: &Scene, settings: &RenderSettings, lobe: &Brdf) -> ShadingOptions {
-    let name = brdf_name(lobe);
+fn lobe_shading(scene: &Scene, settings: &RenderSettings, lobes: &[Brdf], lobe: usize) -> ShadingOptions {
     scene
         .meshes
         .iter()
         .map(|m| m.material)
-        .find(|&i| {
-            scene.materials.get(i).is_some_and(|m| {
-                !matches!(m.brdf, Brdf::Measured { .. }) && brdf_name(&sharpest_brdf(m, scene)) == name
-            })
-        })
+        .find(|&i| lobe_of(scene, lobes, i) == Some(lobe))
         .map_or(settings.shading, |i| settings.shading_for(i))
 }
 
@@ -268,7 +271,7 @@ pub fn predict_with_peak(
         let arithmetic = renderer.arithmetic();
         // Each lobe with the sun model of its materials (`RenderSettings::shading_for`).
         let brdfs = scene_brdfs(scene);
-        let models: Vec<ShadingOptions> = brdfs.iter().map(|b| lobe_shading(scene, settings, b)).collect();
+        let models: Vec<ShadingOptions> = (0..brdfs.len()).map(|i| lobe_shading(scene, settings, &brdfs, i)).collect();
         let any_delta = models.iter().any(|m| m.sun == SunModel::Delta);
         let horizons = if any_delta { horizon_terms(scene, settings, arithmetic, rendered) } else { None };
         let model = |m: &ShadingOptions| match (m.sun, rendered.is_some() && horizons.is_some()) {
@@ -399,11 +402,6 @@ impl Choice {
     pub fn apply(self, settings: &mut RenderSettings) {
         settings.shading = self.shading;
         settings.sun_per_material = self.sun_per_material;
-    }
-
-    /// The sun's grid side of the material of the finest grid (the render's `sun_samples_per_axis`).
-    pub fn sun_samples_per_axis(&self) -> u32 {
-        self.shading.sun_samples_per_axis
     }
 }
 
@@ -569,21 +567,14 @@ pub(crate) fn choose_sun_within(
         };
         chosen.push(SunChoice { sun: SunModel::Disk, sun_samples_per_axis: k });
     }
-    let disks = chosen.iter().filter(|c| c.sun == SunModel::Disk);
-    shading.sun = if disks.clone().next().is_some() { SunModel::Disk } else { SunModel::Delta };
-    shading.sun_samples_per_axis = disks.map(|c| c.sun_samples_per_axis).max().unwrap_or(shading.sun_samples_per_axis);
+    let finest = chosen.iter().filter(|c| c.sun == SunModel::Disk).map(|c| c.sun_samples_per_axis).max();
+    shading.sun = if finest.is_some() { SunModel::Disk } else { SunModel::Delta };
+    shading.sun_samples_per_axis = finest.unwrap_or(shading.sun_samples_per_axis);
     if chosen.windows(2).all(|w| w[0] == w[1]) {
         return Ok(Choice::uniform(shading));
     }
     // Each material gets its lobe's choice.
-    let sun_per_material = scene
-        .materials
-        .iter()
-        .map(|m| {
-            let name = brdf_name(&sharpest_brdf(m, scene));
-            brdfs.iter().position(|b| brdf_name(b) == name).map(|i| chosen[i])
-        })
-        .collect();
+    let sun_per_material = (0..scene.materials.len()).map(|m| lobe_of(scene, &brdfs, m).map(|i| chosen[i])).collect();
     Ok(Choice { shading, sun_per_material })
 }
 

@@ -210,7 +210,7 @@ fn lobe_study<T, E>(
     };
     // The lobe grids alone, over several specular materials: a study per material (`super::material_study`).
     if !sun_grid && !shadow_grid {
-        let materials = specular_materials(request, settings, reference);
+        let materials = specular_materials(scene, settings, reference);
         if materials.len() > 1 {
             return study_per_material(request, settings, (tolerance, budget), materials, render, image_of);
         }
