@@ -846,3 +846,34 @@ fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
     assert!(o.status.success(), "{e}");
     Some(e)
 }
+
+#[test]
+fn a_shadow_map_render_under_the_sky_predicts_the_sky_through_occluders() {
+    use sunshade::accuracy::error::image_error;
+    use sunshade::accuracy::predicted::{predict, Barycentrics, Renderer};
+    // overcast.glb: the sky alone, through the teapot onto its floor. Shadow maps are the sun's and the disk
+    // lights'; the sky has none, so a map render lets the sky through the teapot, as shadows off would.
+    let scene = common::load(std::path::Path::new("models/overcast.glb"));
+    let mut map = settings::resolve_with(&scene, 32, 24, &CameraOptions::default(), &LightOptions::default()).unwrap();
+    assert!(map.lights.sky.is_some() && sunshade::visibility::can_occlude(&scene));
+    map.shading.shadows = Shadows::Map;
+    let renderer = Renderer::Gpu { barycentrics: Barycentrics::F64 };
+    let p = predict(&scene, &map, renderer, true);
+    assert!(p.max_relative >= 1.0, "{}", p.line());
+    assert!(p.line().contains("the sky unshadowed"), "{}", p.line());
+    // What that term stands for, measured: the map's image against the one whose sky rays see the teapot.
+    let mut rays = map.clone();
+    rays.shading.shadows = Shadows::Ray;
+    let reference = ReferenceOptions::default();
+    let e = image_error(&cpu::render(&scene, &map, &reference), &cpu::render(&scene, &rays, &reference), None).unwrap();
+    assert!(e.max_rel > 0.1, "the teapot hides little of the sky from its floor: {}", e.max_rel);
+    // Without a sky the maps are left unbounded, not taken as the sky's whole light.
+    let mut sunlit = map.clone();
+    sunlit.lights.sky = None;
+    let p = predict(&scene, &sunlit, renderer, true);
+    assert!(
+        !p.line().contains("the sky unshadowed") && p.unbounded.iter().any(|u| u == "the shadow maps"),
+        "{}",
+        p.line()
+    );
+}

@@ -318,7 +318,7 @@ pub fn predict_with_peak(
         p.terms.push((estimate.term(), estimate.gci));
         p.max_relative += estimate.gci;
     }
-    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, lobes);
+    occlusion_and_arithmetic(&mut p, settings, renderer, can_occlude, lobes);
     p
 }
 
@@ -346,27 +346,35 @@ fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude
     if lights.sky.is_some() {
         p.terms.push(("irradiance of the sky (closed form):".into(), 0.0));
     }
-    occlusion_and_arithmetic(&mut p, shading, renderer, can_occlude, None);
+    occlusion_and_arithmetic(&mut p, settings, renderer, can_occlude, None);
     p
 }
 
-/// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, and what no bound
-/// covers: penumbrae unless `estimate` refined the shadow rays' grids), and the renderer's arithmetic and
-/// interpolation.
+/// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, the sky's light
+/// through occluders where shadow maps leave it unoccluded, and what no bound covers: the maps, penumbrae unless
+/// `estimate` refined the shadow rays' grids), and the renderer's arithmetic and interpolation.
 fn occlusion_and_arithmetic(
     p: &mut Prediction,
-    shading: &ShadingOptions,
+    settings: &RenderSettings,
     renderer: Renderer,
     can_occlude: bool,
     estimate: Option<&LobeEstimate>,
 ) {
     if can_occlude {
-        match shading.shadows {
+        match settings.shading.shadows {
             Shadows::None => {
                 p.terms.push(("shadows off in a scene that can shadow itself:".into(), 1.0));
                 p.max_relative = 1.0;
             }
-            Shadows::Map => p.unbounded.push("the shadow maps".into()),
+            Shadows::Map => {
+                // The maps are the sun's and the disk lights'; the sky has none and shines through occluders,
+                // as with shadows off (a point under a body gets the sky's whole light for none).
+                if settings.lights.sky.is_some() {
+                    p.terms.push(("the sky unshadowed (shadow maps are the sun's and disk lights'):".into(), 1.0));
+                    p.max_relative = 1.0;
+                }
+                p.unbounded.push("the shadow maps".into())
+            }
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
             _ => p
                 .unbounded
