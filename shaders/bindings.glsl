@@ -79,11 +79,6 @@ layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE o
 // gpu::layout::MAX_DISK_MAPS.
 #define MAX_DISK_MAPS 4u
 
-// The most points a side with a Gauss-Legendre rule in gauss_legendre_nodes, and the fewest on which the sky's lobe
-// grids take one (shading::quadrature::GAUSS_LEGENDRE_MAX_SIDE, shading::sky_lune::SKY_GAUSS_LEGENDRE_MIN_SIDE).
-#define GAUSS_LEGENDRE_MAX_SIDE 256u
-#define SKY_GAUSS_LEGENDRE_MIN_SIDE 24u
-
 // A material's use of a texture: the texture-coordinate transform (KHR_texture_transform) rows, the texture and
 // its coordinate set.
 struct TextureRefGpu {
@@ -192,13 +187,6 @@ layout(std430, set = 0, binding = 12) readonly buffer BvhNodes {
 // file share one copy. One zero sample where no material is measured.
 layout(std430, set = 0, binding = 11) readonly buffer MeasuredBuffer {
     vec4 measured_values[];
-};
-
-// Every Gauss-Legendre rule of 1 to GAUSS_LEGENDRE_MAX_SIDE nodes on (0, 1), the rule of k nodes from offset
-// k (k - 1) / 2, each node (u, k w): its point and its weight over the midpoint rule's 1/k, rounded to f32 as the
-// reference takes them (shading::quadrature::gauss_legendre_table).
-layout(std430, set = 0, binding = 13) readonly buffer GaussLegendreTable {
-    vec2 gauss_legendre_nodes[];
 };
 
 // Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with

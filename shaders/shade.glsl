@@ -298,28 +298,6 @@ float measured_sampling_alpha(float lobe_width) {
     return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
 }
 
-// How a lobe grid places its points on an axis' unit interval (shading::quadrature::GridRule).
-const uint GRID_MIDPOINT = 0u;
-const uint GRID_GAUSS_LEGENDRE = 1u;
-
-// Node i of k under rule: (u, s), the point in (0, 1) and its weight times k (exactly 1 for the midpoint rule);
-// Gauss-Legendre's from the table, up to GAUSS_LEGENDRE_MAX_SIDE nodes (see quadrature.rs).
-vec2 grid_node(uint rule, uint i, uint k) {
-    if (rule == GRID_GAUSS_LEGENDRE && k <= GAUSS_LEGENDRE_MAX_SIDE) {
-        return gauss_legendre_nodes[k * (k - 1u) / 2u + i];
-    }
-    return vec2((float(i) + 0.5) / float(k), 1.0);
-}
-
-// The rule of the sky's lobe grids: Gauss-Legendre for the isotropic analytic lobes from
-// SKY_GAUSS_LEGENDRE_MIN_SIDE to GAUSS_LEGENDRE_MAX_SIDE points a side, midpoints otherwise (see sky_lune.rs).
-uint sky_grid_rule(MaterialGpu m, uint per_axis) {
-    bool isotropic = VARIANT_BRDF == BRDF_PHONG || VARIANT_BRDF == BRDF_BLINN_PHONG
-        || (VARIANT_BRDF == BRDF_WARD && m.params.x == m.params.y);
-    bool sized = per_axis >= SKY_GAUSS_LEGENDRE_MIN_SIDE && per_axis <= GAUSS_LEGENDRE_MAX_SIDE;
-    return isotropic && sized ? GRID_GAUSS_LEGENDRE : GRID_MIDPOINT;
-}
-
 // integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
 // lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
 // (see the Rust).
@@ -332,13 +310,9 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
     vec3 t = orthonormal_to(axis);
     vec3 b = cross(axis, t);
     float k = float(per_axis);
-    // The polar axis by the sky's rule; the azimuth is periodic: midpoints.
-    uint rule = sky_grid_rule(m, per_axis);
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < per_axis; ++i) {
-        vec2 node = grid_node(rule, i, per_axis);
-        float xi1 = node.x;
-        float s1 = node.y;
+        float xi1 = (float(i) + 0.5) / k;
         for (uint j = 0u; j < per_axis; ++j) {
             float xi2 = (float(j) + 0.5) / k;
             float phi = 2.0 * PI * xi2;
@@ -347,7 +321,7 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
                 vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
                 float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
                 if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                    sum += value * s1;
+                    sum += value;
                 }
             } else if (kind == BRDF_BLINN_PHONG) {
                 float e = m.ks.w;
@@ -357,7 +331,7 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
                     vec3 omega = 2.0 * vh * h - v;
                     float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
                     if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value * s1;
+                        sum += value;
                     }
                 }
             } else if (kind == BRDF_WARD) {
@@ -375,7 +349,7 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
                     vec3 omega = 2.0 * vh * h - v;
                     float value = max(dot(n, omega), 0.0) / (vh * cos_d);
                     if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value * s1;
+                        sum += value;
                     }
                 }
             } else if (kind == BRDF_MEASURED) {
@@ -391,7 +365,7 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
                     float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
                     vec3 value = specular_lobe_rgb(m, p, omega) * weight;
                     if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value * s1;
+                        sum += value;
                     }
                 }
             }
@@ -456,20 +430,17 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     GradedAxis psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     GradedAxis lambda_axis = graded_axis(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
     float k = float(per_axis);
-    uint rule = sky_grid_rule(m, per_axis);
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < per_axis; ++i) {
-        vec2 node_psi = grid_node(rule, i, per_axis);
-        vec2 pw = graded_point(psi_axis, node_psi.x);
+        vec2 pw = graded_point(psi_axis, (float(i) + 0.5) / k);
         float sp = sin(pw.x);
         float cp = cos(pw.x);
         for (uint j = 0u; j < per_axis; ++j) {
-            vec2 node_lambda = grid_node(rule, j, per_axis);
-            vec2 lw = graded_point(lambda_axis, node_lambda.x);
+            vec2 lw = graded_point(lambda_axis, (float(j) + 0.5) / k);
             float sl = sin(lw.x);
             float cl = cos(lw.x);
             vec3 omega = cl * (cp * n + sp * b) + sl * e;
-            float weight = cl * cl * max(cp, 0.0) * pw.y * lw.y * (node_psi.y * node_lambda.y);
+            float weight = cl * cl * max(cp, 0.0) * pw.y * lw.y;
             vec3 value = specular_lobe_rgb(m, p, omega) * weight;
             if (lune == LUNE_BELOW || !any(greaterThan(value, vec3(0.0))) || !shadowed
                 || visible_along(p.shadow_origin, omega)) {

@@ -434,9 +434,6 @@ mod tests {
             assert!(glsl.contains(&format!("#define {name} {value}u\n")), "bindings.glsl: {name} is not {value}u");
         }
         assert!(glsl.contains(&format!("#define MAX_DISK_MAPS {MAX_DISK_MAPS}u\n")));
-        use crate::shading::{quadrature::GAUSS_LEGENDRE_MAX_SIDE, sky_lune::SKY_GAUSS_LEGENDRE_MIN_SIDE};
-        assert!(glsl.contains(&format!("#define GAUSS_LEGENDRE_MAX_SIDE {GAUSS_LEGENDRE_MAX_SIDE}u\n")));
-        assert!(glsl.contains(&format!("#define SKY_GAUSS_LEGENDRE_MIN_SIDE {SKY_GAUSS_LEGENDRE_MIN_SIDE}u\n")));
         use super::super::loop_budget::{LOOP_BUDGET_SPENT, LOOP_PROBE_ITERATIONS};
         assert!(glsl.contains(&format!("#define LOOP_PROBE_ITERATIONS {LOOP_PROBE_ITERATIONS}u\n")));
         assert!(glsl.contains(&format!("#define LOOP_BUDGET_SPENT {LOOP_BUDGET_SPENT:.1}\n")));

@@ -89,7 +89,7 @@ impl ScenePipeline {
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
             // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table, 9 the surface
-            // vertices, 10 the occluder triangles, 11 the measured BRDF tables, 13 the Gauss–Legendre rules (storage buffers); 7 the texels (a uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel
+            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the texels (a uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel
             // buffer holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always
             // bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices
             // with ray queries, or 12 the occluders' BVH nodes (a storage buffer), on devices without. All read by the fragment shader. The descriptor pool is sized from the same table.
@@ -102,7 +102,6 @@ impl ScenePipeline {
                 (9, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (10, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (11, vk::DescriptorType::STORAGE_BUFFER, 1),
-                (13, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (7, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),

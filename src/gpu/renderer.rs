@@ -74,8 +74,6 @@ pub struct GpuScene {
     walk: std::cell::OnceCell<(Buffer, Buffer)>,
     /// The measured BRDF tables (`layout::measured_tables`).
     measured: Buffer,
-    /// Every Gauss–Legendre rule the lobe grids may take (`shading::quadrature::gauss_legendre_table`).
-    gauss_legendre: Buffer,
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
@@ -422,11 +420,6 @@ impl Renderer {
             walk_source,
             walk: std::cell::OnceCell::new(),
             measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
-            gauss_legendre: Buffer::storage(
-                &self.dev,
-                bytemuck::cast_slice(crate::shading::quadrature::gauss_legendre_table()),
-                "Gauss–Legendre rules",
-            )?,
             draws,
             // Decided here, once per upload (24 ms for 20k triangles): `auto` renders no shadow pass where it is
             // false, on any device.
@@ -642,8 +635,7 @@ impl Renderer {
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, 13 the
-                // Gauss–Legendre rules, and
+                // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
                 // 12 the occluders' BVH for the pipelines whose shadow rays walk it.
                 let mut buffers = vec![
                     (0, scene.materials.buffer),
@@ -654,7 +646,6 @@ impl Renderer {
                     (9, scene.surface_vertices.buffer),
                     (10, scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, records)| records.buffer)),
                     (11, scene.measured.buffer),
-                    (13, scene.gauss_legendre.buffer),
                 ];
                 if self.pipeline.rays_walk_bvh() {
                     buffers.push((12, scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer)));

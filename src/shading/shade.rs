@@ -603,11 +603,9 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
     let t = orthonormal_to(axis);
     let b = axis.cross(t);
     let k = per_axis as f64;
-    // The polar axis by the sky's rule (`sky_lune::sky_grid_rule`); the azimuth is periodic: midpoints.
-    let rule = super::sky_lune::sky_grid_rule(brdf, per_axis);
     let mut sum = [0.0; 3];
     for i in 0..per_axis {
-        let (xi1, s1) = super::quadrature::grid_node(rule, i, per_axis);
+        let xi1 = (i as f64 + 0.5) / k;
         for j in 0..per_axis {
             let xi2 = (j as f64 + 0.5) / k;
             let phi = 2.0 * PI * xi2;
@@ -678,7 +676,7 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
             if !value.iter().any(|&x| x > 0.0) || visible(omega) {
                 for (s, x) in sum.iter_mut().zip(value) {
-                    *s += x * s1;
+                    *s += x;
                 }
             }
         }

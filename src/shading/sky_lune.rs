@@ -27,7 +27,6 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::brdf::mirror;
-use super::quadrature::{grid_node, GridRule, GAUSS_LEGENDRE_MAX_SIDE};
 use super::shade::{graded_axis, graded_point, lobe_width, orthonormal_to, specular_lobe_rgb, SurfacePoint};
 use super::visibility::Shadowing;
 use crate::scene::Brdf;
@@ -73,39 +72,6 @@ pub fn sky_lune_blend(brdf: &Brdf, p: &SurfacePoint) -> f64 {
     below * (tilt / quarter).min(1.0)
 }
 
-/// The fewest points a side on which the sky's lobe grids take Gauss–Legendre nodes ([`sky_grid_rule`]).
-pub const SKY_GAUSS_LEGENDRE_MIN_SIDE: u32 = 24;
-
-/// The rule of the sky's lobe grids (both lunes' axes and the hemisphere grid's polar axis; its azimuth is
-/// periodic, where the midpoint rule is already spectrally accurate) for `brdf` on `per_axis` points a side:
-/// Gauss–Legendre for the isotropic analytic lobes (Phong, Blinn-Phong, Ward with αx = αy) from
-/// [`SKY_GAUSS_LEGENDRE_MIN_SIDE`] to [`GAUSS_LEGENDRE_MAX_SIDE`] points a side, the midpoint rule otherwise.
-///
-/// Measured (the worst normal of a sphere seen along one direction against the integral on 512² or 1024², as
-/// `cargo run --release --example sky_lobe_tails` prints it), Gauss–Legendre against the midpoint rule at 24²:
-/// Phong e = 80 2.0e-5 against 6.6e-4, e = 1e3 9.1e-4 / 1.4e-3, e = 1e4 3.1e-4 / 6.2e-4; Blinn-Phong e = 300
-/// 4.3e-4 / 2.6e-3, e = 3000 6.2e-4 / 1.5e-3; Ward α = 0.15 7.8e-5 / 1.0e-2, α = 0.05 1.1e-3 / 5.0e-3; at 48²
-/// e = 1e4 2.7e-6 / 1.6e-4, Ward α = 0.05 2.8e-6 / 1.3e-3. At 16² the midpoint rule was the better for four of
-/// those seven lobes (Phong e = 1e4: 1.4e-3 against 7.3e-3), and much the better at 4² to 12²: the warped lobe is
-/// not resolved yet, and Gauss–Legendre's middle points are about π/2 times as far apart; so the default 16² stays
-/// on it. One configuration favours the midpoint rule beyond: a peak exactly on the lune's edge, symmetric about
-/// it (a vertical wall seen head-on), where its error terms vanish by symmetry (Phong e = 1e6 at 32²: 7.7e-5
-/// against 2.3e-3; at 48² 6.9e-7 against 1.5e-5). The anisotropic Ward stays on the midpoint rule: its lune grid
-/// has one width where the lobe has two, and there Gauss–Legendre measured worse at every size (24²: 1.3e-1
-/// against 4.8e-2). A measured table's piecewise-linear lookup is not analytic.
-pub fn sky_grid_rule(brdf: &Brdf, per_axis: u32) -> GridRule {
-    let analytic_isotropic = match *brdf {
-        Brdf::Phong { .. } | Brdf::BlinnPhong { .. } => true,
-        Brdf::Ward { alpha_x, alpha_y, .. } => alpha_x == alpha_y,
-        Brdf::Lambert { .. } | Brdf::Measured { .. } => false,
-    };
-    if analytic_isotropic && (SKY_GAUSS_LEGENDRE_MIN_SIDE..=GAUSS_LEGENDRE_MAX_SIDE).contains(&per_axis) {
-        GridRule::GaussLegendre
-    } else {
-        GridRule::Midpoint
-    }
-}
-
 /// `∫ lobe(ω) (n·ω)+ dω` over one lune of the surface's hemisphere (`Below` or `Above` the horizontal), per unit
 /// radiance, per channel: a `per_axis²` midpoint grid in lune coordinates graded about the lobe's peak (see the
 /// module's text), each sample of the upper lune casting its shadow ray along ω where `shadow` is given (the lower
@@ -146,20 +112,16 @@ pub fn sky_lobe_in_lune(
     let psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     let lambda_axis = graded_axis(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
     let k = per_axis as f64;
-    let rule = sky_grid_rule(brdf, per_axis);
     let mut sum = [0.0; 3];
     for i in 0..per_axis {
-        let (u_psi, s_psi) = grid_node(rule, i, per_axis);
-        let (psi, d_psi) = graded_point(&psi_axis, u_psi);
+        let (psi, d_psi) = graded_point(&psi_axis, (i as f64 + 0.5) / k);
         let (sp, cp) = psi.sin_cos();
         for j in 0..per_axis {
-            let (u_lambda, s_lambda) = grid_node(rule, j, per_axis);
-            let (lambda, d_lambda) = graded_point(&lambda_axis, u_lambda);
+            let (lambda, d_lambda) = graded_point(&lambda_axis, (j as f64 + 0.5) / k);
             let (sl, cl) = lambda.sin_cos();
             let omega = cl * (cp * n + sp * b) + sl * e;
-            // (n·ω) dω = cos λ cos ψ · cos λ dψ dλ; cos ψ ≥ 0 on the hemisphere. The rule's weights (1 for the
-            // midpoint rule: its sums unchanged to the last bit).
-            let weight = cl * cl * cp.max(0.0) * d_psi * d_lambda * (s_psi * s_lambda);
+            // (n·ω) dω = cos λ cos ψ · cos λ dψ dλ; cos ψ ≥ 0 on the hemisphere.
+            let weight = cl * cl * cp.max(0.0) * d_psi * d_lambda;
             let lobe = specular_lobe_rgb(brdf, p, omega).map(|l| l * weight);
             // A sample of the sky that contributes casts its shadow ray.
             if lune == Lune::Below || !lobe.iter().any(|&x| x > 0.0) || shadow.is_none_or(|s| s.visible_along(omega)) {
@@ -215,13 +177,11 @@ mod tests {
         // the lower lune holds exactly half of the hemisphere's integral (1 for these normalised lobes).
         let n = DVec3::X;
         let p = point(n, n);
-        // A lobe of e = 1e6 (0.06° wide) with its peak on the lune's edge needs 32² on the midpoint rule (16²:
-        // 2.2e-2; 32²: 1.5e-4) and 48² on Gauss–Legendre, which the sky's grids take from 24² (32²: 2.3e-3;
-        // 48²: 1.5e-5; see `sky_grid_rule`).
+        // A lobe of e = 1e6 (0.06° wide) with its peak on the lune's edge needs 32² (16²: 2.2e-2; 32²: 1.5e-4).
         for (brdf, k) in [
             (Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 100.0 }, 16),
             (Brdf::BlinnPhong { kd: [0.0; 3], ks: [1.0; 3], exponent: 100.0 }, 16),
-            (Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 1e6 }, 48),
+            (Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 1e6 }, 32),
         ] {
             // The whole hemisphere's integral: the same configuration on a floor, where nothing is below.
             let whole = sky_lobe_integral(&brdf, &point(DVec3::Y, DVec3::Y), 256);
@@ -278,68 +238,6 @@ mod tests {
                 let got = sky_lobe_integral(&brdf, &p, 64);
                 assert!((got - want).abs() < 2e-3 * want.max(1e-2), "{brdf:?} {n} {v}: {got} vs {want}");
             }
-        }
-    }
-
-    /// The upper lune's integral by composite Gauss–Legendre on uniform panels of the lune's coordinates (96 × 96
-    /// panels of 8 × 8 points, no warp): a rule of its own to check [`sky_lobe_integral`]'s graded grids against.
-    fn upper_lune_composite(brdf: &Brdf, p: &SurfacePoint) -> f64 {
-        use crate::shading::quadrature::integrate_composite;
-        let n = p.normal;
-        let (across, tilt) = up_across(n);
-        let sin_t = across.length();
-        let b = if sin_t > 0.0 { across / sin_t } else { orthonormal_to(n) };
-        let e = n.cross(b);
-        integrate_composite(tilt - FRAC_PI_2, FRAC_PI_2, 96, 8, |psi| {
-            let (sp, cp) = psi.sin_cos();
-            integrate_composite(-FRAC_PI_2, FRAC_PI_2, 96, 8, |lambda| {
-                let (sl, cl) = lambda.sin_cos();
-                specular_lobe_rgb(brdf, p, cl * (cp * n + sp * b) + sl * e)[0] * cl * cl * cp.max(0.0)
-            })
-        })
-    }
-
-    #[test]
-    fn gauss_legendre_sky_grids_converge_fast_on_isotropic_lobes() {
-        let (kd, ks) = ([0.0; 3], [1.0; 3]);
-        let aniso = Brdf::Ward { kd, ks, alpha_x: 0.05, alpha_y: 0.3 };
-        let phong = Brdf::Phong { kd, ks, exponent: 80.0 };
-        assert_eq!(sky_grid_rule(&aniso, 24), GridRule::Midpoint);
-        assert_eq!(sky_grid_rule(&phong, SKY_GAUSS_LEGENDRE_MIN_SIDE - 1), GridRule::Midpoint);
-        assert_eq!(sky_grid_rule(&phong, SKY_GAUSS_LEGENDRE_MIN_SIDE), GridRule::GaussLegendre);
-        assert_eq!(sky_grid_rule(&phong, GAUSS_LEGENDRE_MAX_SIDE + 1), GridRule::Midpoint);
-        // brdfs.glb's isotropic lobes over the visible normals of a sphere seen along one direction (a 6 × 6 scan
-        // of the sphere's upper half): every regime of the lune blend, grazing views included. The error of
-        // each normal relative to the larger of its value and 1% of the lobe's peak (the diff's floor).
-        let v = DVec3::new(0.0, 0.3, 1.0).normalize();
-        for brdf in
-            [phong, Brdf::BlinnPhong { kd, ks, exponent: 300.0 }, Brdf::Ward { kd, ks, alpha_x: 0.15, alpha_y: 0.15 }]
-        {
-            let mut cases = Vec::new();
-            for i in 0..6 {
-                for j in 0..6 {
-                    let (th, ph) = ((i as f64 + 0.5) / 6.0 * PI, (j as f64 + 0.5) / 6.0 * PI);
-                    let n = DVec3::new(th.cos(), ph.cos() * th.sin(), ph.sin() * th.sin());
-                    if n.dot(v) > 0.02 {
-                        let p = point(n, v);
-                        let truth = upper_lune_composite(&brdf, &p);
-                        cases.push((p, truth));
-                    }
-                }
-            }
-            let peak = cases.iter().map(|c| c.1).fold(0.0, f64::max);
-            let worst = |k: u32| {
-                cases
-                    .iter()
-                    .map(|(p, truth)| (sky_lobe_integral(&brdf, p, k) - truth).abs() / truth.max(0.01 * peak))
-                    .fold(0.0, f64::max)
-            };
-            let (e19, e24, e32) = (worst(19), worst(24), worst(32));
-            eprintln!("{brdf:?}: {e19:.1e} {e24:.1e} {e32:.1e}");
-            assert!(e24 < 1e-3 && e32 < 1e-4, "{brdf:?}: 24² {e24:.1e}, 32² {e32:.1e}");
-            // From the midpoint rule's 19² (the ladder's rung below) to Gauss–Legendre's 24²: more than the
-            // (24/19)² = 1.6 that the same rule's second order gives.
-            assert!(e24 < e19 / 4.0, "{brdf:?}: 19² {e19:.1e} to 24² {e24:.1e}");
         }
     }
 }
