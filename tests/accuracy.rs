@@ -848,7 +848,7 @@ fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
 }
 
 #[test]
-fn a_shadow_map_render_under_the_sky_predicts_the_sky_through_occluders() {
+fn shadow_map_renders_predict_the_light_no_map_covers() {
     use sunshade::accuracy::error::image_error;
     use sunshade::accuracy::predicted::{predict, Barycentrics, Renderer};
     // overcast.glb: the sky alone, through the teapot onto its floor. Shadow maps are the sun's and the disk
@@ -876,4 +876,18 @@ fn a_shadow_map_render_under_the_sky_predicts_the_sky_through_occluders() {
         "{}",
         p.line()
     );
+    assert!(p.max_relative < 1.0, "{}", p.line());
+    // Disk lights have maps up to MAPPED_DISKS; one more shines through the teapot as the sky does.
+    let disk = |x: f32| sunshade::scene::DiskLight {
+        center: glam::Vec3::new(x, 3.0, 0.0),
+        direction: glam::Vec3::NEG_Y,
+        radius: 0.2,
+        radiance: [10.0; 3],
+    };
+    let mut disks = sunlit.clone();
+    disks.lights.disks = (0..sunshade::shading::MAPPED_DISKS).map(|i| disk(i as f32)).collect();
+    assert!(predict(&scene, &disks, renderer, true).max_relative < 1.0);
+    disks.lights.disks.push(disk(-1.0));
+    let p = predict(&scene, &disks, renderer, true);
+    assert!(p.max_relative >= 1.0 && p.line().contains("disk lights after the first"), "{}", p.line());
 }

@@ -367,10 +367,17 @@ fn occlusion_and_arithmetic(
                 p.max_relative = 1.0;
             }
             Shadows::Map => {
-                // The maps are the sun's and the disk lights'; the sky has none and shines through occluders,
-                // as with shadows off (a point under a body gets the sky's whole light for none).
+                // The maps are the sun's and the first MAPPED_DISKS disk lights'; the sky and further disks have
+                // none and shine through occluders, as with shadows off (a point under a body gets their whole
+                // light for none).
                 if settings.lights.sky.is_some() {
                     p.terms.push(("the sky unshadowed (shadow maps are the sun's and disk lights'):".into(), 1.0));
+                    p.max_relative = 1.0;
+                }
+                if settings.lights.disks.len() > crate::shading::MAPPED_DISKS {
+                    let term =
+                        format!("disk lights after the first {} unshadowed (no map):", crate::shading::MAPPED_DISKS);
+                    p.terms.push((term, 1.0));
                     p.max_relative = 1.0;
                 }
                 p.unbounded.push("the shadow maps".into())
