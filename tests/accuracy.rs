@@ -851,8 +851,8 @@ fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
 fn shadow_map_renders_predict_the_light_no_map_covers() {
     use sunshade::accuracy::error::image_error;
     use sunshade::accuracy::predicted::{predict, Barycentrics, Renderer};
-    // overcast.glb: the sky alone, through the teapot onto its floor. Shadow maps are the sun's and the disk
-    // lights'; the sky has none, so a map render lets the sky through the teapot, as shadows off would.
+    // overcast.glb: the sky alone, through the teapot onto its floor. Shadow maps are the sun's and the first
+    // disk lights'; the sky has none, so a map render lets the sky through the teapot, as shadows off would.
     let scene = common::load(std::path::Path::new("models/overcast.glb"));
     let mut map = settings::resolve_with(&scene, 32, 24, &CameraOptions::default(), &LightOptions::default()).unwrap();
     assert!(map.lights.sky.is_some() && sunshade::visibility::can_occlude(&scene));

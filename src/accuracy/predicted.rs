@@ -350,9 +350,10 @@ fn predict_irradiance(settings: &RenderSettings, renderer: Renderer, can_occlude
     p
 }
 
-/// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, the sky's light
-/// through occluders where shadow maps leave it unoccluded, and what no bound covers: the maps, penumbrae unless
-/// `estimate` refined the shadow rays' grids), and the renderer's arithmetic and interpolation.
+/// The terms every prediction shares: occlusion (shadows off in a scene that can shadow itself, the light of the
+/// sky and of disk lights past the mapped ones through occluders where shadow maps leave them unoccluded, and what
+/// no bound covers: the maps, penumbrae unless `estimate` refined the shadow rays' grids), and the renderer's
+/// arithmetic and interpolation.
 fn occlusion_and_arithmetic(
     p: &mut Prediction,
     settings: &RenderSettings,
