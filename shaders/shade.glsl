@@ -17,6 +17,9 @@ const bool SHADOWS_MAP_ON = VARIANT_SHADOWS == SHADOWS_MAP;
 // The sun's and the first disks' visible fractions from their maps, found by irradiance_visible and reused for the
 // specular part.
 float sun_map_fraction = 1.0;
+// The sun's visible fraction from the shadow rays' located grid, found by irradiance_visible: the specular part
+// casts its lobe samples' rays only where it is strictly between 0 and 1 (see irradiance_and_sun_fraction).
+float sun_ray_fraction = 1.0;
 float disk_map_fraction[MAX_DISK_MAPS] = float[](1.0, 1.0, 1.0, 1.0);
 
 // Which shadow rays a lobe integral's samples cast (Rust: Option<SampleRays>).
@@ -63,6 +66,7 @@ vec3 irradiance_visible(Frame p) {
         if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
             v = VARIANT_SUN == SUN_DELTA ? (visible_along(p.shadow_origin, l) ? 1.0 : 0.0)
                                          : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+            sun_ray_fraction = v;
         }
         if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
             bool pcss = VARIANT_SUN != SUN_DELTA && lights.sampling.z == 1u;
@@ -492,9 +496,14 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
             float radius = tan(0.5 * delta);
+            // The lobe's samples cast rays only in the sun's penumbra (see the Rust).
+            bool penumbra = sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
             SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
-                SHADOWS_ON ? RAYS_ALONG : RAYS_NONE);
+                SHADOWS_ON && penumbra ? RAYS_ALONG : RAYS_NONE);
             vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
+            if (SHADOWS_ON && sun_ray_fraction == 0.0) {
+                integral = vec3(0.0);
+            }
             // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the
             // sun is wholly visible or wholly hidden).
             if (SHADOWS_MAP_ON) {

@@ -905,3 +905,71 @@ fn gpu_ray_queries_keep_the_sky_through_occluders_under_tolerance() {
     eprintln!("overcast.glb on the GPU, T = 1e-2 in penumbrae: measured {measured:.2e} against 128²; {line}");
     assert!(measured <= 1e-2, "{measured:.3e} over 1e-2\n{e}");
 }
+
+/// The specular radiance [W/(m²·sr)] of a Phong floor (ks = 1, exponent `e`, kd = 0) at x under the roof of
+/// [`edge_scene`] (height 1), seen straight down, under a zenith sun of half-angle σ and perpendicular irradiance
+/// E: `L_sun ∫ lobe(ω) (n·ω) V(ω) dω` over the sun's cap, the roof hiding `X < −x` in the tangent-plane
+/// coordinates `P = (X, 1, Z)` of [`zenith_sun_fraction_under_edge`]. The mirror direction is the zenith, so
+/// `lobe (n·ω) dω = (e + 2)/(2π) |P|^−(e + 4) dX dZ`; Z in closed form would need a hypergeometric function, so
+/// both by Gauss–Legendre (X = T sin θ, Z across the cap's chord).
+fn zenith_phong_specular_under_edge(x: f64, e: f64, half_angle: f64, e_perp: f64) -> f64 {
+    let t = half_angle.tan();
+    let l_sun = e_perp / (PI * half_angle.sin().powi(2));
+    let strip = |theta: f64| {
+        let (xx, s) = (t * theta.sin(), t * theta.cos());
+        let across = integrate_composite(-s, s, 16, 8, |z| (1.0 + xx * xx + z * z).powf(-(e + 4.0) / 2.0));
+        across * t * theta.cos()
+    };
+    let c = (-x / t).clamp(-1.0, 1.0);
+    l_sun * (e + 2.0) / (2.0 * PI) * integrate_composite(c.asin(), 0.5 * PI, 64, 8, strip)
+}
+
+#[test]
+fn specular_lobes_in_the_suns_penumbra_meet_their_quadrature() {
+    // A Phong floor (e = 100, a lobe about 6° wide) under the roof's edge and a 10° sun at the zenith, seen
+    // straight down: the mirror direction is the sun's centre, so the lobe varies across the disk and its
+    // visible part is not the diffuse part's fraction. The lobe's samples cast rays only where the shadow rays'
+    // located grid finds the sun partly hidden; elsewhere the lobe is whole (lit) or 0 (umbra).
+    let exponent = 100.0;
+    let phong = Material {
+        double_sided: false,
+        ..Material::with_brdf("phong", Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent })
+    };
+    let roof = quad(Vec3::new(-5.0, 1.0, 0.0), Vec3::new(5.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 5.0));
+    let scene = common::scene_of(&[floor(1.0), roof], phong);
+    let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
+    let half_angle = (10f64.to_radians() as f32 as f64) / 2.0;
+    let mut s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, 16);
+    s.shading.sun_samples_per_axis = 32;
+    let image = cpu::render(&scene, &s, &ReferenceOptions::default());
+    let unoccluded = zenith_phong_specular_under_edge(1.0, exponent as f64, half_angle, E_PERP as f64);
+    let (mut lit, mut umbra, mut penumbra) = (0, 0, 0);
+    let mut worst = 0.0f64;
+    for x in 0..s.width {
+        let p = floor_point(&s, x, 4);
+        let got = image.get(x, 4)[0] as f64;
+        let want = zenith_phong_specular_under_edge(p.x, exponent as f64, half_angle, E_PERP as f64);
+        let t = half_angle.tan();
+        if p.x > t * 1.02 {
+            // Wholly lit: the lobe's grid alone (no ray can change it).
+            assert!((got - want).abs() <= 2e-3 * unoccluded, "lit at x = {}: {got} against {want}", p.x);
+            lit += 1;
+        } else if p.x < -t * 1.02 {
+            assert_eq!(got, 0.0, "umbra at x = {}", p.x);
+            umbra += 1;
+        } else {
+            // A point count of the lobe's 32² samples: first order, each sample worth up to a few /32² of the
+            // peak where the edge crosses the lobe's middle.
+            worst = worst.max((got - want).abs() / unoccluded);
+            penumbra += 1;
+        }
+    }
+    eprintln!("lit {lit}, umbra {umbra}, penumbra {penumbra}: worst {worst:.2e} of the unoccluded {unoccluded:.4e}");
+    assert!(lit > 10 && umbra > 10 && penumbra > 20, "{lit} {umbra} {penumbra}");
+    assert!(worst < 2e-2, "penumbra: {worst:.2e} of the unoccluded lobe");
+    // The GPU takes the same classes (validation on; shadow rays by ray queries or the BVH walk).
+    let mut gpu = CheckedRenderer::new();
+    let g = gpu.render(&scene, &s);
+    let (report, _) = compare::diff(&g, &image, &DiffOptions::default()).unwrap();
+    assert!(report.pass, "{}", report.text("gpu", "reference"));
+}

@@ -185,7 +185,20 @@ pub fn irradiance_visible(
     options: &ShadingOptions,
     shadow: Option<&Shadowing>,
 ) -> [f64; 3] {
+    irradiance_and_sun_fraction(point, lights, options, shadow).0
+}
+
+/// [`irradiance_visible`] and the sun's visible fraction it took (1 without a sun, without shadows, or where the
+/// sun's disk is wholly below the surface's horizon), which the specular part reuses: the GPU keeps it in a
+/// global as `irradiance_visible` finds it (`sun_ray_fraction`, as `sun_map_fraction` for maps).
+pub fn irradiance_and_sun_fraction(
+    point: &SurfacePoint,
+    lights: &Lights,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> ([f64; 3], f64) {
     let mut e = [0.0; 3];
+    let mut sun_fraction = 1.0;
     if let Some(sun) = &lights.sun {
         let l = sun.direction.as_dvec3();
         let n_dot_l = point.normal.dot(l);
@@ -204,6 +217,7 @@ pub fn irradiance_visible(
             },
             _ => 1.0,
         };
+        sun_fraction = v;
         for (ec, u) in e.iter_mut().zip(unoccluded) {
             *ec += u * v;
         }
@@ -237,7 +251,7 @@ pub fn irradiance_visible(
             *ec += sky_irradiance(l0 as f64, point.normal.y) * v;
         }
     }
-    e
+    (e, sun_fraction)
 }
 
 /// The specular lobe of a material (without ks) per channel for light from `l`: the analytic lobes' one value in
@@ -691,7 +705,7 @@ pub fn radiance_out(brdf: &Brdf, point: &SurfacePoint, lights: &Lights, options:
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer from the visible part of
 /// each light (`shadow`; `None`: unoccluded): the diffuse part by the lights' visible fractions, each specular
-/// sample by its own shadow ray (`visibility`).
+/// sample by its own shadow ray (`visibility`; the sun's only in its penumbra, see the sun's branch).
 pub fn radiance_out_visible(
     brdf: &Brdf,
     point: &SurfacePoint,
@@ -703,7 +717,7 @@ pub fn radiance_out_visible(
     if point.normal == DVec3::ZERO {
         return [0.0; 3];
     }
-    let e = irradiance_visible(point, lights, options, shadow);
+    let (e, sun_fraction) = irradiance_and_sun_fraction(point, lights, options, shadow);
     let (kd, ks) = (brdf.kd(), brdf.ks());
     let mut radiance = [0, 1, 2].map(|c| lambert_brdf(kd[c] as f64) * e[c]);
     if brdf.is_lambert() {
@@ -728,11 +742,19 @@ pub fn radiance_out_visible(
             SunModel::Disk => {
                 let delta = sun.angular_diameter as f64;
                 let radius = (0.5 * delta).tan();
-                let rays = shadow.map(SampleRays::Along);
+                // The lobe's samples cast their rays only in the sun's penumbra, where its visible fraction (the
+                // diffuse part's, whose grid locates the edges) is strictly between 0 and 1: where that grid sees
+                // all of the disk the lobe is unoccluded, where it sees none the lobe is 0, as the diffuse part
+                // takes them (an occluder slipping between all of that grid's rays is missed by both alike).
+                let penumbra = sun_fraction > 0.0 && sun_fraction < 1.0;
+                let rays = shadow.filter(|_| penumbra).map(SampleRays::Along);
                 let sums =
                     segment_lobe_integral_visible(brdf, point, l, -l, radius, options.sun_samples_per_axis, rays);
-                let integral =
+                let mut integral =
                     normalized_lobe_integral(sums, sun_projected_solid_angle_above(point.normal.dot(l), delta));
+                if shadow.is_some() && sun_fraction == 0.0 {
+                    integral = [0.0; 3];
+                }
                 let s = (0.5 * delta).sin();
                 for ((sc, &perp), integral) in specular.iter_mut().zip(&sun.irradiance).zip(integral) {
                     *sc += integral * perp as f64 / (PI * s * s);
