@@ -5,7 +5,9 @@
 //! For brdfs.glb's four specular lobes, the sky's lobe integral (`shading::sky_lobe_integral`, unit radiance)
 //! over the visible normals of a sphere seen along one direction (24 × 24 normals, those with n·v > 0.02), on
 //! grids of 4², 8², 16², 24² against the same integral on 512²; the error of each normal relative to the larger of
-//! its value and 1% of the lobe's peak over the normals (the diff's floor), the worst and the normal it is at.
+//! its value and 1% of the lobe's peak over the normals (the diff's floor), the worst and the normal it is at;
+//! then the worst over the normals facing the viewer more than halfway (n·v > 0.5), to show that the error is not
+//! only the grazing views'.
 
 use glam::DVec3;
 use sunshade::scene::Brdf;
@@ -42,16 +44,22 @@ fn main() {
         }
         let peak = normals.iter().map(|(_, t)| *t).fold(0.0, f64::max);
         let mut line = format!("{name}:");
+        let mut facing = String::from("  n·v > 0.5:");
         for k in [4u32, 8, 16, 24] {
-            let (mut worst, mut at) = (0.0, 0.0);
+            let (mut worst, mut at, mut worst_facing) = (0.0, 0.0, 0.0f64);
             for (p, truth) in &normals {
                 let e = (sky_lobe_integral(brdf, p, k) - truth).abs() / truth.abs().max(0.01 * peak);
                 if e > worst {
                     (worst, at) = (e, p.normal.dot(v));
                 }
+                if p.normal.dot(v) > 0.5 {
+                    worst_facing = worst_facing.max(e);
+                }
             }
             line += &format!("  {k}²: {worst:.1e} (n·v {at:.2})");
+            facing += &format!("  {k}²: {worst_facing:.1e}");
         }
+        line += &format!("\n{facing}");
         println!("{line}");
     }
 }
