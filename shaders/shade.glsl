@@ -381,6 +381,8 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
 // Which lune of the hemisphere the horizontal splits off (see sky_lune.rs).
 const uint LUNE_BELOW = 0u;
 const uint LUNE_ABOVE = 1u;
+// How much narrower than a lobe's tail the lune grid is graded across its edge (sky_lune::SKY_TAIL_GRADING).
+const float SKY_TAIL_GRADING = 8.0;
 
 // Up's part across the normal n (xyz: up - (n.up) n = sin(t) b) and the surface's tilt t from up (w), by atan2 of
 // that part's length and n.up (see the Rust).
@@ -426,11 +428,12 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     float lambda_r = atan2_accurate(dot(r, e), sqrt(rn * rn + rb * rb));
     float cos_lambda_r = cos(lambda_r);
     float outside = max(max(psi_r - psi_hi, psi_lo - psi_r), 0.0) * cos_lambda_r;
+    // A peak beyond the lune's edge: its tail graded narrower across the edge (see sky_lune.rs).
     float width = lobe_width(m);
-    float w = outside > 0.0 ? width * width / (width + outside) : width;
+    float w_psi = outside > 0.0 ? width * width / (width + SKY_TAIL_GRADING * outside) : width;
     float psi_c = clamp(psi_r, psi_lo, psi_hi);
-    float width_psi = min(w / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
-    float width_lambda = min(w, 16.0 * PI);
+    float width_psi = min(w_psi / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
+    float width_lambda = min(width, 16.0 * PI);
     GradedAxis psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     GradedAxis lambda_axis = graded_axis(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
     float k = float(per_axis);

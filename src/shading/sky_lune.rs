@@ -48,6 +48,26 @@ pub fn up_across(n: DVec3) -> (DVec3, f64) {
     (across, across.length().atan2(n.y))
 }
 
+/// How much narrower than a Gaussian lobe's fall-off [`sky_lobe_in_lune`] grades its grid across a lune's edge
+/// where the lobe's peak lies beyond it: `width²/(width + 8 × distance)` against the fall-off's `width²/(2 ×
+/// distance)` (`lobe_width` the lobe's width, the distance the peak's from the edge [rad]). The sinh warp spaces its
+/// points geometrically beyond its width, so a narrow width costs little where the tail reaches further.
+///
+/// Measured against `width²/(width + distance)`, used before on both axes (along the edge the width is now the
+/// lobe's own: a tail cut at a distance keeps the lobe's cross-section there). `cargo run --release --example
+/// sky_lobe_tails` (the sky's lobe integral over a sphere's normals against 512², the worst normal relative to the
+/// larger of its value and 1% of the peak; 4², 8², 16², 24²): Phong e = 80 0.19, 2.4e-2, 1.9e-3, 6.6e-4 before, 0.14,
+/// 9.4e-3, 6.2e-4, 3.7e-4 now; Blinn-Phong e = 300 0.47, 8.1e-2, 6.1e-3, 2.6e-3 before, 0.53, 1.6e-2, 2.4e-3, 1.1e-3
+/// now; Ward α = 0.15 0.44, 8.8e-2, 2.3e-2, 1.0e-2 before, 0.38, 3.1e-2, 4.0e-3, 1.8e-3 now; Ward αx = 0.05 αy = 0.3
+/// 2.4, 0.99, 0.18, 4.8e-2 before, 2.5, 0.66, 7.8e-2, 1.2e-2 now. `sunshade albedo`'s table of tilted surfaces
+/// (docs/brdf.md) keeps its medians; its worst cases move both ways (Phong e = 1 at 8²: 5.3e-2 against 2.7e-2;
+/// the anisotropic Ward αx = 0.02 at 8² 1.0 against 0.12, at 32² 0.16 against 0.30: one grid width where that lobe
+/// has two). Tried and not kept: 16 in place of 8 with `sqrt(width (width + distance))` along the edge (better on
+/// the sphere, the anisotropic Ward's 16² 3.8e-2, but 6.6 at 4² on the tilted table), widths projected from the Ward
+/// lobe's two axes at its peak (its far tail is not shaped like its peak), the fall-off measured from the lobe at
+/// the edge (worse for every lobe).
+pub const SKY_TAIL_GRADING: f64 = 8.0;
+
 /// How far the sky's lobe integral is taken directly over the upper lune rather than as the hemisphere's less
 /// the lower lune's: 0 while the lobe's peak (the mirror direction of the viewer) is above the horizontal by more
 /// than a quarter of the lobe's width w (at most 1 rad), 1 once it is below by more than that, linear between, so
@@ -97,18 +117,19 @@ pub fn sky_lobe_in_lune(
     let b = if sin_t > 0.0 { across / sin_t } else { orthonormal_to(n) };
     let e = n.cross(b);
     // The lobe's peak in lune coordinates, its width in each (|dω/dψ| = cos λ, |dω/dλ| = 1). A peak outside the
-    // lune leaves only its tail there, falling off from the lune's edge over width²/(width + distance): crowd the
-    // grid at the edge, that narrow (as for disk lights).
+    // lune leaves only its tail there: crowd the grid at the edge nearest the peak.
     let r = mirror(p.to_viewer, n);
     let psi_r = r.dot(b).atan2(r.dot(n));
     let lambda_r = r.dot(e).atan2((r.dot(n).powi(2) + r.dot(b).powi(2)).sqrt());
     let cos_lambda_r = lambda_r.cos();
     let outside = (psi_r - psi_hi).max(psi_lo - psi_r).max(0.0) * cos_lambda_r;
+    // Across the edge (ψ) the tail is graded narrower than the lobe, the further its peak the narrower
+    // ([`SKY_TAIL_GRADING`]); along the edge (λ) with the lobe's own width. Continuous at distance 0.
     let width = lobe_width(brdf);
-    let w = if outside > 0.0 { width * width / (width + outside) } else { width };
+    let w_psi = if outside > 0.0 { width * width / (width + SKY_TAIL_GRADING * outside) } else { width };
     let psi_c = psi_r.clamp(psi_lo, psi_hi);
-    let width_psi = (w / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
-    let width_lambda = w.min(16.0 * PI);
+    let width_psi = (w_psi / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
+    let width_lambda = width.min(16.0 * PI);
     let psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     let lambda_axis = graded_axis(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
     let k = per_axis as f64;
@@ -162,6 +183,37 @@ mod tests {
             }
         }
         s * (FRAC_PI_2 / nt as f64) * (2.0 * PI / np as f64)
+    }
+
+    #[test]
+    fn the_shader_grades_tails_alike() {
+        let glsl = include_str!("../../shaders/shade.glsl");
+        assert!(glsl.contains(&format!("const float SKY_TAIL_GRADING = {SKY_TAIL_GRADING:.1};\n")));
+    }
+
+    #[test]
+    fn tails_beyond_the_horizontal_converge_on_a_sphere() {
+        // The sky's lobe integral over a sphere's normals seen from one direction (`examples/sky_lobe_tails`, fewer
+        // normals), 16² against 256², relative to the larger of the value and 1% of the peak over the normals.
+        // Graded with the tail's width²/(width + distance) on both axes, Ward α = 0.15 erred 2.8e-2 here (now 4.7e-3).
+        let brdf = Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.15, alpha_y: 0.15 };
+        let v = DVec3::new(0.0, 0.3, 1.0).normalize();
+        let side = 16;
+        let mut cases = Vec::new();
+        for i in 0..side {
+            for j in 0..side {
+                let th = (i as f64 + 0.5) / side as f64 * PI;
+                let ph = (j as f64 + 0.5) / side as f64 * PI;
+                let n = DVec3::new(th.cos(), ph.cos() * th.sin(), ph.sin() * th.sin());
+                if n.dot(v) > 0.02 {
+                    let p = point(n, v);
+                    cases.push((sky_lobe_integral(&brdf, &p, 16), sky_lobe_integral(&brdf, &p, 256)));
+                }
+            }
+        }
+        let peak = cases.iter().map(|c| c.1).fold(0.0, f64::max);
+        let worst = cases.iter().map(|(got, want)| (got - want).abs() / want.max(0.01 * peak)).fold(0.0, f64::max);
+        assert!(worst < 8e-3, "worst {worst}");
     }
 
     #[test]
