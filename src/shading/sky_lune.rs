@@ -50,8 +50,8 @@ pub fn up_across(n: DVec3) -> (DVec3, f64) {
 
 /// How much narrower than a Gaussian lobe's fall-off [`sky_lobe_in_lune`] grades its grid across a lune's edge
 /// where the lobe's peak lies beyond it: `width²/(width + 8 × distance)` against the fall-off's `width²/(2 ×
-/// distance)` (`lobe_width` the lobe's width, the distance the peak's from the edge [rad]). The sinh warp spaces its
-/// points geometrically beyond its width, so a narrow width costs little where the tail reaches further.
+/// distance)` (`lobe_width` the lobe's width, the distance the peak's from the edge, in radians). The sinh warp
+/// spaces its points geometrically beyond its width, so a narrow width costs little where the tail reaches further.
 ///
 /// Measured against `width²/(width + distance)`, used before on both axes (along the edge the width is now the
 /// lobe's own: a tail cut at a distance keeps the lobe's cross-section there). `cargo run --release --example
