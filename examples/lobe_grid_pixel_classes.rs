@@ -7,8 +7,10 @@
 //! unshadowed, at 128², rendered on the rungs 13² to 80² of `--tolerance`'s ladder of lobe grids. Each material's
 //! pixels (`cpu::material_map`) are split into its silhouette ring (a pixel with a neighbour of another material
 //! or of nothing) and the rest, and for each pair of consecutive rungs the largest relative difference of each
-//! class is printed (the diff's floor: 1% of the finer image's peak), as the study measures a material.
+//! class is printed (`refinement::max_difference_where`, the diff's floor: 1% of the finer image's peak), as the
+//! study measures a material.
 
+use sunshade::accuracy::refinement::max_difference_where;
 use sunshade::cpu::{self, ReferenceOptions};
 use sunshade::settings::{self, CameraOptions, LightOptions, SunOptions};
 use sunshade::shading::{ShadingOptions, Shadows};
@@ -44,24 +46,14 @@ fn main() {
         s.shading.samples_per_axis = k;
         let image = cpu::render(&scene, &s, &reference);
         if let Some((j, prev)) = &previous {
-            let peak = image.pixels().iter().flat_map(|q| q[..3].iter().map(|&v| v as f64)).fold(0.0, f64::max);
             println!("{j}² to {k}²:");
             for (m, material) in scene.materials.iter().enumerate().filter(|(_, m)| !m.brdf.is_lambert()) {
-                let (mut on_ring, mut inside) = (0.0f64, 0.0f64);
-                for (i, (a, b)) in
-                    image.pixels().iter().zip(prev.pixels()).enumerate().filter(|(i, _)| map[*i] == Some(m))
-                {
-                    let d = (0..3)
-                        .map(|c| {
-                            (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(0.01 * peak)
-                        })
-                        .fold(0.0, f64::max);
-                    if ring[i] {
-                        on_ring = on_ring.max(d);
-                    } else {
-                        inside = inside.max(d);
-                    }
-                }
+                // The material's pixels on its ring or inside it, measured as the study measures a material.
+                let class = |on_ring: bool| -> Vec<bool> {
+                    map.iter().zip(&ring).map(|(&owner, &r)| owner == Some(m) && r == on_ring).collect()
+                };
+                let on_ring = max_difference_where(prev, &image, Some(&class(true)));
+                let inside = max_difference_where(prev, &image, Some(&class(false)));
                 println!("  {}: ring {on_ring:.1e}, inside {inside:.1e}", material.name);
             }
         }
