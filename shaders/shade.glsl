@@ -384,6 +384,23 @@ const uint LUNE_ABOVE = 1u;
 // How much narrower than a lobe's tail the lune grid is graded across its edge (sky_lune::SKY_TAIL_GRADING).
 const float SKY_TAIL_GRADING = 8.0;
 
+// The least n.v at which grazing_narrowing narrows a lobe in proportion (sky_lune::GRAZING_FLOOR).
+const float GRAZING_FLOOR = 0.05;
+
+// How much narrower than its width an isotropic Ward lobe is along the unit direction u at its peak: 1 in the
+// plane of incidence, n.v across it (at least GRAZING_FLOOR); 1 for every other lobe (see sky_lune.rs).
+// 1 - (n.v)^2 = |n x v|^2, so no normalization where n x v is rounding.
+float grazing_narrowing(MaterialGpu m, Frame p, vec3 u) {
+    if (VARIANT_BRDF != BRDF_WARD || m.params.x != m.params.y) {
+        return 1.0;
+    }
+    vec3 nxv = cross(p.normal, p.to_viewer);
+    float sin2 = dot(nxv, nxv);
+    float scale = min((1.0 - GRAZING_FLOOR * GRAZING_FLOOR) / max(sin2, 1e-30), 1.0);
+    float along = dot(nxv, u);
+    return sqrt(max(1.0 - scale * along * along, 0.0));
+}
+
 // Up's part across the normal n (xyz: up - (n.up) n = sin(t) b) and the surface's tilt t from up (w), by atan2 of
 // that part's length and n.up (see the Rust).
 vec4 up_across(vec3 n) {
@@ -432,8 +449,14 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     float width = lobe_width(m);
     float w_psi = outside > 0.0 ? width * width / (width + SKY_TAIL_GRADING * outside) : width;
     float psi_c = clamp(psi_r, psi_lo, psi_hi);
-    float width_psi = min(w_psi / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
-    float width_lambda = min(width, 16.0 * PI);
+    // Each axis' direction on the sphere at the grid's centre, for a lobe narrower across the plane of incidence.
+    float spc = sin(psi_c);
+    float cpc = cos(psi_c);
+    float slr = sin(lambda_r);
+    float f_psi = grazing_narrowing(m, p, -spc * n + cpc * b);
+    float f_lambda = grazing_narrowing(m, p, -slr * (cpc * n + spc * b) + cos_lambda_r * e);
+    float width_psi = min(w_psi * f_psi / max(cos_lambda_r, 1e-30), 16.0 * (psi_hi - psi_lo));
+    float width_lambda = min(width * f_lambda, 16.0 * PI);
     GradedAxis psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     GradedAxis lambda_axis = graded_axis(-0.5 * PI, 0.5 * PI, lambda_r, width_lambda);
     float k = float(per_axis);

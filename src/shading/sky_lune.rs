@@ -68,6 +68,47 @@ pub fn up_across(n: DVec3) -> (DVec3, f64) {
 /// the edge (worse for every lobe).
 pub const SKY_TAIL_GRADING: f64 = 8.0;
 
+/// The least n·v at which [`grazing_narrowing`] narrows a lobe in proportion (below it, by this much).
+///
+/// Measured with `cargo run --release --example lobe_grid_pixel_classes` (Ward α = 0.15's silhouette ring, the
+/// largest difference from 13² to 19²): 1.2e-2 with 0.2, 8.0e-3 with 0.05 and with 0.02; the sphere's normals of
+/// `sky_lobe_tails` alike for all three.
+pub const GRAZING_FLOOR: f64 = 0.05;
+
+/// How much narrower than its width an isotropic half-vector lobe is along the unit direction `u` (tangent to the
+/// sphere of directions at the lobe's peak): 1 in the plane of incidence, n·v across it (at least
+/// [`GRAZING_FLOOR`]), the support function of that ellipse, `sqrt(1 − (1 − across²) (c·u)²)` with
+/// `c = n × v / |n × v|`. Where the viewer grazes the surface, the mirror direction r = 2(n·v)n − v and v sum to
+/// `2(n·v) n`: turning ω from r by δ across the plane of incidence turns the half vector by δ/(2 n·v), and by δ/2
+/// within it, so an isotropic lobe in the half vector's angle to n is n·v times as wide across as along.
+///
+/// Only the isotropic Ward lobe takes it: Blinn-Phong's is the same in principle, but on `sky_lobe_tails`' sphere
+/// (e = 300) 8² erred 3.4e-2 against 1.6e-2 (its grazing ring 5.1e-4 against 9.9e-3 at 16², which its images do
+/// not need), and the anisotropic Ward's grid has one width where its lobe has two (its tilted surfaces in
+/// docs/brdf.md at 16² 0.65 against 0.20). For Ward α = 0.15 (`sky_lobe_tails`, 4², 8², 16², 24²): the grazing
+/// ring (n·v 0.001 to 0.05) 1.2, 0.50, 3.2e-2, 1.5e-3 before, 0.76, 4.9e-2, 1.1e-3, 4.9e-4 now; the sphere 0.38,
+/// 3.1e-2, 4.0e-3, 1.8e-3 before, 0.43, 2.2e-2, 1.4e-3, 9.1e-4 now. docs/brdf.md's tilted surfaces (views to 85°
+/// from the normal, n·v ≥ 0.087) move both ways for Ward α = 0.2: worst 0.96, 5.6e-2 at 2², 4² before, 0.65,
+/// 9.7e-2 now, the same from 8².
+///
+/// The same lobe seen through the hemisphere's inverse-CDF grid needs nothing: that grid is drawn from the
+/// half vector's own distribution.
+///
+/// Precision: `1 − (n·v)² = |n × v|²` for unit vectors, so where n·v ≥ the floor the factor is
+/// `sqrt(1 − ((n × v)·u)²)` with no normalization: a viewer head-on (n × v → 0, its direction all rounding) gives
+/// 1, continuously. Below the floor |n × v|² ≥ 1 − floor², so normalizing c is safe there.
+pub fn grazing_narrowing(brdf: &Brdf, p: &SurfacePoint, u: DVec3) -> f64 {
+    let isotropic_ward = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x == alpha_y);
+    if !isotropic_ward {
+        return 1.0;
+    }
+    let nxv = p.normal.cross(p.to_viewer);
+    let sin2 = nxv.length_squared();
+    // (1 − across²)/|n × v|²: 1 above the floor, less below it; 1 where n × v is 0 (the product is then 0).
+    let scale = ((1.0 - GRAZING_FLOOR * GRAZING_FLOOR) / sin2.max(1e-30)).min(1.0);
+    (1.0 - scale * nxv.dot(u).powi(2)).max(0.0).sqrt()
+}
+
 /// How far the sky's lobe integral is taken directly over the upper lune rather than as the hemisphere's less
 /// the lower lune's: 0 while the lobe's peak (the mirror direction of the viewer) is above the horizontal by more
 /// than a quarter of the lobe's width w (at most 1 rad), 1 once it is below by more than that, linear between, so
@@ -128,8 +169,13 @@ pub fn sky_lobe_in_lune(
     let width = lobe_width(brdf);
     let w_psi = if outside > 0.0 { width * width / (width + SKY_TAIL_GRADING * outside) } else { width };
     let psi_c = psi_r.clamp(psi_lo, psi_hi);
-    let width_psi = (w_psi / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
-    let width_lambda = width.min(16.0 * PI);
+    // Each axis' direction on the sphere at the grid's centre, for a lobe narrower across the plane of incidence.
+    let (sp, cp) = psi_c.sin_cos();
+    let (sl, cl) = lambda_r.sin_cos();
+    let f_psi = grazing_narrowing(brdf, p, -sp * n + cp * b);
+    let f_lambda = grazing_narrowing(brdf, p, -sl * (cp * n + sp * b) + cl * e);
+    let width_psi = (w_psi * f_psi / cos_lambda_r.max(1e-30)).min(16.0 * (psi_hi - psi_lo));
+    let width_lambda = (width * f_lambda).min(16.0 * PI);
     let psi_axis = graded_axis(psi_lo, psi_hi, psi_c, width_psi);
     let lambda_axis = graded_axis(-FRAC_PI_2, FRAC_PI_2, lambda_r, width_lambda);
     let k = per_axis as f64;
@@ -189,13 +235,61 @@ mod tests {
     fn the_shader_grades_tails_alike() {
         let glsl = include_str!("../../shaders/shade.glsl");
         assert!(glsl.contains(&format!("const float SKY_TAIL_GRADING = {SKY_TAIL_GRADING:.1};\n")));
+        assert!(glsl.contains(&format!("const float GRAZING_FLOOR = {GRAZING_FLOOR:.2};\n")));
+    }
+
+    #[test]
+    fn only_a_grazing_view_of_an_isotropic_ward_narrows_across_the_plane_of_incidence() {
+        let ward = Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.15, alpha_y: 0.15 };
+        let n = DVec3::Y;
+        let across = DVec3::Z;
+        // Head-on: n × v = 0, nothing to narrow, and no NaN from normalizing it.
+        assert_eq!(grazing_narrowing(&ward, &point(n, n), across), 1.0);
+        // n·v = 0.5: across the plane of incidence (x, y) by n·v, within it not at all.
+        let v = DVec3::new(0.75f64.sqrt(), 0.5, 0.0);
+        assert!((grazing_narrowing(&ward, &point(n, v), across) - 0.5).abs() < 1e-12);
+        assert!((grazing_narrowing(&ward, &point(n, v), DVec3::X) - 1.0).abs() < 1e-12);
+        // Grazing: by the floor.
+        let v = DVec3::new(1.0, 1e-9, 0.0).normalize();
+        assert!((grazing_narrowing(&ward, &point(n, v), across) - GRAZING_FLOOR).abs() < 1e-12);
+        // Other lobes keep their width.
+        for brdf in [
+            Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.05, alpha_y: 0.3 },
+            Brdf::BlinnPhong { kd: [0.0; 3], ks: [1.0; 3], exponent: 300.0 },
+            Brdf::Phong { kd: [0.0; 3], ks: [1.0; 3], exponent: 80.0 },
+        ] {
+            assert_eq!(grazing_narrowing(&brdf, &point(n, v), across), 1.0);
+        }
+    }
+
+    #[test]
+    fn grazing_views_of_an_isotropic_ward_converge() {
+        // A ring of normals about the viewer at n·v 0.001 to 0.05 (a sphere's silhouette; `examples/sky_lobe_tails`,
+        // fewer normals), 16² against 256², relative to the larger of the value and 1% of the peak over the ring.
+        // Without the narrowing (GRAZING_FLOOR = 1) Ward α = 0.15 erred 4.5e-2 here (now 7.2e-4).
+        let brdf = Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.15, alpha_y: 0.15 };
+        let v = DVec3::new(0.0, 0.3, 1.0).normalize();
+        let (t1, t2) = (DVec3::X, v.cross(DVec3::X).normalize());
+        let mut cases = Vec::new();
+        for nv in [0.001, 0.01, 0.05] {
+            for j in 0..16 {
+                let ph = (j as f64 + 0.5) / 16.0 * 2.0 * PI;
+                let n = nv * v + (1.0f64 - nv * nv).sqrt() * (ph.cos() * t1 + ph.sin() * t2);
+                let p = point(n, v);
+                cases.push((sky_lobe_integral(&brdf, &p, 16), sky_lobe_integral(&brdf, &p, 256)));
+            }
+        }
+        let peak = cases.iter().map(|c| c.1).fold(0.0, f64::max);
+        let worst = cases.iter().map(|(got, want)| (got - want).abs() / want.max(0.01 * peak)).fold(0.0, f64::max);
+        assert!(worst < 5e-3, "worst {worst}");
     }
 
     #[test]
     fn tails_beyond_the_horizontal_converge_on_a_sphere() {
         // The sky's lobe integral over a sphere's normals seen from one direction (`examples/sky_lobe_tails`, fewer
         // normals), 16² against 256², relative to the larger of the value and 1% of the peak over the normals.
-        // Graded with the tail's width²/(width + distance) on both axes, Ward α = 0.15 erred 2.8e-2 here (now 4.7e-3).
+        // Graded with the tail's width²/(width + distance) on both axes, Ward α = 0.15 erred 2.8e-2 here, 4.7e-3
+        // with the narrower tails, 1.5e-3 since `grazing_narrowing`.
         let brdf = Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.15, alpha_y: 0.15 };
         let v = DVec3::new(0.0, 0.3, 1.0).normalize();
         let side = 16;
