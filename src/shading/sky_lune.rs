@@ -77,8 +77,9 @@ pub const GRAZING_FLOOR: f64 = 0.05;
 
 /// How much narrower than its width an isotropic half-vector lobe is along the unit direction `u` (tangent to the
 /// sphere of directions at the lobe's peak): 1 in the plane of incidence, n·v across it (at least
-/// [`GRAZING_FLOOR`]), the support function of that ellipse, `sqrt(1 − (1 − across²) (c·u)²)` with
-/// `c = n × v / |n × v|`. Where the viewer grazes the surface, the mirror direction r = 2(n·v)n − v and v sum to
+/// [`GRAZING_FLOOR`]): the extent of that ellipse along u, `sqrt(1 − (1 − across²) (c·u)²)` with
+/// `c = n × v / |n × v|` (u is orthogonal to the peak r there; where the peak lies beyond the lune's edge the same
+/// formula is taken at the edge's point nearest it, as the grid is graded about that point). Where the viewer grazes the surface, the mirror direction r = 2(n·v)n − v and v sum to
 /// `2(n·v) n`: turning ω from r by δ across the plane of incidence turns the half vector by δ/(2 n·v), and by δ/2
 /// within it, so an isotropic lobe in the half vector's angle to n is n·v times as wide across as along.
 ///
@@ -91,8 +92,8 @@ pub const GRAZING_FLOOR: f64 = 0.05;
 /// from the normal, n·v ≥ 0.087) move both ways for Ward α = 0.2: worst 0.96, 5.6e-2 at 2², 4² before, 0.65,
 /// 9.7e-2 now, the same from 8².
 ///
-/// The same lobe seen through the hemisphere's inverse-CDF grid needs nothing: that grid is drawn from the
-/// half vector's own distribution.
+/// The hemisphere's inverse-CDF grid is not changed: it is drawn from the half vector's own distribution, so its
+/// samples narrow with the lobe.
 ///
 /// Precision: `1 − (n·v)² = |n × v|²` for unit vectors, so where n·v ≥ the floor the factor is
 /// `sqrt(1 − ((n × v)·u)²)` with no normalization: a viewer head-on (n × v → 0, its direction all rounding) gives
