@@ -408,9 +408,38 @@ vec4 up_across(vec3 n) {
     return vec4(across, atan2_accurate(length(across), n.y));
 }
 
+// The lobe at the sky's direction nearest its peak, relative to the peak, under which sky_beyond_lobe gives the
+// upper lune's grid all the weight (sky_lune::SKY_REACH).
+const float SKY_REACH = 1e-2;
+
+// How surely the sky lies beyond the lobe (0 to 1): 1 - q/SKY_REACH, q the lobe at the sky's direction nearest its
+// peak r over the lobe at r; 0 while r is in the sky (see sky_lune.rs).
+float sky_beyond_lobe(MaterialGpu m, Frame p, vec3 r) {
+    if (!(r.y < 0.0)) {
+        return 0.0;
+    }
+    vec3 n = p.normal;
+    vec3 flat_r = vec3(r.x, 0.0, r.z);
+    vec3 nearest;
+    if (dot(n, flat_r) > 0.0) {
+        nearest = normalize(flat_r);
+    } else {
+        vec3 apex = cross(vec3(0.0, 1.0, 0.0), n);
+        if (dot(apex, apex) == 0.0) {
+            return 1.0;
+        }
+        apex = normalize(apex);
+        nearest = dot(apex, r) < 0.0 ? -apex : apex;
+    }
+    float peak = specular_lobe(m, p, r);
+    float q = peak > 0.0 ? specular_lobe(m, p, nearest) / peak : 0.0;
+    return clamp(1.0 - q / SKY_REACH, 0.0, 1.0);
+}
+
 // How far the sky's lobe integral is taken over the upper lune directly rather than as the hemisphere's less the
 // lower lune's: 0 with the lobe's peak (the mirror of the viewer) above the horizontal by more than a quarter of
-// its width (at most 1 rad), 1 below by more than that, linear between, scaled by the tilt from up over that
+// its width (at most 1 rad), 1 below by more than that, linear between, or
+// 1 - q/SKY_REACH where that is more (sky_beyond_lobe), scaled by the tilt from up over that
 // quarter width (at most 1; see sky_lune.rs).
 float sky_lune_blend(MaterialGpu m, Frame p) {
     vec3 n = p.normal;
@@ -418,7 +447,8 @@ float sky_lune_blend(MaterialGpu m, Frame p) {
     float quarter = 0.25 * min(lobe_width(m), 1.0);
     float tilt = up_across(n).w;
     // A measured table takes the upper lune wherever the surface is tilted (see the Rust).
-    float below = VARIANT_BRDF == BRDF_MEASURED ? 1.0 : clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0);
+    float below = VARIANT_BRDF == BRDF_MEASURED ? 1.0
+        : max(clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0), sky_beyond_lobe(m, p, r));
     return below * min(tilt / quarter, 1.0);
 }
 
