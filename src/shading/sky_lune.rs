@@ -158,7 +158,10 @@ pub const SKY_REACH: f64 = 1e-2;
 /// difference is the two grids' error alone. Measured on the BRDF chart's sphere (Ward α = 0.2, sky alone, view
 /// along +Z) at n ≈ (0.455, −0.890, 0.013): truth 0, weight 0.39 on a difference of 3.4e-2 of the unit lobe at 16².
 /// It reads two values of the lobe, never the sums, so it is continuous and both renderers round it alike.
-/// A surface facing straight down (no apex, no sky in its hemisphere) gives 1.
+/// A surface facing straight down (no apex, no sky in its hemisphere) gives 1. Either path converges to the same
+/// integral; this only chooses the one whose error is not a remainder. (Where r's projection onto the horizontal
+/// is behind the surface, `n·r ≤ n_y r_y`, so r's projection onto the surface's horizon is below the horizontal
+/// too: the apex is then the nearest sky direction.)
 pub fn sky_beyond_lobe(brdf: &Brdf, p: &SurfacePoint, r: DVec3) -> f64 {
     if r.y >= 0.0 || r.y.is_nan() {
         return 0.0;
