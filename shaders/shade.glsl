@@ -438,9 +438,8 @@ float sky_beyond_lobe(MaterialGpu m, Frame p, vec3 r) {
 
 // How far the sky's lobe integral is taken over the upper lune directly rather than as the hemisphere's less the
 // lower lune's: 0 with the lobe's peak (the mirror of the viewer) above the horizontal by more than a quarter of
-// its width (at most 1 rad), 1 below by more than that, linear between, or
-// 1 - q/SKY_REACH where that is more (sky_beyond_lobe), scaled by the tilt from up over that
-// quarter width (at most 1; see sky_lune.rs).
+// its width (at most 1 rad), 1 below by more than that, linear between, or 1 - q/SKY_REACH where that is more
+// (sky_beyond_lobe), scaled by the tilt from up over that quarter width (at most 1; see sky_lune.rs).
 float sky_lune_blend(MaterialGpu m, Frame p) {
     vec3 n = p.normal;
     vec3 r = mirror(p.to_viewer, n);
