@@ -673,6 +673,43 @@ fn bench_pareto_measures_each_setting_against_the_converged_reference() {
     assert_eq!((png.width(), png.height()), (1280, 400), "two charts: max and p99");
 }
 
+/// `bench --pareto`'s `--tolerance` table on a scene that shadows itself: every T is kept (shadow rays; on a device
+/// without ray queries the shader's walk, the table at 64 pixels on the longer side against its own converged
+/// reference), and each image meets T outside the penumbrae (what `--tolerance` promises without
+/// `--tolerance-in-penumbrae`), its prediction too.
+#[test]
+fn bench_pareto_keeps_the_tolerance_of_a_scene_that_shadows_itself() {
+    let o = sunshade(&[
+        "bench",
+        "--pareto",
+        "models/teapot.glb",
+        "--width",
+        "80",
+        "--height",
+        "60",
+        "--repeat",
+        "1",
+        "--max-refinements",
+        "4",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let info = String::from_utf8_lossy(&sunshade(&["info"]).stdout).into_owned();
+    let walk = info.lines().any(|l| l.contains("ray queries") && l.contains(": no"));
+    let table = &json["tables"][1];
+    let caption = table["caption"].as_str().unwrap();
+    assert_eq!(caption.contains("at 64×48"), walk, "{info}\n{caption}");
+    let rows = table["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3, "{table}");
+    for r in rows {
+        let t = r["T"].as_f64().unwrap();
+        assert!(r["max rel outside penumbrae"].as_f64().is_some_and(|e| e <= t), "{r}");
+        assert!(r["max rel"].as_f64().is_some(), "{r}");
+        assert!(r["predicted"].as_f64().unwrap() <= t, "{r}");
+    }
+}
+
 #[test]
 fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
     let dir = TempDir::new("tolerance-cli");

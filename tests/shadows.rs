@@ -156,6 +156,39 @@ fn penumbra_of_a_straight_edge_converges_to_the_circular_segment() {
     }
 }
 
+/// `accuracy::penumbrae::penumbra_mask` names the pixels in a penumbra: under a straight edge 1 m up and a 10° sun
+/// at the zenith, the band `|x| < tan σ` (outside it the sun is wholly visible or wholly hidden), to within 1% of
+/// the band's half-width at its borders, where a sliver of the disk falls between the grid's rays; and no pixel
+/// where nothing shadows the floor, or where no shadow rays are cast.
+#[test]
+fn the_penumbra_mask_is_the_band_a_straight_edge_casts() {
+    use sunshade::accuracy::penumbrae::penumbra_mask;
+    let camera = camera_down(DVec3::ZERO, 0.15 / 12.0, 5.0);
+    let half_angle = (10f64.to_radians() as f32 as f64) / 2.0;
+    let s = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::Ray, 16);
+    let mask = penumbra_mask(&edge_scene(), &s, &ReferenceOptions::default());
+    let band = half_angle.tan();
+    let (mut inside, mut outside) = (0, 0);
+    for y in 0..s.height {
+        for x in 0..s.width {
+            let distance = floor_point(&s, x, y).x.abs();
+            let masked = mask[(y * s.width + x) as usize];
+            if distance < 0.99 * band {
+                assert!(masked, "({x}, {y}) at {distance:.4} m, inside the penumbra ±{band:.4} m, not masked");
+                inside += 1;
+            } else if distance > 1.01 * band {
+                assert!(!masked, "({x}, {y}) at {distance:.4} m, outside the penumbra ±{band:.4} m, masked");
+                outside += 1;
+            }
+        }
+    }
+    assert!(inside > 300 && outside > 200, "both sides measured: {inside} inside, {outside} outside");
+    let lone = scene(&[floor(1.0)]);
+    assert!(!penumbra_mask(&lone, &s, &ReferenceOptions::default()).contains(&true), "nothing shadows the floor");
+    let unshadowed = settings(96, 8, camera, sun_lights(DVec3::Y, 10.0), Shadows::None, 16);
+    assert!(!penumbra_mask(&edge_scene(), &unshadowed, &ReferenceOptions::default()).contains(&true));
+}
+
 #[test]
 fn gpu_ray_queries_agree_with_the_reference_on_the_penumbra() {
     let mut gpu = common::shadow_ray_renderer();

@@ -8,6 +8,7 @@
 //! - [`interpolation`]: the error f32 barycentrics add, bounded per pixel from the triangle's shape and the
 //!   radiance's change over that move;
 //! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
+//! - [`penumbrae`]: the pixels in a penumbra, where `--tolerance` makes no promise unless asked to;
 //! - [`bounds`]: the sun models' error bounds, derived next to the code;
 //! - [`predicted`]: a render's predicted error from those bounds, and `--tolerance`'s choice of models;
 //! - [`refinement`]: the lobe grids' error under disk lights and the sky estimated from a ladder of grids
@@ -25,6 +26,7 @@ pub mod error;
 pub mod interpolation;
 pub mod material_study;
 pub mod pareto;
+pub mod penumbrae;
 pub mod predicted;
 pub mod refinement;
 pub mod trial;

@@ -75,8 +75,10 @@ pub struct BenchArgs {
     /// unless --width/--height are given), every quality knob over its range alone and in a ladder of
     /// combinations (sun model and samples, disk model, lobe samples, interpolation, shadow technique, samples and
     /// map size, where the scene has what they act on), each with its GPU frame time and its error against the
-    /// converged reference (`reference --converged`); the Pareto front is marked. Its --update region is
-    /// "pareto".
+    /// converged reference (`reference --converged`); the Pareto front is marked. Then what `render --tolerance`
+    /// keeps at 1e-2, 1e-3 and 1e-4, its cost and its error over every pixel and outside the penumbrae (on a
+    /// device without ray queries, a scene that shadows itself at 64 pixels on the longer side, against its own
+    /// converged reference). Its --update region is "pareto".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures"])]
     pub pareto: bool,
     /// Measured BRDFs: analytic BRDFs tabulated into the MERL format against their formulas (linear and nearest
@@ -111,7 +113,7 @@ pub(super) fn warm_frames(
     uploaded: &crate::gpu::GpuScene,
     s: &crate::settings::RenderSettings,
     repeat: u32,
-) -> Result<(crate::Image, Vec<Duration>), CliError> {
+) -> Result<(crate::Image, Vec<Duration>), crate::gpu::GpuError> {
     let (image, _) = renderer.render(uploaded, s)?;
     let mut times = Vec::with_capacity(repeat as usize);
     for _ in 0..repeat {

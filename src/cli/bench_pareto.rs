@@ -11,7 +11,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::bench::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
-use super::bench_tolerance::{tolerance_rows, tolerance_table};
+use super::bench_tolerance::{table_size, tolerance_rows, tolerance_table};
 use super::generated::{machine, print_output, today, update_region};
 use super::sweep::{sweep, Relevance};
 use super::CliError;
@@ -104,17 +104,34 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         bar.set_message(format!("{name}: --tolerance"));
         let predicted_default =
             predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(default_mode) };
+        // Without ray queries a scene that shadows itself gets the table at a smaller size, with its own truth.
+        let size = table_size((width, height), ray_queries, can_occlude);
+        let smaller = (size != (width, height)).then(|| {
+            bar.set_message(format!("{name}: the converged reference at {}×{} for --tolerance", size.0, size.1));
+            let t = Instant::now();
+            let mut small =
+                settings::resolve(&scene, size.0, size.1, &CameraOptions::default(), &SunOptions::default())
+                    .expect("resolved at the sweep's size");
+            small.shading.shadows = truth_settings.shading.shadows;
+            let truth = render_converged(&scene, &small, &reference, &convergence);
+            (small, truth, t.elapsed().as_secs_f64())
+        });
+        let (table_settings, table_truth) = match &smaller {
+            Some((small, truth, _)) => (small, truth),
+            None => (&truth_settings, &truth),
+        };
         let tolerance_rows = tolerance_rows(
             &scene,
-            &truth_settings,
+            table_settings,
             &mut renderers[0],
             &uploaded[0],
             predicted_default,
             &reference,
-            &truth,
+            table_truth,
             a.repeat,
             a.tolerance_in_penumbrae,
         )?;
+        let smaller = smaller.map(|(_, _, seconds)| (size, seconds));
         let mut rows = Vec::new();
         for setting in sweep(&relevance, default_mode, &modes) {
             let label = setting.label(&relevance);
@@ -168,7 +185,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             );
         }
         out += "\n";
-        out += &tolerance_table(&name, &tolerance_rows, a.tolerance_in_penumbrae);
+        out += &tolerance_table(&name, &tolerance_rows, a.tolerance_in_penumbrae, smaller);
         costs.push((name.clone(), exactness_cost(&rows)));
         for (metric, fronts, value) in [
             ("max relative error", &front, (|e: &ImageError| e.max_rel) as fn(&ImageError) -> f64),

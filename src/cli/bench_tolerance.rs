@@ -1,7 +1,11 @@
 //! `bench --pareto`'s `--tolerance` table: for each scene and T = 1e-2, 1e-3, 1e-4, the models `render --tolerance
 //! T` chose, what its renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid
-//! study's rungs, the image kept), and the kept image's error against the same converged reference as the sweep's;
-//! or why it refused.
+//! study's rungs, the image kept), and the kept image's error against a converged reference, over every pixel and
+//! outside the penumbrae (what `--tolerance` promises without `--tolerance-in-penumbrae`); or why it refused.
+//!
+//! On a device without ray queries, a scene that shadows itself gets its table at a smaller size ([`table_size`])
+//! against its own converged reference: its shadow rays walk the BVH in the fragment shader there, seconds a frame
+//! at the sweep's 256², and the sweep itself reads shadow maps, which `--tolerance` refuses.
 
 use std::time::Duration;
 
@@ -10,11 +14,12 @@ use super::metadata::{lobe_model_line, sun_model_line};
 use super::CliError;
 use crate::accuracy::converged::Converged;
 use crate::accuracy::error::image_error;
+use crate::accuracy::penumbrae::penumbra_mask;
 use crate::accuracy::predicted::Renderer as Predicted;
 use crate::accuracy::predicted::Request;
 use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
 use crate::cpu::ReferenceOptions;
-use crate::gpu::{GpuScene, Renderer};
+use crate::gpu::{GpuError, GpuScene, Renderer};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;
@@ -28,20 +33,39 @@ pub(super) struct ToleranceRow {
     outcome: Result<Kept, String>,
 }
 
-/// The image `--tolerance` kept: its models in words, its renders' cost, its measured and predicted error.
+/// The image `--tolerance` kept: its models in words, its renders' cost, its measured error (over every pixel and
+/// outside the penumbrae) and its predicted error.
 struct Kept {
     models: String,
     gpu_ms: f64,
     renders: u32,
     max_rel: f64,
+    max_rel_outside_penumbrae: f64,
     predicted: f64,
 }
 
-/// The table's rows for one scene: `settings` as resolved (default models, shadows as the truth has them),
-/// rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat` warm frames;
-/// `truth` the converged reference, its unconverged pixels left out; `in_penumbrae`: each T is held in the sun's
-/// penumbrae too (`--tolerance-in-penumbrae`), else outside them. A scene that can shadow itself on a device
-/// without ray queries is refused without a render (only shadow rays have a known error).
+/// The longest side of the table on a device without ray queries, where a scene shadows itself [pixels].
+pub(super) const WALK_TABLE_SIDE: u32 = 64;
+
+/// The size of a scene's `--tolerance` table: the sweep's, but on a device without ray queries for a scene that
+/// shadows itself, scaled down (aspect kept, sides rounded, at least 1) so that its longer side is at most
+/// [`WALK_TABLE_SIDE`]. Measured on the system lavapipe (Mesa 22.3.6, 2 threads): the tables of the eight models at
+/// 64² took about a minute, against 4 to 8 s a render of one at 256².
+pub(super) fn table_size((width, height): (u32, u32), ray_queries: bool, can_occlude: bool) -> (u32, u32) {
+    let longer = width.max(height);
+    if ray_queries || !can_occlude || longer <= WALK_TABLE_SIDE {
+        return (width, height);
+    }
+    let scale = |side: u32| ((side as u64 * WALK_TABLE_SIDE as u64 + longer as u64 / 2) / longer as u64).max(1) as u32;
+    (scale(width), scale(height))
+}
+
+/// The table's rows for one scene: `settings` as resolved (default models, shadows as the truth has them, the
+/// table's size), rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat`
+/// warm frames; `truth` the converged reference at that size, its unconverged pixels left out; `in_penumbrae`:
+/// each T is held in the sun's penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows
+/// measure apart ([`penumbra_mask`] under the truth's finest shadow rays). A render the device cannot run (its
+/// loop limiter) is a refusal, as `render` makes it.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tolerance_rows(
     scene: &Scene,
@@ -56,15 +80,10 @@ pub(super) fn tolerance_rows(
 ) -> Result<Vec<ToleranceRow>, CliError> {
     let can_occlude = settings.shading.shadows != Shadows::None;
     let excluded = truth.unconverged_mask();
+    // Unconverged pixels and those in a penumbra, computed at the first image kept.
+    let mut outside_penumbrae: Option<Vec<bool>> = None;
     let mut rows = Vec::new();
     for tolerance in TOLERANCES {
-        if can_occlude && !renderer.device_info().ray_query {
-            let why = "the scene can shadow itself and the device has no ray queries (its shadow rays would walk the \
-                       BVH in the shader: seconds a frame on lavapipe, not swept)"
-                .to_string();
-            rows.push(ToleranceRow { tolerance, outcome: Err(why) });
-            continue;
-        }
         let mut s = settings.clone();
         let (mut spent, mut renders) = (Duration::ZERO, 0u32);
         let request =
@@ -78,48 +97,93 @@ pub(super) fn tolerance_rows(
                 let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;
                 spent += median(times);
                 renders += 1;
-                Ok::<_, CliError>(image)
+                Ok::<_, GpuError>(image)
             },
             |image| image,
         );
         let outcome = match done {
             Ok(done) => {
-                let error = image_error(&done.kept, &truth.image, Some(&excluded))
-                    .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
+                let error = |excluded: &[bool]| {
+                    image_error(&done.kept, &truth.image, Some(excluded))
+                        .map(|e| e.max_rel)
+                        .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))
+                };
+                let outside = outside_penumbrae.get_or_insert_with(|| {
+                    let mut finest = settings.clone();
+                    finest.shading.shadow_samples_per_axis = truth.shading.shadow_samples_per_axis;
+                    let penumbrae = penumbra_mask(scene, &finest, reference);
+                    excluded.iter().zip(penumbrae).map(|(&u, p)| u || p).collect()
+                });
                 let models: Vec<String> =
                     [Some(sun_model_line(&s, scene)), lobe_model_line(&s, scene)].into_iter().flatten().collect();
                 Ok(Kept {
                     models: models.join("; "),
                     gpu_ms: ms(spent),
                     renders,
-                    max_rel: error.max_rel,
+                    max_rel: error(&excluded)?,
+                    max_rel_outside_penumbrae: error(outside)?,
                     predicted: done.prediction.max_relative,
                 })
             }
             Err(TrialError::Tolerance(why)) => Err(why),
-            Err(TrialError::Render(e)) => return Err(e),
+            Err(TrialError::Render(GpuError::LoopBudget(why))) => Err(format!(
+                "a render it needs (at most {}² lobe grids, {}² sun samples, {}² shadow rays) is beyond this \
+                 device: {why}",
+                s.shading.samples_per_axis, s.shading.sun_samples_per_axis, s.shading.shadow_samples_per_axis
+            )),
+            Err(TrialError::Render(e)) => return Err(e.into()),
         };
         rows.push(ToleranceRow { tolerance, outcome });
     }
     Ok(rows)
 }
 
-/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`).
-pub(super) fn tolerance_table(name: &str, rows: &[ToleranceRow], in_penumbrae: bool) -> String {
+/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `size`: the
+/// table's, where it is not the sweep's, and its truth's reference time [s]).
+pub(super) fn tolerance_table(
+    name: &str,
+    rows: &[ToleranceRow],
+    in_penumbrae: bool,
+    smaller: Option<((u32, u32), f64)>,
+) -> String {
     let flags = if in_penumbrae { "render --tolerance T --tolerance-in-penumbrae" } else { "render --tolerance T" };
+    let truth = match smaller {
+        Some(((w, h), seconds)) => format!(
+            "at {w}×{h}, against the converged reference at that size ({seconds:.1} s): the device has no ray \
+             queries, so its shadow rays walk the BVH in the fragment shader"
+        ),
+        None => "the same truth".into(),
+    };
     let mut out = format!(
-        "`{flags}` on {name} (the same truth; GPU time: the sum of the median warm frames of every render it made; \
-         max rel over every pixel, penumbrae included):\n\n| T | models chosen | renders | GPU time [ms] | max rel | \
-         predicted |\n|---:|---|---:|---:|---:|---:|\n"
+        "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
+         rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae, where a light \
+         is partly hidden: what `--tolerance` promises without `--tolerance-in-penumbrae`):\n\n| T | models chosen \
+         | renders | GPU time [ms] | max rel | max rel outside penumbrae | predicted |\n\
+         |---:|---|---:|---:|---:|---:|---:|\n"
     );
     for r in rows {
         out += &match &r.outcome {
             Ok(k) => format!(
-                "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.1e} |\n",
-                r.tolerance, k.models, k.renders, k.gpu_ms, k.max_rel, k.predicted
+                "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.1e} |\n",
+                r.tolerance, k.models, k.renders, k.gpu_ms, k.max_rel, k.max_rel_outside_penumbrae, k.predicted
             ),
-            Err(why) => format!("| {:.0e} | refused: {} | 0 | — | — | — |\n", r.tolerance, why.replace('|', "/")),
+            Err(why) => format!("| {:.0e} | refused: {} | 0 | — | — | — | — |\n", r.tolerance, why.replace('|', "/")),
         };
     }
     out + "\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_a_scene_that_shadows_itself_without_ray_queries_gets_a_smaller_table() {
+        assert_eq!(table_size((256, 256), false, true), (64, 64));
+        assert_eq!(table_size((256, 192), false, true), (64, 48));
+        assert_eq!(table_size((1000, 3), false, true), (64, 1), "at least one pixel a side");
+        assert_eq!(table_size((256, 256), true, true), (256, 256), "ray queries: the sweep's size");
+        assert_eq!(table_size((256, 256), false, false), (256, 256), "nothing to shadow");
+        assert_eq!(table_size((48, 36), false, true), (48, 36), "already small");
+    }
 }

@@ -1,0 +1,31 @@
+//! Where an image's shadows are soft: the pixels in a penumbra, as the reference's shadow rays see it.
+//!
+//! `--tolerance` without `--tolerance-in-penumbrae` promises its T outside the sun's penumbrae (where a light is
+//! partly hidden, its visible fraction is a grid's count and has no bound), so a measurement of that promise needs
+//! those pixels named. A pixel is in a penumbra where some light is neither wholly visible nor wholly hidden from
+//! it; there, and only there, the light's visible fraction from one ray to its centre (a hard shadow: 0 or 1)
+//! differs from the fraction over its disk. So the mask is the pixels where the reference with one shadow ray a
+//! light and the reference with the given grid of them differ at all, every other sample grid the same: outside a
+//! penumbra both renders run the same arithmetic on a fraction of exactly 0 or 1, and agree to the bit.
+//!
+//! What it cannot see is what the grid cannot: an occluder that every ray of the grid misses. The callers take
+//! the finest shadow grid the converged reference reached, which the truth's own pixels were judged by.
+
+use crate::cpu::{self, ReferenceOptions};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::shading::Shadows;
+
+/// The pixels (row-major, as the image's) in a penumbra of any light under `settings`' shadow rays (module
+/// text); all `false` where `settings` casts no shadow rays.
+pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, reference: &ReferenceOptions) -> Vec<bool> {
+    let pixels = (settings.width * settings.height) as usize;
+    if settings.shading.shadows != Shadows::Ray {
+        return vec![false; pixels];
+    }
+    let soft = cpu::render(scene, settings, reference);
+    let mut hard_settings = settings.clone();
+    hard_settings.shading.shadow_samples_per_axis = 1;
+    let hard = cpu::render(scene, &hard_settings, reference);
+    soft.pixels().iter().zip(hard.pixels()).map(|(s, h)| s[..3] != h[..3]).collect()
+}
