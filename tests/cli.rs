@@ -706,7 +706,9 @@ fn bench_pareto_keeps_the_tolerance_of_a_scene_that_shadows_itself() {
         let t = r["T"].as_f64().unwrap();
         assert!(r["max rel outside penumbrae"].as_f64().is_some_and(|e| e <= t), "{r}");
         assert!(r["max rel"].as_f64().is_some(), "{r}");
-        assert!(r["predicted"].as_f64().unwrap() <= t, "{r}");
+        // † where the prediction names the penumbrae as not bounded.
+        let predicted = r["predicted"].as_f64().or_else(|| r["predicted"].as_str()?.trim_end_matches('†').parse().ok());
+        assert!(predicted.unwrap() <= t, "{r}");
     }
 }
 

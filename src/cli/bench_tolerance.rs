@@ -41,7 +41,9 @@ struct Kept {
     renders: u32,
     max_rel: f64,
     max_rel_outside_penumbrae: f64,
-    predicted: f64,
+    /// The predicted bound, and whether part of the image has none (the penumbrae, without
+    /// `--tolerance-in-penumbrae`).
+    predicted: (f64, bool),
 }
 
 /// The longest side of the table on a device without ray queries, where a scene shadows itself [pixels].
@@ -122,7 +124,7 @@ pub(super) fn tolerance_rows(
                     renders,
                     max_rel: error(&excluded)?,
                     max_rel_outside_penumbrae: error(outside)?,
-                    predicted: done.prediction.max_relative,
+                    predicted: (done.prediction.max_relative, !done.prediction.unbounded.is_empty()),
                 })
             }
             Err(TrialError::Tolerance(why)) => Err(why),
@@ -157,15 +159,23 @@ pub(super) fn tolerance_table(
     let mut out = format!(
         "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
          rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae, where a light \
-         is partly hidden: what `--tolerance` promises without `--tolerance-in-penumbrae`):\n\n| T | models chosen \
+         is partly hidden: what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the prediction names \
+         part of the image as not bounded, the penumbrae):\n\n| T | models chosen \
          | renders | GPU time [ms] | max rel | max rel outside penumbrae | predicted |\n\
          |---:|---|---:|---:|---:|---:|---:|\n"
     );
     for r in rows {
         out += &match &r.outcome {
             Ok(k) => format!(
-                "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.1e} |\n",
-                r.tolerance, k.models, k.renders, k.gpu_ms, k.max_rel, k.max_rel_outside_penumbrae, k.predicted
+                "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.1e}{} |\n",
+                r.tolerance,
+                k.models,
+                k.renders,
+                k.gpu_ms,
+                k.max_rel,
+                k.max_rel_outside_penumbrae,
+                k.predicted.0,
+                if k.predicted.1 { "†" } else { "" }
             ),
             Err(why) => format!("| {:.0e} | refused: {} | 0 | — | — | — | — |\n", r.tolerance, why.replace('|', "/")),
         };
