@@ -27,8 +27,15 @@ use crate::shading::Shadows;
 /// The tolerances of the table.
 pub(super) const TOLERANCES: [f64; 3] = [1e-2, 1e-3, 1e-4];
 
+/// A scene's table: its rows, and how many of the truth's covered pixels are in a penumbra (where it was
+/// computed: once an image was kept) of how many.
+pub(super) struct ToleranceTable {
+    rows: Vec<ToleranceRow>,
+    penumbra_pixels: Option<(usize, usize)>,
+}
+
 /// What `--tolerance` did for one T.
-pub(super) struct ToleranceRow {
+struct ToleranceRow {
     tolerance: f64,
     outcome: Result<Kept, String>,
 }
@@ -79,11 +86,12 @@ pub(super) fn tolerance_rows(
     truth: &Converged,
     repeat: u32,
     in_penumbrae: bool,
-) -> Result<Vec<ToleranceRow>, CliError> {
+) -> Result<ToleranceTable, CliError> {
     let can_occlude = settings.shading.shadows != Shadows::None;
     let excluded = truth.unconverged_mask();
-    // Unconverged pixels and those in a penumbra, computed at the first image kept.
+    // Unconverged pixels and those in a penumbra, computed at the first image kept, and the penumbrae's pixels.
     let mut outside_penumbrae: Option<Vec<bool>> = None;
+    let mut penumbra_pixels = None;
     let mut rows = Vec::new();
     for tolerance in TOLERANCES {
         let mut s = settings.clone();
@@ -114,6 +122,10 @@ pub(super) fn tolerance_rows(
                     let mut finest = settings.clone();
                     finest.shading.shadow_samples_per_axis = truth.shading.shadow_samples_per_axis;
                     let penumbrae = penumbra_mask(scene, &finest, reference);
+                    let covered = truth.image.pixels().iter().map(|p| p[3] > 0.0);
+                    let counts =
+                        covered.zip(&penumbrae).fold((0, 0), |(n, c), (k, &p)| (n + (k && p) as usize, c + k as usize));
+                    penumbra_pixels = Some(counts);
                     excluded.iter().zip(penumbrae).map(|(&u, p)| u || p).collect()
                 });
                 let models: Vec<String> =
@@ -137,14 +149,14 @@ pub(super) fn tolerance_rows(
         };
         rows.push(ToleranceRow { tolerance, outcome });
     }
-    Ok(rows)
+    Ok(ToleranceTable { rows, penumbra_pixels })
 }
 
 /// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `size`: the
 /// table's, where it is not the sweep's, and its truth's reference time [s]).
 pub(super) fn tolerance_table(
     name: &str,
-    rows: &[ToleranceRow],
+    table: &ToleranceTable,
     in_penumbrae: bool,
     smaller: Option<((u32, u32), f64)>,
 ) -> String {
@@ -156,15 +168,19 @@ pub(super) fn tolerance_table(
         ),
         None => "the same truth".into(),
     };
+    let penumbrae = match table.penumbra_pixels {
+        Some((n, covered)) => format!(", {n} of its {covered} covered pixels"),
+        None => String::new(),
+    };
     let mut out = format!(
         "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
-         rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae, where a light \
-         is partly hidden: what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the prediction names \
+         rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae (where a light \
+         is partly hidden{penumbrae}): what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the prediction names \
          part of the image as not bounded, the penumbrae):\n\n| T | models chosen \
          | renders | GPU time [ms] | max rel | max rel outside penumbrae | predicted |\n\
          |---:|---|---:|---:|---:|---:|---:|\n"
     );
-    for r in rows {
+    for r in &table.rows {
         out += &match &r.outcome {
             Ok(k) => format!(
                 "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.1e}{} |\n",
