@@ -11,6 +11,7 @@
 //! What it cannot see is what the grid cannot: an occluder that every ray of the grid misses. The callers take
 //! the finest shadow grid the converged reference reached, which the truth's own pixels were judged by.
 
+use super::converged::Converged;
 use crate::cpu::{self, ReferenceOptions};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -28,4 +29,22 @@ pub fn penumbra_mask(scene: &Scene, settings: &RenderSettings, reference: &Refer
     hard_settings.shading.shadow_samples_per_axis = 1;
     let hard = cpu::render(scene, &hard_settings, reference);
     soft.pixels().iter().zip(hard.pixels()).map(|(s, h)| s[..3] != h[..3]).collect()
+}
+
+/// The pixels a measurement of `--tolerance`'s promise outside the penumbrae leaves out, against `truth`, the
+/// converged reference of `settings`: those the truth did not converge on, and those in a penumbra under the
+/// finest shadow rays the truth reached; with how many of the truth's covered pixels are in a penumbra.
+pub fn outside_penumbrae_excluded(
+    scene: &Scene,
+    settings: &RenderSettings,
+    truth: &Converged,
+    reference: &ReferenceOptions,
+) -> (Vec<bool>, usize) {
+    let mut finest = settings.clone();
+    finest.shading.shadow_samples_per_axis = truth.shading.shadow_samples_per_axis;
+    let penumbrae = penumbra_mask(scene, &finest, reference);
+    let covered_in_penumbrae =
+        truth.image.pixels().iter().zip(&penumbrae).filter(|(pixel, &p)| p && pixel[3] > 0.0).count();
+    let excluded = truth.unconverged_mask().into_iter().zip(penumbrae).map(|(u, p)| u || p).collect();
+    (excluded, covered_in_penumbrae)
 }

@@ -14,7 +14,7 @@ use super::metadata::{lobe_model_line, sun_model_line};
 use super::CliError;
 use crate::accuracy::converged::Converged;
 use crate::accuracy::error::image_error;
-use crate::accuracy::penumbrae::penumbra_mask;
+use crate::accuracy::penumbrae::outside_penumbrae_excluded;
 use crate::accuracy::predicted::Renderer as Predicted;
 use crate::accuracy::predicted::Request;
 use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
@@ -73,7 +73,7 @@ pub(super) fn table_size((width, height): (u32, u32), ray_queries: bool, can_occ
 /// table's size), rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat`
 /// warm frames; `truth` the converged reference at that size, its unconverged pixels left out; `in_penumbrae`:
 /// each T is held in the sun's penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows
-/// measure apart ([`penumbra_mask`] under the truth's finest shadow rays). A render the device cannot run (its
+/// measure apart ([`outside_penumbrae_excluded`]). A render the device cannot run (its
 /// loop limiter) is a refusal, as `render` makes it.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tolerance_rows(
@@ -119,14 +119,9 @@ pub(super) fn tolerance_rows(
                         .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))
                 };
                 let outside = outside_penumbrae.get_or_insert_with(|| {
-                    let mut finest = settings.clone();
-                    finest.shading.shadow_samples_per_axis = truth.shading.shadow_samples_per_axis;
-                    let penumbrae = penumbra_mask(scene, &finest, reference);
-                    let covered = truth.image.pixels().iter().map(|p| p[3] > 0.0);
-                    let counts =
-                        covered.zip(&penumbrae).fold((0, 0), |(n, c), (k, &p)| (n + (k && p) as usize, c + k as usize));
-                    penumbra_pixels = Some(counts);
-                    excluded.iter().zip(penumbrae).map(|(&u, p)| u || p).collect()
+                    let (excluded, in_penumbrae) = outside_penumbrae_excluded(scene, settings, truth, reference);
+                    penumbra_pixels = Some((in_penumbrae, truth.covered));
+                    excluded
                 });
                 let models: Vec<String> =
                     [Some(sun_model_line(&s, scene)), lobe_model_line(&s, scene)].into_iter().flatten().collect();
