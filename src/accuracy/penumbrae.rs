@@ -1,10 +1,10 @@
 //! Where an image's shadows are soft: the pixels in a penumbra, as the reference's shadow rays see it.
 //!
-//! `--tolerance` without `--tolerance-in-penumbrae` promises its T outside the sun's penumbrae (where a light is
-//! partly hidden, its visible fraction is a grid's count and has no bound), so a measurement of that promise needs
-//! those pixels named. A pixel is in a penumbra where some light is neither wholly visible nor wholly hidden from
+//! `--tolerance` without `--tolerance-in-penumbrae` promises its T outside the penumbrae (where a light is partly
+//! hidden, its visible fraction is a grid's count and has no bound), so a measurement of that promise needs those
+//! pixels named. A pixel is in a penumbra where some light is neither wholly visible nor wholly hidden from
 //! it; there, and only there, the light's visible fraction from one ray to its centre (a hard shadow: 0 or 1)
-//! differs from the fraction over its disk. So the mask is the pixels where the reference with one shadow ray a
+//! differs from the fraction over the light (the sun's disk, a disk light's, the sky's lune). So the mask is the pixels where the reference with one shadow ray a
 //! light and the reference with the given grid of them differ at all, every other sample grid the same: outside a
 //! penumbra both renders run the same arithmetic on a fraction of exactly 0 or 1, and agree to the bit.
 //!

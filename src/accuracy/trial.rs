@@ -36,9 +36,9 @@ pub struct WithinTolerance<T> {
 /// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it
 /// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside every light's
 /// penumbrae (where a light is partly hidden: under a sky, every point that sees an occluder above its horizon),
-/// which the prediction names as not bounded (`super::penumbrae` finds them to measure it); with it, the shadow rays' grids
-/// are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in penumbrae
-/// (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
+/// which the prediction names as not bounded (`super::penumbrae` finds them to measure it); with it, the shadow
+/// rays' grids are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in
+/// penumbrae (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     pub max_relative: f64,
@@ -165,8 +165,8 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 /// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]),
 /// the shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a
 /// specular penumbra). Refused as [`techniques_within`] refuses (the device's interpolation, shadows other than
-/// rays), where the sun's bound
-/// cannot meet three quarters of the tolerance, or where the ladder's finest grid does not meet it.
+/// rays), where the sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid
+/// does not meet it.
 fn lobe_study<T, E>(
     request: Request,
     settings: &mut RenderSettings,

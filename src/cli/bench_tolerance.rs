@@ -58,8 +58,9 @@ pub(super) const WALK_TABLE_SIDE: u32 = 64;
 
 /// The size of a scene's `--tolerance` table: the sweep's, but on a device without ray queries for a scene that
 /// shadows itself, scaled down (aspect kept, sides rounded, at least 1) so that its longer side is at most
-/// [`WALK_TABLE_SIDE`]. Measured on the system lavapipe (Mesa 22.3.6, 2 threads): the tables of the eight models at
-/// 64² took about a minute, against 4 to 8 s a render of one at 256².
+/// [`WALK_TABLE_SIDE`]. Measured on the system lavapipe (Mesa 22.3.6, 2 threads): the whole bench of the eight
+/// models at 64² (their sweeps too) took 67 s, where one render of teapot.glb or sunset.glb walking the BVH at 256²
+/// takes 4 to 8 s.
 pub(super) fn table_size((width, height): (u32, u32), ray_queries: bool, can_occlude: bool) -> (u32, u32) {
     let longer = width.max(height);
     if ray_queries || !can_occlude || longer <= WALK_TABLE_SIDE {
@@ -72,7 +73,7 @@ pub(super) fn table_size((width, height): (u32, u32), ray_queries: bool, can_occ
 /// The table's rows for one scene: `settings` as resolved (default models, shadows as the truth has them, the
 /// table's size), rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat`
 /// warm frames; `truth` the converged reference at that size, its unconverged pixels left out; `in_penumbrae`:
-/// each T is held in the sun's penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows
+/// each T is held in the penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows
 /// measure apart ([`outside_penumbrae_excluded`]). A render the device cannot run (its
 /// loop limiter) is a refusal, as `render` makes it.
 #[allow(clippy::too_many_arguments)]
