@@ -384,12 +384,6 @@ fn occlusion_and_arithmetic(
                 p.unbounded.push("the shadow maps".into())
             }
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
-            // Under a sky, every point that sees an occluder above its horizon is in the sky's penumbra.
-            _ if settings.lights.sky.is_some() => p.unbounded.push(
-                "penumbrae (the shadow rays' visible fractions; under the sky every point that sees an occluder \
-                 above its horizon: --tolerance-in-penumbrae estimates them)"
-                    .into(),
-            ),
             _ => p
                 .unbounded
                 .push("penumbrae (the shadow rays' visible fractions: --tolerance-in-penumbrae estimates them)".into()),
@@ -494,20 +488,33 @@ pub fn choose_for_tolerance_with_peak(
 }
 
 /// What `--tolerance` refuses whatever the materials, or the settings with the disk lights' exact model (on
-/// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): the device's
-/// interpolation, shadows other than rays where the scene can shadow itself. Light through occluders is not
-/// refused: outside the penumbrae every light's visible fraction is exactly 0 or 1 whatever the shadow rays' grid,
-/// and the promise holds there (the prediction names the penumbrae as not bounded) unless
-/// `--tolerance-in-penumbrae` studies them too ([`penumbrae_need_study`]). Before 2026-12-03 the light of disk
-/// lights and the sky through occluders was refused without that study, a sky's penumbra covering every point that
-/// sees an occluder above its horizon (on overcast.glb 2193 of 2461 pixels at 64²; on room.gltf's disk skylight 222
-/// of 4096).
+/// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): the light of the sky
+/// through occluders unless the shadow rays' grids are estimated by refinement (`shadow_grids`:
+/// `--tolerance-in-penumbrae`, [`penumbrae_need_study`]), the device's interpolation, shadows other than rays
+/// where the scene can shadow itself.
+///
+/// The light of the sun and of disk lights through occluders is held outside their penumbrae, where a light's
+/// visible fraction is exactly 0 or 1 whatever the shadow rays' grid (the prediction names the penumbrae as not
+/// bounded); a disk light's penumbrae are where its shadows are, as the sun's (room.gltf's disk skylight: 222 of
+/// 4096 pixels at 64²). The sky's penumbra is every point that sees an occluder above its horizon, nearly a whole
+/// image that has occluders (overcast.glb: 2193 of 2461 pixels; brdfs.glb under a sky: 2515 of 2518), so a promise
+/// outside it would be one about almost nothing: refused. (Until 2026-12-03 disk lights were refused alike.)
 pub(crate) fn techniques_within(
     settings: &RenderSettings,
     renderer: Renderer,
     can_occlude: bool,
+    shadow_grids: bool,
     tolerance: f64,
 ) -> Result<ShadingOptions, String> {
+    if settings.lights.sky.is_some() && can_occlude && !shadow_grids {
+        return Err(format!(
+            "--tolerance {tolerance:e}: the scene can shadow itself, and the sky's penumbra is every point that sees \
+             an occluder above its horizon (nearly the whole image), where its visible fraction has no bound (a \
+             shadow-ray grid errs by the share of its cells an occluder's edge crosses): --tolerance-in-penumbrae \
+             estimates it by refinement (costly: it converges at first order), --shadows none bounds the render \
+             against the unshadowed truth"
+        ));
+    }
     let mut shading = settings.shading;
     shading.disk = DiskModel::Exact;
     if let Renderer::Gpu { barycentrics: Barycentrics::Device } = renderer {
@@ -548,7 +555,7 @@ pub(crate) fn choose_sun_within(
              do; docs/accuracy.md, \"Error bounds\")"
         ));
     }
-    let mut shading = techniques_within(settings, renderer, can_occlude, tolerance)?;
+    let mut shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
     let lights = &settings.lights;
     let arithmetic = renderer.arithmetic();
     let Some(sun) = &lights.sun else { return Ok(Choice::uniform(shading)) };

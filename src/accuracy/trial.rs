@@ -34,10 +34,10 @@ pub struct WithinTolerance<T> {
 }
 
 /// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it
-/// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside every light's
-/// penumbrae (where a light is partly hidden: under a sky, every point that sees an occluder above its horizon),
-/// which the prediction names as not bounded (`super::penumbrae` finds them to measure it); with it, the shadow
-/// rays' grids are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in
+/// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside the penumbrae of
+/// the sun and of disk lights (where a light is partly hidden), which the prediction names as not bounded
+/// (`super::penumbrae` finds them to measure it), and the sky through occluders is refused (its penumbra is every
+/// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in
 /// penumbrae (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
@@ -164,9 +164,9 @@ pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 /// refined on the same rungs instead, and the estimate gets all of the tolerance but the arithmetic; where the
 /// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]),
 /// the shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a
-/// specular penumbra). Refused as [`techniques_within`] refuses (the device's interpolation, shadows other than
-/// rays), where the sun's bound cannot meet three quarters of the tolerance, or where the ladder's finest grid
-/// does not meet it.
+/// specular penumbra). Refused as [`techniques_within`] refuses (the sky through occluders without `shadow_grids`,
+/// the device's interpolation, shadows other than rays), where the sun's bound cannot meet three quarters of the
+/// tolerance, or where the ladder's finest grid does not meet it.
 fn lobe_study<T, E>(
     request: Request,
     settings: &mut RenderSettings,
@@ -181,8 +181,8 @@ fn lobe_study<T, E>(
     let budget = if sun_grid || settings.lights.sun.is_none() {
         // No sun's bound to choose: the sun's grid is on the ladder too (the disk sun; the estimate covers it), or
         // there is no sun.
-        settings.shading =
-            techniques_within(settings, renderer, can_occlude, tolerance).map_err(TrialError::Tolerance)?;
+        settings.shading = techniques_within(settings, renderer, can_occlude, shadow_grid, tolerance)
+            .map_err(TrialError::Tolerance)?;
         settings.sun_per_material.clear();
         if sun_grid {
             settings.shading.sun = SunModel::Disk;

@@ -261,18 +261,20 @@ pub struct SceneArgs {
     /// leaves (with several specular materials, a ladder per material: each keeps the coarsest rung that fits its
     /// own pixels); measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
     /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
-    /// and kept within REL beside the models'. Refused: the device's interpolation and `--shadows map` (`auto`
+    /// and kept within REL beside the models'. Refused: light of the sky through occluders (its penumbra is every
+    /// point that sees an occluder above its horizon), the device's interpolation, and `--shadows map` (`auto`
     /// casts shadow rays, on a device without ray queries by the shader's walk of the scene's BVH; `--shadows
     /// none` measures against the unshadowed truth). Where the scene shadows itself the promise holds outside the
-    /// penumbrae, where a light is partly hidden (under a sky: every point that sees an occluder above its
-    /// horizon; `-v` names them as not bounded); `--tolerance-in-penumbrae` extends it to them.
+    /// penumbrae of the sun and of disk lights (`-v` names them as not bounded); `--tolerance-in-penumbrae`
+    /// extends it to them and to the sky.
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
     /// With --tolerance: hold it in penumbrae too. The shadow rays' grids (overriding --shadow-samples) go on the
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
-    /// penumbra, the lights' located edges at second). Costly, and refused where the ladder
+    /// penumbra, the lights' located edges at second). Light of the sky through occluders is then estimated
+    /// instead of refused. Costly, and refused where the ladder
     /// cannot reach T: in the dark end of a penumbra the visible fraction must be right to T/100 of the peak (the
     /// diff's floor).
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
