@@ -37,8 +37,9 @@ pub struct WithinTolerance<T> {
 /// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside the penumbrae of
 /// the sun and of disk lights (where a light is partly hidden), which the prediction names as not bounded
 /// (`super::penumbrae` finds them to measure it), and the sky through occluders is refused (its penumbra is every
-/// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in
-/// penumbrae (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
+/// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are
+/// refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in penumbrae
+/// (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     pub max_relative: f64,

@@ -274,9 +274,8 @@ pub struct SceneArgs {
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
     /// penumbra, the lights' located edges at second). Light of the sky through occluders is then estimated
-    /// instead of refused. Costly, and refused where the ladder
-    /// cannot reach T: in the dark end of a penumbra the visible fraction must be right to T/100 of the peak (the
-    /// diff's floor).
+    /// instead of refused. Costly, and refused where the ladder cannot reach T: in the dark end of a penumbra the
+    /// visible fraction must be right to T/100 of the peak (the diff's floor).
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
     pub tolerance_in_penumbrae: bool,
 
