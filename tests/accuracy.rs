@@ -795,12 +795,7 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
             assert!(everywhere <= 1e-2, "{name}: {everywhere:.3e} over 1e-2\n{e}");
         }
     }
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
-        .args(["render", "models/overcast.glb", "--width", "48", "--height", "36", "--tolerance", "1e-2", "-o"])
-        .arg(dir.path("overcast.exr"))
-        .env("SUNSHADE_VALIDATION", "1")
-        .output()
-        .unwrap();
+    let o = render_to("models/overcast.glb --width 48 --height 36 --tolerance 1e-2", &dir.path("overcast.exr"));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.code() == Some(2) && e.contains("the sky's penumbra"), "{e}");
     assert!(!dir.path("overcast.exr").exists(), "no image where it refused");
@@ -858,18 +853,23 @@ fn reference_tolerance_in_penumbrae_keeps_the_sky_through_occluders() {
     assert!(measured <= 1e-2, "{measured:.3e} over 1e-2\n{e}");
 }
 
-/// `sunshade render FLAGS -o OUT` with validation on (FLAGS split at white space, paths relative to the crate):
-/// its stderr, asserting success; `None` where the device's interpolation has no bound for `--tolerance` to keep
-/// (a device without f64 interpolation).
-fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
+/// `sunshade render FLAGS -o OUT`, validation on.
+fn render_to(flags: &str, out: &std::path::Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
         .arg("render")
         .args(flags.split_whitespace())
         .arg("-o")
         .arg(out)
         .env("SUNSHADE_VALIDATION", "1")
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// `sunshade render FLAGS -o OUT` with validation on (FLAGS split at white space, paths relative to the crate):
+/// its stderr, asserting success; `None` where the device's interpolation has no bound for `--tolerance` to keep
+/// (a device without f64 interpolation).
+fn render_with_tolerance(flags: &str, out: &std::path::Path) -> Option<String> {
+    let o = render_to(flags, out);
     let e = String::from_utf8_lossy(&o.stderr).into_owned();
     if e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
         return None;

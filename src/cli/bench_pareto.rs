@@ -106,16 +106,18 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(default_mode) };
         // Without ray queries a scene that shadows itself gets the table at a smaller size, with its own truth.
         let size = table_size((width, height), ray_queries, can_occlude);
-        let smaller = (size != (width, height)).then(|| {
+        let smaller = if size != (width, height) {
             bar.set_message(format!("{name}: the converged reference at {}×{} for --tolerance", size.0, size.1));
             let t = Instant::now();
             let mut small =
                 settings::resolve(&scene, size.0, size.1, &CameraOptions::default(), &SunOptions::default())
-                    .expect("resolved at the sweep's size");
+                    .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
             small.shading.shadows = truth_settings.shading.shadows;
             let truth = render_converged(&scene, &small, &reference, &convergence);
-            (small, truth, t.elapsed().as_secs_f64())
-        });
+            Some((small, truth, t.elapsed().as_secs_f64()))
+        } else {
+            None
+        };
         let (table_settings, table_truth) = match &smaller {
             Some((small, truth, _)) => (small, truth),
             None => (&truth_settings, &truth),

@@ -11,6 +11,7 @@ use std::time::Duration;
 
 use super::bench::{median, ms, warm_frames};
 use super::metadata::{lobe_model_line, sun_model_line};
+use super::render::beyond_this_device;
 use super::CliError;
 use crate::accuracy::converged::Converged;
 use crate::accuracy::error::image_error;
@@ -73,9 +74,9 @@ pub(super) fn table_size((width, height): (u32, u32), ray_queries: bool, can_occ
 /// The table's rows for one scene: `settings` as resolved (default models, shadows as the truth has them, the
 /// table's size), rendered on `renderer` (whose error is predicted as `predicted`), each render timed by `repeat`
 /// warm frames; `truth` the converged reference at that size, its unconverged pixels left out; `in_penumbrae`:
-/// each T is held in the penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows
-/// measure apart ([`outside_penumbrae_excluded`]). A render the device cannot run (its
-/// loop limiter) is a refusal, as `render` makes it.
+/// each T is held in the penumbrae too (`--tolerance-in-penumbrae`), else outside them, which the rows measure
+/// apart ([`outside_penumbrae_excluded`]). A render the device cannot run (its loop limiter) is a refusal, as
+/// `render` makes it ([`beyond_this_device`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tolerance_rows(
     scene: &Scene,
@@ -136,11 +137,7 @@ pub(super) fn tolerance_rows(
                 })
             }
             Err(TrialError::Tolerance(why)) => Err(why),
-            Err(TrialError::Render(GpuError::LoopBudget(why))) => Err(format!(
-                "a render it needs (at most {}² lobe grids, {}² sun samples, {}² shadow rays) is beyond this \
-                 device: {why}",
-                s.shading.samples_per_axis, s.shading.sun_samples_per_axis, s.shading.shadow_samples_per_axis
-            )),
+            Err(TrialError::Render(GpuError::LoopBudget(why))) => Err(beyond_this_device(&s, &why)),
             Err(TrialError::Render(e)) => return Err(e.into()),
         };
         rows.push(ToleranceRow { tolerance, outcome });
@@ -148,8 +145,8 @@ pub(super) fn tolerance_rows(
     Ok(ToleranceTable { rows, penumbra_pixels })
 }
 
-/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `size`: the
-/// table's, where it is not the sweep's, and its truth's reference time [s]).
+/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `smaller`: the
+/// table's size where it is not the sweep's, and how long its own truth took [s]).
 pub(super) fn tolerance_table(
     name: &str,
     table: &ToleranceTable,
@@ -171,9 +168,9 @@ pub(super) fn tolerance_table(
     let mut out = format!(
         "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
          rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae (where a light \
-         is partly hidden{penumbrae}): what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the prediction names \
-         part of the image as not bounded, the penumbrae):\n\n| T | models chosen \
-         | renders | GPU time [ms] | max rel | max rel outside penumbrae | predicted |\n\
+         is partly hidden{penumbrae}): what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the \
+         prediction names part of the image as not bounded, the penumbrae):\n\n| T | models chosen | renders | GPU \
+         time [ms] | max rel | max rel outside penumbrae | predicted |\n\
          |---:|---|---:|---:|---:|---:|---:|\n"
     );
     for r in &table.rows {

@@ -169,14 +169,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         (TrialError::Tolerance(why), _) => CliError::Usage(why),
         // A render the device cannot run (`settings` holds its grids, the finest of any material's): the models
         // chosen, or a grid the study went on to; no setting it can render meets the tolerance.
-        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
-            "--tolerance {:e}: a render it needs (at most {}² lobe grids, {}² sun samples, {}² shadow rays; the \
-             next rung where it studies its grids) is beyond this device: {why}",
-            t.max_relative,
-            settings.shading.samples_per_axis,
-            settings.shading.sun_samples_per_axis,
-            settings.shading.shadow_samples_per_axis
-        )),
+        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => {
+            CliError::Usage(format!("--tolerance {:e}: {}", t.max_relative, beyond_this_device(&settings, &why)))
+        }
         (TrialError::Render(e), _) => CliError::from(e),
     })?;
     let (image, _) = done.kept;
@@ -184,6 +179,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let prediction = done.prediction;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
+}
+
+/// Why `--tolerance` stopped at a render the device's loop limiter refused (`why`): `settings` holds that render's
+/// grids, the finest of any material's (the models chosen, or the next rung where it studies its grids).
+pub(super) fn beyond_this_device(settings: &RenderSettings, why: &str) -> String {
+    format!(
+        "a render it needs (at most {}² lobe grids, {}² sun samples, {}² shadow rays; the next rung where it studies \
+         its grids) is beyond this device: {why}",
+        settings.shading.samples_per_axis,
+        settings.shading.sun_samples_per_axis,
+        settings.shading.shadow_samples_per_axis
+    )
 }
 
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
