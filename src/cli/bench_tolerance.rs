@@ -136,13 +136,22 @@ pub(super) fn tolerance_rows(
                     predicted: (done.prediction.max_relative, !done.prediction.unbounded.is_empty()),
                 })
             }
-            Err(TrialError::Tolerance(why)) => Err(why),
-            Err(TrialError::Render(GpuError::LoopBudget(why))) => Err(beyond_this_device(&s, &why)),
-            Err(TrialError::Render(e)) => return Err(e.into()),
+            Err(e) => Err(refusal(&s, e)?),
         };
         rows.push(ToleranceRow { tolerance, outcome });
     }
     Ok(ToleranceTable { rows, penumbra_pixels })
+}
+
+/// The row of a T that `--tolerance` did not keep an image for, `settings` its last render's: its refusal, or
+/// the device's loop limiter refusing that render (as `render` words it, [`beyond_this_device`]); any other
+/// failure of the GPU fails the bench.
+fn refusal(settings: &RenderSettings, error: TrialError<GpuError>) -> Result<String, CliError> {
+    match error {
+        TrialError::Tolerance(why) => Ok(why),
+        TrialError::Render(GpuError::LoopBudget(why)) => Ok(beyond_this_device(settings, &why)),
+        TrialError::Render(e) => Err(e.into()),
+    }
 }
 
 /// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `smaller`: the
@@ -195,6 +204,40 @@ pub(super) fn tolerance_table(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::light::Lights;
+    use crate::scene::{Camera, Projection};
+    use glam::DVec3;
+
+    /// The loop limiter's refusal becomes a row naming the render that met it; other failures of the GPU fail the
+    /// bench instead of hiding in a row.
+    #[test]
+    fn a_render_the_loop_limiter_cut_short_is_a_refused_row() {
+        let camera = Camera::looking(
+            DVec3::ZERO,
+            -DVec3::Z,
+            DVec3::Y,
+            Projection::Orthographic { ymag: 1.0, znear: 0.1, zfar: 10.0 },
+        )
+        .unwrap();
+        let mut settings = RenderSettings::new(8, 8, camera, Lights::default());
+        settings.shading.samples_per_axis = 27;
+        settings.shading.shadow_samples_per_axis = 13;
+        let why = "llvmpipe cut the loops of 41 pixel(s) short".to_string();
+        let row = refusal(&settings, TrialError::Render(GpuError::LoopBudget(why))).unwrap();
+        assert!(row.contains("27² lobe grids") && row.contains("13² shadow rays"), "{row}");
+        assert!(row.contains("beyond this device: llvmpipe cut the loops of 41 pixel(s) short"), "{row}");
+        assert_eq!(refusal(&settings, TrialError::Tolerance("no bound".into())).unwrap(), "no bound");
+        let failed = refusal(&settings, TrialError::Render(GpuError::Validation(vec!["VUID".into()])));
+        assert!(failed.is_err(), "a validation message fails the bench");
+
+        let table = ToleranceTable {
+            rows: vec![ToleranceRow { tolerance: 1e-3, outcome: Err(format!("a | b {row}")) }],
+            penumbra_pixels: None,
+        };
+        let text = tolerance_table("overcast.glb", &table, true, None);
+        let line = text.lines().find(|l| l.starts_with("| 1e-3 |")).expect("the refused row");
+        assert!(line.contains("refused: a / b a render it needs") && line.ends_with("| 0 | — | — | — | — |"), "{line}");
+    }
 
     #[test]
     fn only_a_scene_that_shadows_itself_without_ray_queries_gets_a_smaller_table() {
