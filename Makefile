@@ -29,6 +29,7 @@ test: setup
 lint:
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps
 
 # Regenerates the measured figures in README.md and docs/accuracy.md (on this machine; the tables name it).
 bench: build

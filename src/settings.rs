@@ -11,7 +11,7 @@ use crate::shading::radiometry::{
 };
 use crate::shading::{ShadingOptions, SunChoice};
 
-/// Default image size [pixels].
+/// Default image size \[pixels\].
 pub const DEFAULT_WIDTH: u32 = 512;
 pub const DEFAULT_HEIGHT: u32 = 512;
 /// Direction towards the sun when neither the scene nor the flags give one (normalised).
@@ -96,7 +96,7 @@ pub struct CameraOptions {
     pub eye: Option<DVec3>,
     pub target: Option<DVec3>,
     pub up: Option<DVec3>,
-    /// Vertical field of view [degrees] (perspective only).
+    /// Vertical field of view \[degrees\] (perspective only).
     pub fov_degrees: Option<f64>,
 }
 
@@ -105,15 +105,15 @@ pub struct CameraOptions {
 pub struct SunOptions {
     /// Direction towards the sun (need not be normalised).
     pub direction: Option<DVec3>,
-    /// Elevation above the horizontal XZ plane [degrees].
+    /// Elevation above the horizontal XZ plane \[degrees\].
     pub elevation_degrees: Option<f64>,
-    /// Azimuth [degrees]: 0° towards +Z, 90° towards +X.
+    /// Azimuth \[degrees\]: 0° towards +Z, 90° towards +X.
     pub azimuth_degrees: Option<f64>,
     /// `E⊥` [W/m²].
     pub irradiance: Option<f64>,
     /// `L_sun` [W/(m²·sr)] (alternative to `irradiance`).
     pub radiance: Option<f64>,
-    /// Angular diameter [degrees].
+    /// Angular diameter \[degrees\].
     pub diameter_degrees: Option<f64>,
     /// Per-channel factors on `E⊥`.
     pub color: Option<[f64; 3]>,
@@ -151,7 +151,7 @@ fn usage(msg: impl Into<String>) -> SettingsError {
     SettingsError(msg.into())
 }
 
-/// Unit direction towards the sun from elevation and azimuth [degrees]: `(cos e sin a, sin e, cos e cos a)`.
+/// Unit direction towards the sun from elevation and azimuth \[degrees\]: `(cos e sin a, sin e, cos e cos a)`.
 pub fn sun_direction_from_angles(elevation_degrees: f64, azimuth_degrees: f64) -> DVec3 {
     let (e, a) = (degrees_to_radians(elevation_degrees), degrees_to_radians(azimuth_degrees));
     DVec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos())

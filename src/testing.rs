@@ -5,7 +5,7 @@
 //!   one the command line gives.
 //! - [`CheckedRenderer`]: the GPU renderer with Vulkan validation on; any validation message fails (the renderer
 //!   sunshade's own tests use).
-//! - [`reference`]: the CPU reference of a job, with a device's [`ReferenceOptions`].
+//! - [`reference`](fn@reference): the CPU reference of a job, with a device's [`ReferenceOptions`].
 //! - [`assert_images_close!`](crate::assert_images_close) and
 //!   [`assert_matches_golden!`](crate::assert_matches_golden): the comparison of `sunshade diff` (default: the
 //!   tolerance of `render --check`). A golden is an EXR file. With `UPDATE_GOLDENS=1` the golden is (re)written;

@@ -57,7 +57,7 @@ pub const GPU_ARITHMETIC: f64 = 1e-5;
 /// The viewer's polar angles [degrees] of the curvature scan (besides those about each mirror configuration).
 const VIEW_POLAR_DEGREES: [f64; 11] = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 85.0, 88.0];
 
-/// The range of angles [rad] between the sun and the direction towards the viewer that a render can show: a
+/// The range of angles \[rad\] between the sun and the direction towards the viewer that a render can show: a
 /// perspective camera's viewer directions span its frustum, to the corners; an orthographic camera's are one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SunViewAngles {
@@ -123,7 +123,7 @@ fn configurations(width: f64, angles: SunViewAngles, azimuths: &[f64]) -> Vec<(D
 
 /// A lobe's largest cell-scale curvatures against the floor: `max (|f₁₁| + |f₂₂|)` and `max |f₁₁ + f₂₂|` over the
 /// configurations of the module's text with the sun-view angles `angles`, by second differences of step `step`
-/// [rad]. 0 for a BRDF without a lobe.
+/// \[rad\]. 0 for a BRDF without a lobe.
 ///
 /// The scan is a pure function of its arguments and costs ~10 ms a material; its results are kept for the
 /// process (a batch of renders, `--tolerance` trying grid after grid, asks the same questions again).
@@ -219,7 +219,7 @@ fn kink(brdf: &Brdf) -> Option<f64> {
 }
 
 /// The relative error bound of the delta sun's lobe term against the disk sun's exact integral, for this BRDF
-/// under a sun of angular radius `r` [rad]: `(r²/8) max |∇²f|` (see the module's text), at most 1.
+/// under a sun of angular radius `r` \[rad\]: `(r²/8) max |∇²f|` (see the module's text), at most 1.
 pub fn sun_delta_bound(brdf: &Brdf, r: f64, angles: SunViewAngles) -> f64 {
     if matches!(brdf, Brdf::Lambert { .. }) {
         return 0.0;

@@ -11,7 +11,7 @@
 //! penumbrae without that study, shadow maps, the device's interpolation (f32 barycentrics are bounded where
 //! `--tolerance` computes it: `super::interpolation`), and shadows turned off in a scene that can shadow itself
 //! (there the error is up to 100%). An irradiance image has no lobes: its lights'
-//! closed forms are exact ([`predict_irradiance`]).
+//! closed forms are exact (`predict_irradiance`).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
@@ -246,7 +246,7 @@ pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can
 }
 
 /// [`predict`], where a delta sun's render is known to peak at `rendered` [W/(m²·sr)] (its own image's peak): the
-/// horizon term is then taken against that peak ([`horizon_terms`]) instead of the material's own response.
+/// horizon term is then taken against that peak (`horizon_terms`) instead of the material's own response.
 /// `lobes`: the refinement's estimate of the lobe grids under disk lights and the sky where one was made
 /// ([`super::refinement`]); it adds to the sun's term (both err at the same pixels).
 pub fn predict_with_peak(
@@ -435,7 +435,7 @@ pub fn choose_for_tolerance(
     choose_for_tolerance_with_peak(scene, settings, renderer, can_occlude, tolerance, None)
 }
 
-/// Whether a delta-sun render of `scene` is worth trying for `tolerance` before choosing ([`delta_peak`]'s
+/// Whether a delta-sun render of `scene` is worth trying for `tolerance` before choosing (`delta_peak`'s
 /// caller renders it and passes its peak to [`choose_for_tolerance_with_peak`]): the choice without it is not the
 /// delta sun, the scene shows the sun a horizon, and every other term of the delta sun's bound meets the tolerance,
 /// so that only the horizon term, taken against the render's peak, decides.

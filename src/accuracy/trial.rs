@@ -38,7 +38,7 @@ pub struct WithinTolerance<T> {
 /// the sun and of disk lights (where a light is partly hidden), which the prediction names as not bounded
 /// (`super::penumbrae` finds them to measure it), and the sky through occluders is refused (its penumbra is every
 /// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are
-/// refined by the study with every other grid ([`lobe_study`]), whose first-order convergence in penumbrae
+/// refined by the study with every other grid (`lobe_study`), whose first-order convergence in penumbrae
 /// (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
@@ -67,7 +67,7 @@ pub enum TrialError<E> {
 /// Renders the request's scene with `--tolerance`'s models (`settings.shading` updated to them) by `render` (whose
 /// result holds an image, `image_of`), and predicts its error for the request's renderer. A delta render, asked
 /// for or chosen, has its horizon term taken against its own image's peak. Specular surfaces under disk lights or
-/// the sky, measured materials, and penumbrae where the tolerance is to hold there: [`lobe_study`]. On a GPU with
+/// the sky, measured materials, and penumbrae where the tolerance is to hold there: `lobe_study`. On a GPU with
 /// f32 barycentrics, the bound they add (`accuracy::interpolation`) is computed by the reference with `reference`
 /// (mirroring the device) and kept within the tolerance beside the models'.
 pub fn render_within_tolerance<T, E>(

@@ -16,7 +16,7 @@ pub struct ChartMaterial {
     pub extras: Value,
 }
 
-/// Angles [degrees] between the viewer (+Z) and the sun in the chart's renders.
+/// Angles \[degrees\] between the viewer (+Z) and the sun in the chart's renders.
 pub const SUN_FROM_VIEW_DEGREES: [f64; 3] = [20.0, 60.0, 85.0];
 
 /// Direction towards the sun at `degrees` from the viewer (+Z), leaning towards (0.8, 0.6, 0).

@@ -256,7 +256,7 @@ impl GltfBuilder {
         self.textures.len() - 1
     }
 
-    /// Adds a perspective camera (`yfov` [rad], `zfar = None` infinite); returns its index.
+    /// Adds a perspective camera (`yfov` \[rad\], `zfar = None` infinite); returns its index.
     pub fn add_perspective_camera(&mut self, yfov: f32, znear: f32, zfar: Option<f32>) -> usize {
         let mut p = json!({ "yfov": yfov, "znear": znear, "aspectRatio": 1.0 });
         if let Some(f) = zfar {
@@ -266,7 +266,7 @@ impl GltfBuilder {
         self.cameras.len() - 1
     }
 
-    /// Adds an orthographic camera (half-sizes [m]); returns its index.
+    /// Adds an orthographic camera (half-sizes \[m\]); returns its index.
     pub fn add_orthographic_camera(&mut self, xmag: f32, ymag: f32, znear: f32, zfar: f32) -> usize {
         self.cameras.push(json!({
             "type": "orthographic",

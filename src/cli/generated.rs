@@ -50,7 +50,7 @@ pub fn cpu_model() -> String {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }
 
-/// "<cpu model> (<n> threads)".
+/// "`<cpu model> (<n> threads)`".
 pub fn machine() -> String {
     format!("{} ({} threads)", cpu_model(), std::thread::available_parallelism().map_or(1, |n| n.get()))
 }

@@ -7,7 +7,7 @@
 //! The *reach* of a pixel's map lookups, for each light with a map (`gpu::renderer` fits the same frames,
 //! `visibility::shadow_map`):
 //! - **sun** (orthographic): every texel within `search + 1.5` texels of the point's map position, `search =
-//!   d tan(δ/2) / texel` for the PCSS filter (`d` the point's depth from the sun [m]), 0 for the nearest texel or
+//!   d tan(δ/2) / texel` for the PCSS filter (`d` the point's depth from the sun \[m\]), 0 for the nearest texel or
 //!   a delta sun; 1.5 texels cover the texel a lookup rounds to and the f32 map position. Each is a ray along
 //!   the sun from the receiver's own plane under that texel (the plane the map compares with), starting past
 //!   the map's depth tolerance.

@@ -67,7 +67,7 @@ impl Default for ReferenceOptions {
     }
 }
 
-/// The longest side the reference renders [pixels]: lavapipe's `maxImageDimension2D`, so that the reference has
+/// The longest side the reference renders \[pixels\]: lavapipe's `maxImageDimension2D`, so that the reference has
 /// the GPU's limits.
 pub const MAX_DIMENSION: u32 = 16384;
 
@@ -275,11 +275,11 @@ pub const FRAGILE_TEXTURE_RELATIVE: f64 = 1.0 / 65536.0;
 
 /// [`render`], and for each pixel whether it is *fragile*: one of its shadow rays passes within
 /// [`FRAGILE_RAY_RELATIVE`] of the scene's size from an occluder's boundary, so that the GPU's f32 geometry could
-/// answer it the other way ([`Bvh::occluded_with_margin`]), or one of its texture lookups (or its alpha mask) lies
-/// within [`FRAGILE_TEXTURE_RELATIVE`] of a discontinuity (a `NEAREST` texel boundary, a nearest mip level's
-/// boundary, the switch between magnification and minification filters, an alpha cutoff). Image-diff tests count
-/// GPU/reference differences at those pixels apart, as coverage mismatches at triangle edges are. Slower than
-/// [`render`] (every ray traverses with padded boxes and tests edge distances).
+/// answer it the other way ([`crate::visibility::Bvh::occluded_with_margin`]), or one of its texture lookups
+/// (or its alpha mask) lies within [`FRAGILE_TEXTURE_RELATIVE`] of a discontinuity (a `NEAREST` texel
+/// boundary, a nearest mip level's boundary, the switch between magnification and minification filters, an alpha
+/// cutoff). Image-diff tests count GPU/reference differences at those pixels apart, as coverage mismatches at
+/// triangle edges are. Slower than [`render`] (every ray traverses with padded boxes and tests edge distances).
 pub fn render_with_fragile_pixels(
     scene: &Scene,
     settings: &RenderSettings,
@@ -431,7 +431,7 @@ fn render_inner(
     (image, mask)
 }
 
-/// For each pixel, the distance [pixels] from its sample to the nearest edge of any triangle whose bounds
+/// For each pixel, the distance \[pixels\] from its sample to the nearest edge of any triangle whose bounds
 /// contain it (infinity where none does), in the reference's snapped geometry. The image-diff tests use it to
 /// check that coverage mismatches lie on triangle edges.
 pub fn nearest_edge_distances(

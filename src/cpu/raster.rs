@@ -81,7 +81,7 @@ impl RasterTriangle {
         Some(Self { edges, bounds, front_facing, order })
     }
 
-    /// Distance [pixels] from the sample of pixel `(x, y)` to the nearest of the three edge lines.
+    /// Distance \[pixels\] from the sample of pixel `(x, y)` to the nearest of the three edge lines.
     pub fn edge_distance(&self, x: u32, y: u32, bits: u32) -> f64 {
         let one = (1i64 << bits) as f64;
         self.edges

@@ -23,11 +23,11 @@ pub const DEFAULT_LINKE_TURBIDITY: f64 = 3.0;
 pub struct ClearSkyInputs {
     /// Linke turbidity `T_L` at air mass 2 (1 = a clean, dry atmosphere; 2–7 usual).
     pub linke_turbidity: f64,
-    /// Site elevation above sea level [m].
+    /// Site elevation above sea level \[m\].
     pub elevation_m: f64,
-    /// Site pressure [mbar], for the absolute air mass.
+    /// Site pressure \[mbar\], for the absolute air mass.
     pub pressure_mbar: f64,
-    /// Earth–sun distance [AU], for the extraterrestrial irradiance `I₀ = SOLAR_CONSTANT / R²`.
+    /// Earth–sun distance \[AU\], for the extraterrestrial irradiance `I₀ = SOLAR_CONSTANT / R²`.
     pub distance_au: f64,
 }
 

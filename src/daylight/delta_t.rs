@@ -1,4 +1,4 @@
-//! ΔT = TT − UT [s], the difference between the uniform time of the ephemerides and the Earth's rotation.
+//! ΔT = TT − UT \[s\], the difference between the uniform time of the ephemerides and the Earth's rotation.
 //!
 //! Source: the polynomial expressions of Espenak & Meeus (2006), "Five Millennium Canon of Solar Eclipses"
 //! (NASA/TP-2006-214141), also on NASA's eclipse web site, a fit to historical and measured values and to an
@@ -6,7 +6,7 @@
 //! about 69 s in 2025; 6 s of ΔT moves the sun along the ecliptic by 6 s × 0.0411″/s ≈ 7·10⁻⁵°, inside the
 //! algorithm's ±3·10⁻⁴°. A user with a better value gives it (`--delta-t`).
 
-/// ΔT [s] at the decimal year `y` (`year + (month − 0.5)/12`), by Espenak & Meeus's piecewise polynomials.
+/// ΔT \[s\] at the decimal year `y` (`year + (month − 0.5)/12`), by Espenak & Meeus's piecewise polynomials.
 pub fn delta_t_seconds(y: f64) -> f64 {
     let poly = |t: f64, c: &[f64]| c.iter().rev().fold(0.0, |acc, &k| acc * t + k);
     let long_term = |y: f64| {

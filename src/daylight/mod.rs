@@ -1,5 +1,5 @@
-//! Daylight: where the sun is at a date, time and place ([`solar_position`], the NREL Solar Position Algorithm),
-//! how the scene is turned on the Earth ([`orientation`]), and what a clear sky delivers ([`clear_sky`]). It turns
+//! Daylight: where the sun is at a date, time and place ([`solar_position`](mod@solar_position), the NREL Solar
+//! Position Algorithm), how the scene is turned on the Earth ([`orientation`]), and what a clear sky delivers ([`clear_sky`]). It turns
 //! `--time`/`--location` into a sun direction in scene axes and, unless the user gives them, the sun's `E⊥` and the
 //! sky's radiance. Knows neither glTF nor Vulkan: its output is numbers the settings turn into lights.
 

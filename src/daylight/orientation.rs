@@ -9,7 +9,7 @@
 
 use glam::DVec3;
 
-/// Scene azimuth of north when none is given [degrees]: north is −Z.
+/// Scene azimuth of north when none is given \[degrees\]: north is −Z.
 pub const DEFAULT_NORTH_DEG: f64 = 180.0;
 
 /// The scene's local horizon frame: unit east, north and up vectors in world axes (right-handed: east × north = up).

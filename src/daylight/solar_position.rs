@@ -18,11 +18,11 @@ use super::spa_terms::{EarthTerm, B0, B1, L0, L1, L2, L3, L4, L5, NUTATION, R0, 
 /// An observer on the Earth (WGS-84-like ellipsoid as the paper uses it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Location {
-    /// Geodetic latitude φ [degrees], north positive, −90..90.
+    /// Geodetic latitude φ \[degrees\], north positive, −90..90.
     pub latitude_deg: f64,
-    /// Longitude σ [degrees], east of Greenwich positive, −180..180.
+    /// Longitude σ \[degrees\], east of Greenwich positive, −180..180.
     pub longitude_deg: f64,
-    /// Elevation above the ellipsoid [m].
+    /// Elevation above the ellipsoid \[m\].
     pub elevation_m: f64,
 }
 
@@ -48,9 +48,9 @@ impl Atmosphere {
 /// The inputs beyond instant and place.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpaOptions {
-    /// ΔT = TT − UT [s]; `None` takes [`super::delta_t::delta_t_seconds`].
+    /// ΔT = TT − UT \[s\]; `None` takes [`super::delta_t::delta_t_seconds`].
     pub delta_t_s: Option<f64>,
-    /// UT1 − UTC [s] (|DUT1| < 0.9 s; each second turns the Earth by 0.0042°).
+    /// UT1 − UTC \[s\] (|DUT1| < 0.9 s; each second turns the Earth by 0.0042°).
     pub delta_ut1_s: f64,
     /// The atmosphere for refraction, or `None` for the geometric (airless) position.
     pub refraction: Option<Atmosphere>,
@@ -59,26 +59,26 @@ pub struct SpaOptions {
 /// The sun seen from a place at an instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolarPosition {
-    /// Topocentric zenith angle θ [degrees]: 0 overhead, 90 at the horizon; includes refraction when asked.
+    /// Topocentric zenith angle θ \[degrees\]: 0 overhead, 90 at the horizon; includes refraction when asked.
     pub zenith_deg: f64,
-    /// Topocentric azimuth Φ [degrees], clockwise from north (east = 90), 0..360.
+    /// Topocentric azimuth Φ \[degrees\], clockwise from north (east = 90), 0..360.
     pub azimuth_deg: f64,
     /// Whether `zenith_deg` includes atmospheric refraction.
     pub refraction: bool,
-    /// Topocentric zenith without refraction [degrees].
+    /// Topocentric zenith without refraction \[degrees\].
     pub geometric_zenith_deg: f64,
-    /// Geocentric declination δ and right ascension α [degrees]; local hour angle H [degrees].
+    /// Geocentric declination δ and right ascension α \[degrees\]; local hour angle H \[degrees\].
     pub declination_deg: f64,
     pub right_ascension_deg: f64,
     pub hour_angle_deg: f64,
-    /// Topocentric declination δ′ [degrees] (δ seen from the observer rather than the Earth's centre).
+    /// Topocentric declination δ′ \[degrees\] (δ seen from the observer rather than the Earth's centre).
     pub topocentric_declination_deg: f64,
-    /// Earth–sun distance R [AU].
+    /// Earth–sun distance R \[AU\].
     pub distance_au: f64,
-    /// ΔT used [s].
+    /// ΔT used \[s\].
     pub delta_t_s: f64,
-    /// Intermediate values of the paper's worked example, for the tests: heliocentric L, B [degrees], nutation
-    /// Δψ, Δε and true obliquity ε [degrees], apparent sun longitude λ [degrees].
+    /// Intermediate values of the paper's worked example, for the tests: heliocentric L, B \[degrees\], nutation
+    /// Δψ, Δε and true obliquity ε \[degrees\], apparent sun longitude λ \[degrees\].
     pub heliocentric_longitude_deg: f64,
     pub heliocentric_latitude_deg: f64,
     pub nutation_longitude_deg: f64,
@@ -88,7 +88,7 @@ pub struct SolarPosition {
 }
 
 impl SolarPosition {
-    /// Elevation above the horizon [degrees] (90 − zenith).
+    /// Elevation above the horizon \[degrees\] (90 − zenith).
     pub fn elevation_deg(&self) -> f64 {
         90.0 - self.zenith_deg
     }

@@ -20,12 +20,12 @@ pub struct DeviceInfo {
     pub viewport_sub_pixel_bits: u32,
     pub max_image_dimension_2d: u32,
     pub max_viewport_dimensions: [u32; 2],
-    /// Largest single allocation [bytes] (`maxMemoryAllocationSize`).
+    /// Largest single allocation \[bytes\] (`maxMemoryAllocationSize`).
     pub max_memory_allocation_size: u64,
-    /// Size of the largest device-local heap [bytes].
+    /// Size of the largest device-local heap \[bytes\].
     pub device_local_heap_bytes: u64,
     pub max_push_constants_size: u32,
-    /// `maxStorageBufferRange` [bytes]: the most one storage-buffer binding shows a shader (vertices, texels).
+    /// `maxStorageBufferRange` \[bytes\]: the most one storage-buffer binding shows a shader (vertices, texels).
     pub max_storage_buffer_range: u32,
     /// `maxTexelBufferElements`: the most texels one texel buffer holds (the textures' texels).
     pub max_texel_buffer_elements: u32,

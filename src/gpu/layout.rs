@@ -86,7 +86,7 @@ impl ShaderVariant {
     }
 }
 
-/// One vertex: world position [m], unit normal, unit tangent and handedness, interleaved (`FLOATS_PER_VERTEX` =
+/// One vertex: world position \[m\], unit normal, unit tangent and handedness, interleaved (`FLOATS_PER_VERTEX` =
 /// 10 floats and the `VERTEX_*` offsets in the shaders). What only textured materials read is in
 /// [`SurfaceVertex`], a buffer of its own, so that untextured draws fetch what they did before textures existed
 /// (and a storage buffer of `maxStorageBufferRange`, 128 MiB on lavapipe, holds 3.3 M vertices).
@@ -164,11 +164,11 @@ pub struct LightsHeader {
     pub sampling: [u32; 4],
     /// World → the sun's shadow map (column-major), `visibility::shadow_map`.
     pub sun_map_from_world: [f32; 16],
-    /// Texel side [m], depth extent [m], size [texels], 1 if the map was rendered this frame (else 0).
+    /// Texel side \[m\], depth extent \[m\], size \[texels\], 1 if the map was rendered this frame (else 0).
     pub sun_map: [f32; 4],
     /// World → each of the first disks' shadow maps (column-major), `visibility::shadow_map::fit_disk_map`.
     pub disk_map_from_world: [[f32; 16]; MAX_DISK_MAPS],
-    /// tan of the half field of view, near [m], far [m], size [texels] (0: no map this frame).
+    /// tan of the half field of view, near \[m\], far \[m\], size \[texels\] (0: no map this frame).
     pub disk_map: [[f32; 4]; MAX_DISK_MAPS],
 }
 
@@ -191,7 +191,7 @@ pub struct PushConstants {
 /// The measured buffer's floats (binding 11): each distinct table the materials use once (materials naming the
 /// same file share its `Arc`, and here its one copy), one after another, each sample as RGBA (A unused: one 16-byte
 /// load per sample, measured 20–24% faster frames on lavapipe than three scalar loads, for 4/3 the memory); and per
-/// material the offset [samples] of its table (0 for the others). One zero sample where no material is measured
+/// material the offset \[samples\] of its table (0 for the others). One zero sample where no material is measured
 /// (a binding needs a buffer).
 pub fn measured_tables(materials: &[Material]) -> (Vec<f32>, Vec<u32>) {
     let mut data: Vec<f32> = Vec::new();
@@ -218,7 +218,7 @@ pub fn measured_tables(materials: &[Material]) -> (Vec<f32>, Vec<u32>) {
 }
 
 /// A material's record; `measured_offset`: where its measured table (if any) starts in the measured buffer
-/// [samples] ([`measured_tables`]).
+/// \[samples\] ([`measured_tables`]).
 pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
     let (kd, ks) = (m.brdf.kd(), m.brdf.ks());
     let (kind, exponent, params) = match m.brdf {

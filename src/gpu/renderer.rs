@@ -30,7 +30,7 @@ use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
 use bytemuck::Zeroable;
 
-/// Wall-clock time of the set-up phases [s].
+/// Wall-clock time of the set-up phases \[s\].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SetupTimings {
     /// Loader, instance, device and allocator creation.

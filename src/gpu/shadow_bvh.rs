@@ -21,7 +21,7 @@ use crate::scene::Scene;
 /// The boxes' widening for the f32 slab test, relative to the scene's largest coordinate magnitude: `2⁻¹⁸`.
 pub const F32_BOX_PAD: f64 = 1.0 / 262_144.0;
 
-/// One node of the tree (`BvhNode` in shaders/bindings.glsl; 32 bytes, std430): its box [m] in f32, widened by
+/// One node of the tree (`BvhNode` in shaders/bindings.glsl; 32 bytes, std430): its box \[m\] in f32, widened by
 /// [`F32_BOX_PAD`], and `first`/`count` as in `visibility::Bvh::nodes`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]

@@ -102,7 +102,7 @@ impl Canvas {
         }
     }
 
-    /// Width of `text` at `scale` [pixels].
+    /// Width of `text` at `scale` \[pixels\].
     pub fn text_width(text: &str, scale: i32) -> i32 {
         text.chars().count() as i32 * GLYPH * scale
     }

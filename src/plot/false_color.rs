@@ -17,7 +17,7 @@ use crate::film::Image;
 
 const EMPTY: Rgb = [40, 40, 40];
 const INK: Rgb = [0, 0, 0];
-/// Height of the legend under the picture [pixels].
+/// Height of the legend under the picture \[pixels\].
 pub const LEGEND_HEIGHT: u32 = 48;
 const MIN_WIDTH: u32 = 320;
 

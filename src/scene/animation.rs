@@ -29,7 +29,7 @@ enum Interpolation {
     CubicSpline,
 }
 
-/// Samples animation `index` at `time` [s]: the pose of every node it drives.
+/// Samples animation `index` at `time` \[s\]: the pose of every node it drives.
 pub fn sample(root: &Root, reader: &AccessorReader, index: usize, time: f64) -> Result<HashMap<u64, NodePose>, String> {
     let count = root.animations.len();
     let animation =

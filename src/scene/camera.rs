@@ -14,14 +14,14 @@ use super::BoundingSphere;
 pub enum Projection {
     /// Perspective with vertical field of view `yfov`; `zfar = None` is an infinite far plane.
     Perspective { yfov: f64, znear: f64, zfar: Option<f64> },
-    /// Orthographic with half-height `ymag` [m].
+    /// Orthographic with half-height `ymag` \[m\].
     Orthographic { ymag: f64, znear: f64, zfar: f64 },
 }
 
 /// A camera in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
-    /// Eye position [m].
+    /// Eye position \[m\].
     pub eye: DVec3,
     /// Unit view direction.
     pub forward: DVec3,
@@ -30,9 +30,9 @@ pub struct Camera {
     pub projection: Projection,
 }
 
-/// Default vertical field of view of the automatic camera [degrees].
+/// Default vertical field of view of the automatic camera \[degrees\].
 pub const AUTO_FOV_DEGREES: f64 = 45.0;
-/// Elevation and azimuth of the automatic camera's viewing direction, seen from the scene [degrees]: front
+/// Elevation and azimuth of the automatic camera's viewing direction, seen from the scene \[degrees\]: front
 /// (+Z), a little to the right (+X) and above.
 pub const AUTO_ELEVATION_DEGREES: f64 = 20.0;
 pub const AUTO_AZIMUTH_DEGREES: f64 = 30.0;

@@ -16,23 +16,23 @@ pub struct Sun {
     pub direction: Vec3,
     /// `E⊥` [W/m²] per channel.
     pub irradiance: [f32; 3],
-    /// Angular diameter `δ` [rad] (0.53° by default).
+    /// Angular diameter `δ` \[rad\] (0.53° by default).
     pub angular_diameter: f32,
 }
 
-/// The largest radius and centre coordinate of a disk light [m]. The disk formulas square lengths in f32
+/// The largest radius and centre coordinate of a disk light \[m\]. The disk formulas square lengths in f32
 /// (`R² + f²`); 10¹⁵ m keeps those squares (≤ 1e30 plus the scene's extent) far inside f32's range (3.4e38), so
 /// that a disk light never turns an image into inf/inf = NaN.
 pub const MAX_DISK_EXTENT_M: f64 = 1e15;
 
-/// A disk skylight: radius `R` [m], uniform radiance `L0` [W/(m²·sr)], emitting from one face.
+/// A disk skylight: radius `R` \[m\], uniform radiance `L0` [W/(m²·sr)], emitting from one face.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiskLight {
-    /// Centre [m], world space.
+    /// Centre \[m\], world space.
     pub center: Vec3,
     /// Unit vector in the direction the disk emits (its lit side faces this way).
     pub direction: Vec3,
-    /// Radius `R` [m].
+    /// Radius `R` \[m\].
     pub radius: f32,
     /// Radiance `L0` [W/(m²·sr)] per channel.
     pub radiance: [f32; 3],

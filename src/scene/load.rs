@@ -51,7 +51,7 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// Where buffer and image files may be (default: inside the scene's folder).
     pub uris: UriScope,
-    /// Pose the scene by animation N at time T [s] (`--animation N --time T`); `None`: the file's own transforms
+    /// Pose the scene by animation N at time T \[s\] (`--animation N --time T`); `None`: the file's own transforms
     /// and weights (the rest pose).
     pub animation: Option<(usize, f64)>,
     /// Textures larger than this many texels on a side start at their first mip level that fits

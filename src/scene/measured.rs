@@ -19,7 +19,7 @@ pub const THETA_D_BINS: usize = 90;
 pub const PHI_D_BINS: usize = 180;
 /// Samples per channel.
 pub const MERL_SAMPLES: usize = THETA_H_BINS * THETA_D_BINS * PHI_D_BINS;
-/// The size of a MERL file [bytes]: the header and three planes of f64.
+/// The size of a MERL file \[bytes\]: the header and three planes of f64.
 pub const MERL_FILE_BYTES: usize = 12 + 3 * 8 * MERL_SAMPLES;
 /// The factors from stored values to ρ [1/sr], per channel (the database's convention).
 pub const MERL_CHANNEL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
@@ -40,7 +40,7 @@ pub struct MeasuredBrdf {
     pub missing: usize,
     /// Per sample, whether a channel of it was missing (empty where none was).
     pub missing_mask: Vec<bool>,
-    /// The angular width [rad] of the specular peak about the mirror direction, for grading the sample grids:
+    /// The angular width \[rad\] of the specular peak about the mirror direction, for grading the sample grids:
     /// twice the θ_h at which the channels' mean, at θ_d = φ_d = 0 and above the floor, first falls to e^{-1/2}
     /// of its value at θ_h = 0 (ω turns twice as fast as the half vector); π where it never does (a table
     /// without a peak).
@@ -63,7 +63,7 @@ pub fn merl_index(theta_h: usize, theta_d: usize, phi_d: usize) -> usize {
     phi_d + PHI_D_BINS * (theta_d + THETA_D_BINS * theta_h)
 }
 
-/// The angle [rad] at the lower edge of each bin, where sunshade places its sample (`shading::measured`):
+/// The angle \[rad\] at the lower edge of each bin, where sunshade places its sample (`shading::measured`):
 /// `θ_h = (i/90)² π/2` (the square-root scale), `θ_d = j π/180`, `φ_d = k π/180`.
 pub fn merl_bin_angles(i: usize, j: usize, k: usize) -> (f64, f64, f64) {
     let half_pi = std::f64::consts::FRAC_PI_2;

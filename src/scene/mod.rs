@@ -52,7 +52,7 @@ pub struct Scene {
 pub struct Mesh {
     /// A name for messages: the glTF mesh name (or index) and primitive index.
     pub name: String,
-    /// Vertex positions in world space [m].
+    /// Vertex positions in world space \[m\].
     pub positions: Vec<Vec3>,
     /// Unit vertex normals in world space (a zero vector where the file's normal was zero).
     pub normals: Vec<Vec3>,
@@ -76,14 +76,14 @@ impl Mesh {
     }
 }
 
-/// An axis-aligned box in world space [m].
+/// An axis-aligned box in world space \[m\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
     pub min: DVec3,
     pub max: DVec3,
 }
 
-/// A sphere enclosing the scene [m].
+/// A sphere enclosing the scene \[m\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoundingSphere {
     pub center: DVec3,

@@ -113,7 +113,7 @@ pub fn lobe_albedo_at_order(brdf: &Brdf, theta: f64, azimuth: f64, order: usize)
     total
 }
 
-/// The lobe's directional albedo at a viewer at angle `theta` [rad] from the normal and `azimuth` [rad] from the
+/// The lobe's directional albedo at a viewer at angle `theta` \[rad\] from the normal and `azimuth` \[rad\] from the
 /// tangent, converged: the order doubles from 8 until two estimates agree to `tolerance` (relative), at most
 /// 64. Returns `(albedo, last relative change)`.
 pub fn lobe_albedo(brdf: &Brdf, theta: f64, azimuth: f64, tolerance: f64) -> (f64, f64) {

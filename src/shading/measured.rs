@@ -53,7 +53,7 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
     a.cross(b).length().atan2(a.dot(b))
 }
 
-/// Rusinkiewicz's `(θ_h, θ_d, φ_d)` [rad] of light from `l` seen from `v` about the normal `n` (unit vectors),
+/// Rusinkiewicz's `(θ_h, θ_d, φ_d)` \[rad\] of light from `l` seen from `v` about the normal `n` (unit vectors),
 /// φ_d in (−π, π]; `None` where l + v = 0 (no half vector).
 pub fn half_diff_angles(n: DVec3, l: DVec3, v: DVec3) -> Option<(f64, f64, f64)> {
     let sum = l + v;
@@ -207,7 +207,7 @@ pub fn half_diff_directions(theta_h: f64, theta_d: f64, phi_d: f64) -> (DVec3, D
     (l, v)
 }
 
-/// A table's directional albedo per channel for a viewer at `theta` [rad] from the normal: `∫ ρ(l, v) cos θ_l dω_l`
+/// A table's directional albedo per channel for a viewer at `theta` \[rad\] from the normal: `∫ ρ(l, v) cos θ_l dω_l`
 /// over the hemisphere, by a `per_axis²` stratified midpoint grid drawn cosine-weighted (pdf `cos θ/π`, so each
 /// sample weighs `π ρ / per_axis²`). Exact for a constant table; a peak narrower than the grid's cells (about
 /// `π/per_axis` rad) is resolved only on average.

@@ -1,6 +1,6 @@
 //! Radiometry: angles, solid angles and the irradiance each light gives a surface.
 //!
-//! Units: angles in radians unless a name says degrees; solid angles in steradians [sr]; radiance `L` in
+//! Units: angles in radians unless a name says degrees; solid angles in steradians \[sr\]; radiance `L` in
 //! W/(m²·sr); irradiance `E` in W/m². `shaders/radiometry.glsl` mirrors these functions name for name.
 //!
 //! Definitions (e.g. Pharr, Jakob & Humphreys, *Physically Based Rendering*, 4th ed., §4.1):
@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-/// The sun's mean angular diameter seen from the Earth [degrees].
+/// The sun's mean angular diameter seen from the Earth \[degrees\].
 pub const SUN_ANGULAR_DIAMETER_DEGREES: f64 = 0.53;
 
 /// Default irradiance on a surface facing the sun, `E⊥` [W/m²].
@@ -25,7 +25,7 @@ pub fn radians_to_degrees(radians: f64) -> f64 {
     radians * (180.0 / PI)
 }
 
-/// Exact solid angle [sr] of a cone of half-angle `half_angle` [rad]: `2π(1 − cos a)`.
+/// Exact solid angle \[sr\] of a cone of half-angle `half_angle` \[rad\]: `2π(1 − cos a)`.
 ///
 /// Precision: for small cones `1 − cos a` cancels catastrophically (for the sun, `cos a = 1 − 1.07·10⁻⁵`, losing
 /// five digits). The identity `1 − cos a = 2 sin²(a/2)` gives the same value without any subtraction.
@@ -34,7 +34,7 @@ pub fn cone_solid_angle(half_angle: f64) -> f64 {
     4.0 * PI * s * s
 }
 
-/// Small-cone estimate of a solid angle [sr]: `area of the base / height²` (base area [m²], height [m]).
+/// Small-cone estimate of a solid angle \[sr\]: `area of the base / height²` (base area \[m²\], height \[m\]).
 ///
 /// For a sphere of radius `r` seen from distance `d` (the sun) the base is its cross-section `π r²` and the
 /// estimate is `π sin²a`, low by ≈ `a²/4` relative (5.3·10⁻⁶ for the sun). For a flat disk of radius `r` at
@@ -43,12 +43,12 @@ pub fn small_cone_solid_angle(base_area: f64, height: f64) -> f64 {
     base_area / (height * height)
 }
 
-/// The sun's solid angle `Ω_sun` [sr] from its angular diameter `δ` [rad]: `2π(1 − cos(δ/2))`.
+/// The sun's solid angle `Ω_sun` \[sr\] from its angular diameter `δ` \[rad\]: `2π(1 − cos(δ/2))`.
 pub fn sun_solid_angle(angular_diameter: f64) -> f64 {
     cone_solid_angle(0.5 * angular_diameter)
 }
 
-/// Projected solid angle [sr] of the sun's cone at normal incidence: `∫ cosθ dΩ = π sin²(δ/2)`.
+/// Projected solid angle \[sr\] of the sun's cone at normal incidence: `∫ cosθ dΩ = π sin²(δ/2)`.
 ///
 /// This is the exact ratio `E⊥ / L_sun`; it equals `Ω_sun (1 + cos(δ/2))/2`, i.e. `Ω_sun` to within
 /// `sin²(δ/4)` relative (5.3·10⁻⁶ at 0.53°).
@@ -129,7 +129,7 @@ pub fn sky_irradiance(radiance: f64, n_dot_up: f64) -> f64 {
     PI * radiance * 0.5 * (1.0 + n_dot_up)
 }
 
-/// A disk light's geometry in world space: centre [m], unit emission direction, radius [m].
+/// A disk light's geometry in world space: centre \[m\], unit emission direction, radius \[m\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiskGeometry {
     pub center: DVec3,
@@ -137,7 +137,7 @@ pub struct DiskGeometry {
     pub radius: f64,
 }
 
-/// The lecture's small-source estimate of a disk's projected solid angle [sr] from `x` with normal `n`:
+/// The lecture's small-source estimate of a disk's projected solid angle \[sr\] from `x` with normal `n`:
 /// `A cosθ_receiver cosθ_disk / d²` (`A = πR²`, d the distance to the centre; each cosine clamped at 0). Under a
 /// disk at height f facing down it is `A (n·l)⁴ / f²` on the floor. `E ≈ L0 ·` this.
 pub fn disk_projected_solid_angle_small_source(x: DVec3, n: DVec3, disk: &DiskGeometry) -> f64 {
@@ -152,7 +152,7 @@ pub fn disk_projected_solid_angle_small_source(x: DVec3, n: DVec3, disk: &DiskGe
     PI * disk.radius * disk.radius * cos_receiver * cos_disk / d2
 }
 
-/// The exact projected solid angle [sr] of the part of a disk that lies above the horizon of a receiver at `x`
+/// The exact projected solid angle \[sr\] of the part of a disk that lies above the horizon of a receiver at `x`
 /// with unit normal `n` (0 behind the disk's emitting face): `E = L0 ·` this.
 ///
 /// By Stokes' theorem the projected solid angle of a region is `−½ ∮ n·(p × dp)/|p|²` around its boundary (the

@@ -84,7 +84,7 @@ pub struct ShadingOptions {
     pub shadows: Shadows,
     /// Grid side of each light's visible-fraction grid (`n²` shadow rays per light and pixel).
     pub shadow_samples_per_axis: u32,
-    /// Side of the sun's shadow map [texels] (`--shadows map`).
+    /// Side of the sun's shadow map \[texels\] (`--shadows map`).
     pub shadow_map_size: u32,
     /// Its filter.
     pub shadow_map_filter: ShadowMapFilter,
@@ -133,7 +133,7 @@ impl std::str::FromStr for DiskModel {
 /// A point on a surface, in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
-    /// Position [m].
+    /// Position \[m\].
     pub position: DVec3,
     /// Unit shading normal, on the side being seen; the zero vector where it is undefined (then nothing is
     /// reflected).
@@ -288,7 +288,7 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the sun's cap (half-angle `σ = δ/2`), per unit radiance. The directions of the cap
 /// are exactly those through a disk of radius `tan σ` one unit away along `direction`, facing back, so the graded
-/// grid of [`segment_lobe_integral`] integrates it, lobes narrower than the sun included (a Phong lobe of
+/// grid of `segment_lobe_integral` integrates it, lobes narrower than the sun included (a Phong lobe of
 /// e = 1e6 is 0.06° wide against the sun's 0.53°).
 /// Per channel, the first (an analytic lobe's three are equal).
 pub fn sun_lobe_integral(brdf: &Brdf, p: &SurfacePoint, direction: DVec3, angular_diameter: f64, per_axis: u32) -> f64 {
@@ -303,7 +303,7 @@ pub fn sun_projected_solid_angle_above(n_dot_l: f64, angular_diameter: f64) -> f
     PI * s * s * sun_irradiance_disk(1.0, n_dot_l, angular_diameter)
 }
 
-/// The angular width [rad] about a specular lobe's peak (the mirror direction of the viewer) over which the disk
+/// The angular width \[rad\] about a specular lobe's peak (the mirror direction of the viewer) over which the disk
 /// integral crowds its samples: where the lobe falls to about `e^{-1/2}`. Phong's `cosᵉα` at `α ≈ 1/√e`;
 /// Blinn-Phong's in the half vector, and ω turns twice as fast: `2/√e`; Ward's `exp(−tan²δ/α²)` at `δ = α/√2`,
 /// `√2 α` in ω, taken as `2√(αx αy)` (the geometric mean measured better than either α on anisotropic lobes).
@@ -573,7 +573,7 @@ pub fn measured_sampling_alpha(lobe_width: f64) -> f64 {
 }
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the sky (the surface's hemisphere above the horizontal, per unit radiance):
-/// [`sky_lobe_integral_visible`] unoccluded. Per channel, the first (an analytic lobe's three are equal).
+/// `sky_lobe_integral_visible` unoccluded. Per channel, the first (an analytic lobe's three are equal).
 pub fn sky_lobe_integral(brdf: &Brdf, p: &SurfacePoint, per_axis: u32) -> f64 {
     sky_lobe_integral_visible(brdf, p, per_axis, None)[0]
 }

@@ -43,7 +43,7 @@ pub enum Lune {
 }
 
 /// Up's part across the normal n (`up − (n·up) n = sin t b`, b the unit uphill direction) and the surface's tilt t
-/// from up [rad]. `sin t` is that part's length and t its `atan2` with `n·up`: `acos(n·up)` or `sqrt(1 − cos²t)`
+/// from up \[rad\]. `sin t` is that part's length and t its `atan2` with `n·up`: `acos(n·up)` or `sqrt(1 − cos²t)`
 /// would cancel for surfaces nearly facing up, whose thin lune t then places wrongly.
 pub fn up_across(n: DVec3) -> (DVec3, f64) {
     let across = DVec3::Y - n.y * n;

@@ -18,7 +18,7 @@
 //! Chiu's concentric map (equal-area, low distortion; "A Low Distortion Map Between Disk and Square", 1997), the
 //! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
 //! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
-//! squares): second order in `1/k` through a penumbra ([`grid_fraction`]). With k = 1 one ray, through the
+//! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
 //! light's centre: a hard shadow.
 //!
 //! **Specular part.** The lobe integrals already sample each light (`shade.rs`); each of their samples casts its
@@ -77,7 +77,7 @@ impl std::str::FromStr for ShadowMapFilter {
     }
 }
 
-/// Default side of the sun's shadow map [texels] (`--shadow-map-size`; GPU, `--shadows map`).
+/// Default side of the sun's shadow map \[texels\] (`--shadow-map-size`; GPU, `--shadows map`).
 pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 2048;
 
 /// How far along a ray to a point on a disk light the ray is tested: `t < 1 − 2⁻¹²`.
@@ -175,7 +175,7 @@ impl ShadowedLights {
 /// What a shading point needs to cast shadow rays.
 #[derive(Clone, Copy)]
 pub struct Shadowing<'a> {
-    /// The rays' origin [m] ([`shadow_ray_origin`]).
+    /// The rays' origin \[m\] ([`shadow_ray_origin`]).
     pub origin: DVec3,
     pub occluders: &'a dyn Occlusion,
     /// Samples per axis of the visible-fraction grids.
@@ -205,7 +205,7 @@ impl<'a> Shadowing<'a> {
         !self.occluders.occluded(self.origin, direction, f64::INFINITY)
     }
 
-    /// Whether the point `target` [m] (on a disk light) is unblocked.
+    /// Whether the point `target` \[m\] (on a disk light) is unblocked.
     pub fn visible_to(&self, target: DVec3) -> bool {
         !self.occluders.occluded(self.origin, target - self.origin, SEGMENT_T_MAX)
     }
@@ -285,12 +285,12 @@ impl GridLight {
     }
 }
 
-/// The largest `k` of the located grid on the GPU ([`grid_fraction`]; `MAX_LOCATED_GRID` in
+/// The largest `k` of the located grid on the GPU (`grid_fraction`; `MAX_LOCATED_GRID` in
 /// shaders/visibility.glsl): the shader keeps two columns of `k + 1` corners in arrays of a fixed size. The
 /// reference has no such limit.
 pub const MAX_LOCATED_GRID: u32 = 256;
 
-/// Bisection steps that place a visibility edge between two neighbouring corners of a grid ([`grid_fraction`]):
+/// Bisection steps that place a visibility edge between two neighbouring corners of a grid (`grid_fraction`):
 /// `⌈log₂ k⌉` (at least 1), so that the edge's position error, at most a side `1/k` over `2^(steps+1)`, stays
 /// below `1/(2k²)`: of the second order in `1/k`, like the rest of the estimate. Measured on the straight edges of
 /// `located_edges_converge_at_second_order`, worst over 16 edges at 16², 32², 64²: 1.2e-3, 1.6e-4, 9.0e-5 (one step
@@ -464,7 +464,7 @@ pub fn sun_sample(n: DVec3, l: DVec3, t: DVec3, b: DVec3, radius: f64, (x, y): (
 }
 
 /// A disk light's sample at the point `(u, v)` of the unit disk, in the frame `(a, b)` of its plane: the point
-/// `y` [m] and its weight `(n·ω)⁺ (−d·ω)⁺ / |y − x|²` from `x` (0 where either cosine is not positive). Shared by
+/// `y` \[m\] and its weight `(n·ω)⁺ (−d·ω)⁺ / |y − x|²` from `x` (0 where either cosine is not positive). Shared by
 /// the rays and the shadow maps.
 #[allow(clippy::too_many_arguments)]
 pub fn disk_sample(
@@ -485,7 +485,7 @@ pub fn disk_sample(
     (y, if cos_r > 0.0 && cos_d > 0.0 { cos_r * cos_d / dist2 } else { 0.0 })
 }
 
-/// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ [rad]) from a point
+/// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ \[rad\]) from a point
 /// with unit normal `n`.
 pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
     let radius = (0.5 * angular_diameter).tan();
@@ -494,7 +494,7 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
     grid_fraction(s, &GridLight::Sun { n, l, t, b, radius })
 }
 
-/// The visible fraction of a disk light (centre [m], unit emission direction `d`, radius [m]), weighted by
+/// The visible fraction of a disk light (centre \[m\], unit emission direction `d`, radius \[m\]), weighted by
 /// projected solid angle, from the point `x` with unit normal `n`.
 pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
     let a = orthonormal_to(d);
@@ -514,12 +514,12 @@ pub struct SkyLune {
     pub a: DVec3,
     /// The horizontal unit vector `e` towards which `n` leans (any one perpendicular to `a` for a floor).
     pub e: DVec3,
-    /// The surface's tilt from up [rad].
+    /// The surface's tilt from up \[rad\].
     pub tilt: f64,
 }
 
 impl SkyLune {
-    /// The lune's width `π − tilt` [rad].
+    /// The lune's width `π − tilt` \[rad\].
     pub fn width(&self) -> f64 {
         PI - self.tilt
     }
@@ -555,7 +555,7 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 }
 
 /// The visible fraction of the sky (the directions with `ω_y > 0`), cosine-weighted, from a point with unit
-/// normal `n`: its view factor to the sky relative to the unoccluded one, by [`grid_fraction`]'s located edges over
+/// normal `n`: its view factor to the sky relative to the unoccluded one, by `grid_fraction`'s located edges over
 /// the sky's lune ([`SkyLune`], [`sky_sample`]).
 ///
 /// The grid covers the lune and nothing else, so neither horizon is an edge inside it: the ground's is the grid's
@@ -572,13 +572,13 @@ pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
     grid_fraction(s, &GridLight::Sky(sky_lune(n)))
 }
 
-/// The push along the face normal for a triangle with these corners [m]: `2⁻¹⁶ max |pᵢ|∞` (see the module docs).
+/// The push along the face normal for a triangle with these corners \[m\]: `2⁻¹⁶ max |pᵢ|∞` (see the module docs).
 pub fn ray_offset(corners: &[DVec3; 3]) -> f64 {
     let m = corners.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
     RAY_OFFSET_RELATIVE * m
 }
 
-/// The origin of the shadow rays from the point with barycentrics `b` of the triangle with corners `p` [m],
+/// The origin of the shadow rays from the point with barycentrics `b` of the triangle with corners `p` \[m\],
 /// vertex normals `normals` (unit, on the side being shaded) and unit shading normal `n`: Hanika's terminator
 /// offset, then the push along the face normal on the shading normal's side (module docs).
 pub fn shadow_ray_origin(p: &[DVec3; 3], normals: &[DVec3; 3], b: [f64; 3], x: DVec3, n: DVec3) -> DVec3 {

@@ -44,7 +44,7 @@ struct Node {
     count: u32,
 }
 
-/// A BVH over triangles given in world space [m].
+/// A BVH over triangles given in world space \[m\].
 #[derive(Clone, Debug)]
 pub struct Bvh {
     triangles: Vec<[DVec3; 3]>,
@@ -111,7 +111,7 @@ impl Bvh {
         &self.order
     }
 
-    /// The nodes, root first, each as `(min, max, first, count)` [m]: a leaf (`count > 0`) holds
+    /// The nodes, root first, each as `(min, max, first, count)` \[m\]: a leaf (`count > 0`) holds
     /// `order()[first..first + count]`, an inner node (`count == 0`) has its children at `first` and `first + 1`.
     /// The boxes are padded as the traversal here uses them. The GPU's traversal (shaders/occluders.glsl) walks
     /// the same tree.
@@ -284,7 +284,7 @@ impl crate::shading::Occlusion for Bvh {
 
 impl Bvh {
     /// Whether the ray is occluded for `t_min < t < t_max`, and whether that answer is *fragile*: no triangle is
-    /// hit farther than `eps` [m] inside its boundary, but one is hit, or missed, within `eps` of it, so that a
+    /// hit farther than `eps` \[m\] inside its boundary, but one is hit, or missed, within `eps` of it, so that a
     /// few ulps of f32 geometry (the GPU's) could flip it. Boxes are padded by `eps` for this traversal.
     pub fn occluded_with_margin(&self, ray: &WatertightRay, t_min: f64, t_max: f64, eps: f64) -> (bool, bool) {
         self.occluded_with_margin_where(ray, t_min, t_max, eps, |_, _| (true, false))

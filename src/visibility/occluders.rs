@@ -35,7 +35,7 @@ pub fn occluder_bvh(scene: &Scene) -> Bvh {
     Bvh::new(occluder_triangles(scene))
 }
 
-/// Every triangle of the scene in world space [m], the meshes' triangles in turn: what [`occluder_bvh`] holds.
+/// Every triangle of the scene in world space \[m\], the meshes' triangles in turn: what [`occluder_bvh`] holds.
 pub fn occluder_triangles(scene: &Scene) -> Vec<[DVec3; 3]> {
     scene
         .meshes

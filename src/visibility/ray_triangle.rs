@@ -92,7 +92,7 @@ impl WatertightRay {
 
     /// How far the ray passes from the boundary of the triangle `(a, b, c)`, where it meets the triangle's plane
     /// with `t_min < t < t_max` (`None` otherwise, or for a ray in the plane): in the sheared plane of the test,
-    /// each edge function over its edge's length is the distance from the ray to that edge's line [m]; positive
+    /// each edge function over its edge's length is the distance from the ray to that edge's line \[m\]; positive
     /// inside (the smallest of the three, a hit exactly when [`WatertightRay::intersect`] hits), negative outside
     /// (the largest violation). Used to find rays whose visibility a few ulps of geometry could flip.
     pub fn edge_margin(&self, triangle: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {

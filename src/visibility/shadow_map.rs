@@ -4,7 +4,7 @@
 //!
 //! Light space: `x = orthonormal_to(l)`, `y = l × x` (the same basis as the sun's sample grid in
 //! `shading::visibility`, so that a sample's offset on the sun's disk is the same offset in the map), and depth
-//! measured from the sun, `d = l_max − l·p` [m]. Map coordinates: `u = (x·p − cx)/h`, `v = (y·p − cy)/h` in
+//! measured from the sun, `d = l_max − l·p` \[m\]. Map coordinates: `u = (x·p − cx)/h`, `v = (y·p − cy)/h` in
 //! [−1, 1] (h the larger half-extent, padded by two texels), depth `z = d / depth_extent` in [0, 1].
 
 use glam::{DMat4, DVec3, DVec4};
@@ -17,9 +17,9 @@ use crate::shading::orthonormal_to;
 pub struct SunMapFrame {
     /// World → map clip space (x, y in [−1, 1], depth in [0, 1]).
     pub map_from_world: DMat4,
-    /// The side of one texel [m].
+    /// The side of one texel \[m\].
     pub texel: f64,
-    /// The depth range [m] that [0, 1] covers.
+    /// The depth range \[m\] that [0, 1] covers.
     pub depth_extent: f64,
 }
 
@@ -108,7 +108,7 @@ pub struct DiskMapFrame {
     pub map_from_world: DMat4,
     /// Tangent of the half field of view (both axes).
     pub tan_half: f64,
-    /// Near and far planes [m] along `d`.
+    /// Near and far planes \[m\] along `d`.
     pub near: f64,
     pub far: f64,
 }
