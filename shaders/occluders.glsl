@@ -113,26 +113,40 @@ bool intersect(WatertightRay r, vec3 a, vec3 b, vec3 c, float t_max, out vec2 ba
 
 // The slab test of a node's box for 0 < t < t_max (`inv`: 1/direction where it is not 0). An axis along which
 // the ray does not move keeps the box exactly when the origin lies within its slab (the Rust's ±inf and NaN
-// products give the same answer; division by 0 is avoided here).
+// products give the same answer; division by 0 is avoided here). The three axes are written out, not looped
+// over: llvmpipe counts every iteration of every loop against one budget a fragment (gpu::loop_budget), and a
+// loop of three spent three of it on every box a walk tests. The same operations in the same order as the loop
+// had, without its early exit: the interval only narrows, so the one comparison at the end rejects what an exit
+// after any axis would (a NaN, which no comparison rejects, keeps the box, as it did).
 bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     float lo = 0.0;
     float hi = t_max;
-    for (uint k = 0u; k < 3u; ++k) {
-        if (direction[k] == 0.0) {
-            if (origin[k] < node.lo[k] || origin[k] > node.hi[k]) {
-                return false;
-            }
-            continue;
-        }
-        float a = (node.lo[k] - origin[k]) * inv[k];
-        float b = (node.hi[k] - origin[k]) * inv[k];
+    bool outside = false;
+    if (direction.x == 0.0) {
+        outside = outside || origin.x < node.lo.x || origin.x > node.hi.x;
+    } else {
+        float a = (node.lo.x - origin.x) * inv.x;
+        float b = (node.hi.x - origin.x) * inv.x;
         lo = max(lo, min(a, b));
         hi = min(hi, max(a, b));
-        if (lo > hi) {
-            return false;
-        }
     }
-    return true;
+    if (direction.y == 0.0) {
+        outside = outside || origin.y < node.lo.y || origin.y > node.hi.y;
+    } else {
+        float a = (node.lo.y - origin.y) * inv.y;
+        float b = (node.hi.y - origin.y) * inv.y;
+        lo = max(lo, min(a, b));
+        hi = min(hi, max(a, b));
+    }
+    if (direction.z == 0.0) {
+        outside = outside || origin.z < node.lo.z || origin.z > node.hi.z;
+    } else {
+        float a = (node.lo.z - origin.z) * inv.z;
+        float b = (node.hi.z - origin.z) * inv.z;
+        lo = max(lo, min(a, b));
+        hi = min(hi, max(a, b));
+    }
+    return !outside && !(lo > hi);
 }
 
 // The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
