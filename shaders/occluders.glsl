@@ -111,41 +111,34 @@ bool intersect(WatertightRay r, vec3 a, vec3 b, vec3 c, float t_max, out vec2 ba
     return t > 0.0 && t < t_max;
 }
 
+// One axis of the slab test (slab): the interval [lo, hi] of t narrowed to the box's slab [box_lo, box_hi] along
+// it, or, where the ray does not move along it (d = 0), `outside` set when the origin lies outside the slab.
+void slab_axis(float box_lo, float box_hi, float o, float d, float inv_d, inout float lo, inout float hi,
+               inout bool outside) {
+    if (d == 0.0) {
+        outside = outside || o < box_lo || o > box_hi;
+        return;
+    }
+    float a = (box_lo - o) * inv_d;
+    float b = (box_hi - o) * inv_d;
+    lo = max(lo, min(a, b));
+    hi = min(hi, max(a, b));
+}
+
 // The slab test of a node's box for 0 < t < t_max (`inv`: 1/direction where it is not 0). An axis along which
 // the ray does not move keeps the box exactly when the origin lies within its slab (the Rust's ±inf and NaN
-// products give the same answer; division by 0 is avoided here). The three axes are written out, not looped
-// over: llvmpipe counts every iteration of every loop against one budget a fragment (gpu::loop_budget), and a
-// loop of three spent three of it on every box a walk tests. The same operations in the same order as the loop
-// had, without its early exit: the interval only narrows, so the one comparison at the end rejects what an exit
-// after any axis would (a NaN, which no comparison rejects, keeps the box, as it did).
+// products give the same answer; division by 0 is avoided here). The three axes are called one by one, not
+// looped over: llvmpipe counts every iteration of every loop against one budget a fragment (gpu::loop_budget),
+// and a loop of three spent three of it on every box a walk tests. The same operations in the same order as the
+// loop had, without its early exit: the interval only narrows, so the one comparison at the end rejects what an
+// exit after any axis would (a NaN, which no comparison rejects, keeps the box, as it did).
 bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     float lo = 0.0;
     float hi = t_max;
     bool outside = false;
-    if (direction.x == 0.0) {
-        outside = outside || origin.x < node.lo.x || origin.x > node.hi.x;
-    } else {
-        float a = (node.lo.x - origin.x) * inv.x;
-        float b = (node.hi.x - origin.x) * inv.x;
-        lo = max(lo, min(a, b));
-        hi = min(hi, max(a, b));
-    }
-    if (direction.y == 0.0) {
-        outside = outside || origin.y < node.lo.y || origin.y > node.hi.y;
-    } else {
-        float a = (node.lo.y - origin.y) * inv.y;
-        float b = (node.hi.y - origin.y) * inv.y;
-        lo = max(lo, min(a, b));
-        hi = min(hi, max(a, b));
-    }
-    if (direction.z == 0.0) {
-        outside = outside || origin.z < node.lo.z || origin.z > node.hi.z;
-    } else {
-        float a = (node.lo.z - origin.z) * inv.z;
-        float b = (node.hi.z - origin.z) * inv.z;
-        lo = max(lo, min(a, b));
-        hi = min(hi, max(a, b));
-    }
+    slab_axis(node.lo.x, node.hi.x, origin.x, direction.x, inv.x, lo, hi, outside);
+    slab_axis(node.lo.y, node.hi.y, origin.y, direction.y, inv.y, lo, hi, outside);
+    slab_axis(node.lo.z, node.hi.z, origin.z, direction.z, inv.z, lo, hi, outside);
     return !outside && !(lo > hi);
 }
 

@@ -332,19 +332,21 @@ impl Bvh {
 fn slab(node: &Node, pad: f64, origin: DVec3, inv: DVec3, t_min: f64, t_max: f64) -> bool {
     let (mut lo, mut hi) = (t_min, t_max);
     for k in 0..3 {
-        let (a, b) = ((node.min[k] - pad - origin[k]) * inv[k], (node.max[k] + pad - origin[k]) * inv[k]);
-        let (near, far) = if a <= b { (a, b) } else { (b, a) };
-        if near > lo {
-            lo = near;
-        }
-        if far < hi {
-            hi = far;
-        }
+        (lo, hi) = slab_axis(node.min[k] - pad, node.max[k] + pad, origin[k], inv[k], (lo, hi));
         if lo > hi {
             return false;
         }
     }
     true
+}
+
+/// One axis of [`slab`]: the interval `(lo, hi)` of t narrowed to the slab `[box_min, box_max]` along it (`inv`:
+/// 1/direction along it, ±inf where that is 0). The shader calls it axis by axis, without a loop (llvmpipe's
+/// loop budget, src/gpu/loop_budget.rs).
+fn slab_axis(box_min: f64, box_max: f64, origin: f64, inv: f64, (lo, hi): (f64, f64)) -> (f64, f64) {
+    let (a, b) = ((box_min - origin) * inv, (box_max - origin) * inv);
+    let (near, far) = if a <= b { (a, b) } else { (b, a) };
+    (if near > lo { near } else { lo }, if far < hi { far } else { hi })
 }
 
 #[cfg(test)]
