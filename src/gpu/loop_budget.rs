@@ -13,7 +13,7 @@
 //! their own.
 //!
 //! A loop of known count counts too: the walk's slab test looped over three axes, three iterations a box, until
-//! written out axis by axis (2026-12-04): overcast.glb at 96 × 72 then passed 32² shadow rays where it had been
+//! called axis by axis (`slab_axis`, 2026-12-04): overcast.glb at 96 × 72 then passed 32² shadow rays where it had been
 //! refused at 12² (docs/platform.md).
 //!
 //! What sunshade does: every fragment ends with a probe loop of [`LOOP_PROBE_ITERATIONS`] iterations, a count the
