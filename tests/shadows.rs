@@ -241,6 +241,7 @@ fn terminator_counts(l: DVec3) -> ((usize, usize), (usize, usize)) {
                         occluders: &bvh as &dyn Occlusion,
                         samples_per_axis: 4,
                         lights: ShadowedLights::ALL,
+                        sky_slices: false,
                     };
                     let e = irradiance_visible(&point, &lights, &options, Some(&sh))[0];
                     let e0 = irradiance_visible(&point, &lights, &options, None)[0];
@@ -327,7 +328,13 @@ fn floor_sun_visible(scene: &Scene, floor_half: f64, p: DVec3, l: DVec3) -> f64 
         DVec3::new(0.0, 0.0, floor_half),
     ];
     let origin = shadow_ray_origin(&corners, &[DVec3::Y; 3], [1.0 / 3.0; 3], p, DVec3::Y);
-    let sh = Shadowing { origin, occluders: &bvh as &dyn Occlusion, samples_per_axis: 1, lights: ShadowedLights::ALL };
+    let sh = Shadowing {
+        origin,
+        occluders: &bvh as &dyn Occlusion,
+        samples_per_axis: 1,
+        lights: ShadowedLights::ALL,
+        sky_slices: false,
+    };
     f64::from(u8::from(sh.visible_along(l.normalize())))
 }
 

@@ -117,8 +117,13 @@ impl MapReach {
     /// Whether the pixel whose shadow rays leave from `origin` (face normal `face`, on the shaded side; point
     /// `x` with normal `n`) is a map edge for any light with a map.
     pub fn is_edge(&self, occluders: &Occluders, origin: DVec3, face: DVec3, x: DVec3, n: DVec3) -> bool {
-        let rays =
-            Shadowing { origin, occluders, samples_per_axis: self.samples_per_axis, lights: ShadowedLights::ALL };
+        let rays = Shadowing {
+            origin,
+            occluders,
+            samples_per_axis: self.samples_per_axis,
+            lights: ShadowedLights::ALL,
+            sky_slices: false,
+        };
         if let Some(sun) = &self.sun {
             let v = if sun.delta {
                 f64::from(u8::from(rays.visible_along(sun.l)))

@@ -10,6 +10,7 @@ use glam::DVec3;
 
 use crate::scene::{AlphaMode, Scene};
 use crate::shading::surface::{masked_hit_blocks, SurfaceSample};
+use crate::shading::visibility::Slice;
 use crate::shading::Occlusion;
 use crate::visibility::{occluder_bvh, Bvh, WatertightRay};
 
@@ -90,5 +91,10 @@ impl Occlusion for Occluders<'_> {
             return self.bvh.any_hit(&ray, 0.0, t_max);
         }
         self.bvh.any_hit_where(&ray, 0.0, t_max, |i, t| self.blocks(i, origin, direction, t).0)
+    }
+
+    /// The sky's slices need opaque triangles: with an alpha-masked occluder the reference casts rays instead.
+    fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
+        self.masked.is_empty() && self.bvh.slice_triangles(slice, visit)
     }
 }

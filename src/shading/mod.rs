@@ -13,6 +13,7 @@ pub mod quantity;
 pub mod radiometry;
 mod shade;
 pub mod sky_lune;
+pub mod sky_slices;
 pub mod surface;
 pub mod texture_filter;
 pub mod visibility;
@@ -25,6 +26,6 @@ pub use shade::{
     DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{
-    Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
+    Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, SkyVisibility, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
     DEFAULT_SHADOW_SAMPLES_PER_AXIS, MAPPED_DISKS,
 };

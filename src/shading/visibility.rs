@@ -19,7 +19,8 @@
 //! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
 //! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
 //! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
-//! light's centre: a hard shadow.
+//! light's centre: a hard shadow. The reference can take the sky's fraction by slices instead (`sky_slices`,
+//! `reference --sky-visibility`), exact along one angle, for a truth that the grid converges on too slowly.
 //!
 //! **Specular part.** The lobe integrals already sample each light (`shade.rs`); each of their samples casts its
 //! own shadow ray, so the lobe sees exactly the part of the light that is visible. A delta sun and a small-source
@@ -55,6 +56,28 @@ use super::shade::orthonormal_to;
 /// lavapipe's BVH walk located 6² renders teapot.glb and sunset.glb in 3.1–3.3 s and 5.4 s, the old 8² in 4.0–4.9 s
 /// and 6.7–6.8 s. Shadow maps filter on the same grid (PCSS, `k²` taps).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 6;
+
+/// How the reference takes the sky's visible fraction where it casts rays (`reference --sky-visibility`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SkyVisibility {
+    /// The located grid of shadow rays the GPU casts too (`grid_fraction`; second order, `--shadow-samples`).
+    #[default]
+    Grid,
+    /// Slices exact along one angle of the lune (`sky_slices`; second order with 4 rows a grid ray, no rays):
+    /// the converged reference's, where every occluder is opaque. No GPU mirror.
+    Slices,
+}
+
+impl std::str::FromStr for SkyVisibility {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "grid" => Ok(SkyVisibility::Grid),
+            "slices" => Ok(SkyVisibility::Slices),
+            _ => Err(format!("'{s}' is not a sky visibility (grid, slices)")),
+        }
+    }
+}
 
 /// How the sun's shadow map is filtered (`--shadow-map-filter`; GPU, `--shadows map`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -129,6 +152,26 @@ impl std::str::FromStr for Shadows {
 pub trait Occlusion: Sync {
     /// Whether any occluder meets `origin + t direction` for `0 < t < t_max` (`direction` need not be unit).
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool;
+
+    /// Calls `visit` with (at least) every occluding triangle (corners \[m\]) that meets the half-plane through
+    /// `origin` of unit normal `m` on the side `d·(x − origin) ≥ 0` and reaches into both half-spaces
+    /// `k·(x − origin) > 0` of `above` (`sky_slices`: the sky's and the surface's sides), and returns true; false,
+    /// visiting nothing, where the occluders are not all opaque triangles (then the caller casts rays).
+    fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
+        let _ = (slice, visit);
+        false
+    }
+}
+
+/// One slice of the sky's slices (`sky_slices`): the half-plane through `origin` \[m\] of unit normal `m` on the
+/// side `d·(x − origin) ≥ 0`, and the half-spaces `k·(x − origin) > 0` (`above`) outside which nothing can
+/// block a direction that counts.
+#[derive(Clone, Copy, Debug)]
+pub struct Slice {
+    pub origin: DVec3,
+    pub m: DVec3,
+    pub d: DVec3,
+    pub above: [DVec3; 2],
 }
 
 /// Nothing occludes anything.
@@ -137,6 +180,10 @@ pub struct Unoccluded;
 impl Occlusion for Unoccluded {
     fn occluded(&self, _: DVec3, _: DVec3, _: f64) -> bool {
         false
+    }
+
+    fn slice_triangles(&self, _: &Slice, _: &mut dyn FnMut([DVec3; 3])) -> bool {
+        true
     }
 }
 
@@ -182,6 +229,9 @@ pub struct Shadowing<'a> {
     pub samples_per_axis: u32,
     /// The lights these rays shadow; the others are unoccluded.
     pub lights: ShadowedLights,
+    /// Whether the sky's visible fraction is taken by slices (`sky_slices`, the reference's exact-in-one-angle
+    /// rule) where the occluders allow it, rather than by the located grid the GPU mirrors.
+    pub sky_slices: bool,
 }
 
 impl<'a> Shadowing<'a> {
@@ -568,7 +618,16 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 /// (first order), but their weight is itself of the order of the spacing there (`sin²β`, `sin(width − ψ)`), so
 /// their error is second order with the rest. The rays along the ground's horizon (`u = 0`) are horizontal: they
 /// reach what stands at the point's own height, the limit of the sky's rays just above it.
+///
+/// Where `s.sky_slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
+/// slices instead (`sky_slices`: exact along one angle, second order in its rows), which the GPU does not mirror.
 pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
+    use super::sky_slices::{sky_rows, sky_visible_fraction_sliced};
+    if s.sky_slices {
+        if let Some(v) = sky_visible_fraction_sliced(s, n, sky_rows(s.samples_per_axis)) {
+            return v;
+        }
+    }
     grid_fraction(s, &GridLight::Sky(sky_lune(n)))
 }
 
@@ -618,7 +677,13 @@ mod tests {
     }
 
     fn shadowing<'a>(occ: &'a dyn Occlusion, k: u32) -> Shadowing<'a> {
-        Shadowing { origin: DVec3::ZERO, occluders: occ, samples_per_axis: k, lights: ShadowedLights::ALL }
+        Shadowing {
+            origin: DVec3::ZERO,
+            occluders: occ,
+            samples_per_axis: k,
+            lights: ShadowedLights::ALL,
+            sky_slices: false,
+        }
     }
 
     #[test]

@@ -280,6 +280,49 @@ impl crate::shading::Occlusion for Bvh {
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
         WatertightRay::new(origin, direction).is_some_and(|ray| self.any_hit(&ray, 0.0, t_max))
     }
+
+    fn slice_triangles(&self, slice: &crate::shading::visibility::Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
+        self.near_half_plane(slice, |i| visit(self.triangles[i]));
+        true
+    }
+}
+
+impl Bvh {
+    /// Visits (the index as given to [`Bvh::new`] of) every triangle in a leaf whose box meets the slice's
+    /// half-plane and reaches into its half-spaces `above` (the sky's slices, `shading::sky_slices`). A box
+    /// meets the plane where its centre's distance is at most its half-extent projected on the normal, and
+    /// reaches into a half-space where its centre's signed distance plus that extent is positive; the boxes'
+    /// padding (a relative 1e-9) covers the rounding of those tests.
+    pub fn near_half_plane(&self, slice: &crate::shading::visibility::Slice, mut visit: impl FnMut(usize)) {
+        let (origin, m, d) = (slice.origin, slice.m, slice.d);
+        let reaches = |centre: DVec3, half: DVec3, k: DVec3| centre.dot(k) + half.dot(k.abs()) > 0.0;
+        if self.order.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; STACK_SIZE];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            let centre = 0.5 * (node.min + node.max) - origin;
+            let half = 0.5 * (node.max - node.min);
+            if centre.dot(m).abs() > half.dot(m.abs())
+                || centre.dot(d) + half.dot(d.abs()) < 0.0
+                || !slice.above.iter().all(|&k| reaches(centre, half, k))
+            {
+                continue;
+            }
+            if node.count == 0 {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+                continue;
+            }
+            for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                visit(i as usize);
+            }
+        }
+    }
 }
 
 impl Bvh {
@@ -361,6 +404,40 @@ mod tests {
         }
         fn v(&mut self, s: f64) -> DVec3 {
             DVec3::new(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5) * s
+        }
+    }
+
+    #[test]
+    fn the_half_plane_walk_visits_every_triangle_the_slice_can_meet() {
+        // Every triangle with a corner on each side of the plane (or on it), a corner on the half-plane's side of
+        // the axis and a corner in each half-space `above` must be visited (the walk may visit more).
+        let mut rng = Rng(11);
+        for (count, size) in [(1usize, 0.5), (200, 0.2), (3000, 0.05)] {
+            let tris: Vec<[DVec3; 3]> = (0..count)
+                .map(|_| {
+                    let c = rng.v(2.0);
+                    [c + rng.v(size), c + rng.v(size), c + rng.v(size)]
+                })
+                .collect();
+            let bvh = Bvh::new(tris.clone());
+            for _ in 0..500 {
+                let origin = rng.v(3.0);
+                let m = rng.v(1.0).normalize();
+                let d = m.any_orthonormal_vector();
+                let above = [rng.v(1.0).normalize(), rng.v(1.0).normalize()];
+                let slice = crate::shading::visibility::Slice { origin, m, d, above };
+                let mut visited = vec![false; count];
+                bvh.near_half_plane(&slice, |i| visited[i] = true);
+                for (i, t) in tris.iter().enumerate() {
+                    let side = |k: DVec3| t.map(|p| (p - origin).dot(k));
+                    let (dm, dd) = (side(m), side(d));
+                    let cut = dm.iter().any(|&x| x >= 0.0) && dm.iter().any(|&x| x <= 0.0);
+                    let reaches = |k: DVec3| side(k).iter().any(|&x| x > 0.0);
+                    if cut && dd.iter().any(|&x| x >= 0.0) && above.iter().all(|&k| reaches(k)) {
+                        assert!(visited[i], "{count} triangles: triangle {i} missed");
+                    }
+                }
+            }
         }
     }
 
