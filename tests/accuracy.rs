@@ -122,6 +122,58 @@ fn the_sky_through_occluders_converges_by_slices() {
     assert!(e.max_rel < step, "{:.2e} against {step:.2e}", e.max_rel);
 }
 
+/// `--tolerance` on the reference where it takes the sky through occluders by slices (`reference --tolerance`'s
+/// default): overcast.glb, refused on the located grid without `--tolerance-in-penumbrae`, now meets T = 1e-2,
+/// 1e-3 and 1e-4 over every pixel against its converged reference (by slices, every pixel's last doubling under
+/// a tenth of the tightest T), penumbrae included, and costs more at tighter T. Measured 2026-12-04 at 32 × 24:
+/// 9², 19², 56² shadow grids (4k² rows each), 1.3e-3, 6.9e-5, 2.6e-6.
+#[test]
+fn reference_tolerance_keeps_the_sky_through_occluders_by_slices() {
+    use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
+    let scene = common::load(std::path::Path::new("models/overcast.glb"));
+    let mut s = settings::resolve(&scene, 32, 24, &CameraOptions::default(), &SunOptions::default()).unwrap();
+    s.shading.shadows = Shadows::Ray;
+    s.shading.sky_visibility = SkyVisibility::Slices;
+    let reference = ReferenceOptions::default();
+    // The truth's ladder from 7² (7, 10, 15, 22, 32, 46, 66) shares no rung with `--tolerance`'s (from the
+    // default 6²: 9, 13, 19, 27, 39, 56), so no image is compared with itself.
+    let mut fine = s.clone();
+    fine.shading.shadow_samples_per_axis = 7;
+    let truth = render_converged(&scene, &fine, &reference, &ConvergenceOptions { accuracy: 1e-5, max_refinements: 6 });
+    eprintln!("truth: {}", truth.summary());
+    // Every pixel's last doubling moved it by less than a tenth of the tightest T (those that moved by 1e-6 or
+    // more are the truth's "unconverged" at its 1e-5 claim), so the comparison takes every pixel.
+    assert!(truth.unconverged.iter().all(|u| u.change < 1e-5), "{}", truth.summary());
+    let mut grids = Vec::new();
+    for tolerance in [1e-2, 1e-3, 1e-4] {
+        let mut t = s.clone();
+        let asked = Tolerance::outside_penumbrae(tolerance);
+        let (image, prediction) =
+            reference_within_tolerance(&scene, &mut t, &reference, Shadows::Ray, true, Some(asked)).unwrap();
+        let e = sunshade::accuracy::error::image_error(&image, &truth.image, None).unwrap();
+        let k = t.shading.shadow_samples_per_axis;
+        eprintln!(
+            "T = {tolerance:e}: shadow grid {k}², predicted {:.2e}, measured {:.2e}",
+            prediction.max_relative, e.max_rel
+        );
+        assert!(prediction.max_relative <= tolerance && e.max_rel <= tolerance, "T = {tolerance:e}: {:.2e}", e.max_rel);
+        grids.push(k);
+    }
+    assert!(grids.windows(2).all(|w| w[0] <= w[1]), "looser T must cost no more: {grids:?}");
+    // The located grid is refused there, as before.
+    let mut g = s.clone();
+    g.shading.sky_visibility = SkyVisibility::Grid;
+    let refused = reference_within_tolerance(
+        &scene,
+        &mut g,
+        &reference,
+        Shadows::Ray,
+        true,
+        Some(Tolerance::outside_penumbrae(1e-2)),
+    );
+    assert!(refused.is_err_and(|e| e.contains("the sky's penumbra")));
+}
+
 #[test]
 fn pixels_that_do_not_converge_are_reported() {
     let dir = common::TempDir::new("unconverged");
