@@ -241,7 +241,7 @@ fn terminator_counts(l: DVec3) -> ((usize, usize), (usize, usize)) {
                         occluders: &bvh as &dyn Occlusion,
                         samples_per_axis: 4,
                         lights: ShadowedLights::ALL,
-                        sky_slices: false,
+                        slices: false,
                     };
                     let e = irradiance_visible(&point, &lights, &options, Some(&sh))[0];
                     let e0 = irradiance_visible(&point, &lights, &options, None)[0];
@@ -333,7 +333,7 @@ fn floor_sun_visible(scene: &Scene, floor_half: f64, p: DVec3, l: DVec3) -> f64 
         occluders: &bvh as &dyn Occlusion,
         samples_per_axis: 1,
         lights: ShadowedLights::ALL,
-        sky_slices: false,
+        slices: false,
     };
     f64::from(u8::from(sh.visible_along(l.normalize())))
 }

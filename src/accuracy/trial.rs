@@ -24,7 +24,7 @@ use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
 use crate::scene::{AlphaMode, Scene};
 use crate::settings::RenderSettings;
-use crate::shading::{Shadows, SkyVisibility, SunModel};
+use crate::shading::{Shadows, SunModel, VisibilityRule};
 
 /// What [`render_within_tolerance`] rendered: the render kept and its predicted error (the renders made and not
 /// kept, a delta trial or the coarser rungs of a lobe study, were dropped as soon as they had served).
@@ -278,12 +278,12 @@ pub fn reference_within_tolerance(
 }
 
 /// Whether the reference's shadow rays see the sky through occluders by slices: the sky lit, shadows by rays in a
-/// scene that can shadow itself, `--sky-visibility slices`, and no alpha-masked material (whose occluders send
+/// scene that can shadow itself, `--visibility slices`, and no alpha-masked material (whose occluders send
 /// the slices back to the grid, `shading::sky_slices`).
 pub fn sky_by_slices(scene: &Scene, settings: &RenderSettings, scene_can_occlude: bool) -> bool {
     settings.lights.sky.is_some()
         && scene_can_occlude
         && settings.shading.shadows == Shadows::Ray
-        && settings.shading.sky_visibility == SkyVisibility::Slices
+        && settings.shading.visibility_rule == VisibilityRule::Slices
         && !scene.materials.iter().any(|m| matches!(m.alpha, AlphaMode::Mask(_)))
 }

@@ -12,7 +12,7 @@ use crate::scene::light::MAX_DISK_EXTENT_M;
 use crate::scene::{BrdfKind, DiskLight, LoadOptions, UriScope};
 use crate::settings::{CameraOptions, LightOptions, SunOptions, DEFAULT_HEIGHT, DEFAULT_WIDTH};
 use crate::shading::{
-    DiskModel, ShadingOptions, ShadowMapFilter, Shadows, SkyVisibility, SunModel, DEFAULT_SAMPLES_PER_AXIS,
+    DiskModel, ShadingOptions, ShadowMapFilter, Shadows, SunModel, VisibilityRule, DEFAULT_SAMPLES_PER_AXIS,
     DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 
@@ -403,7 +403,7 @@ impl SceneArgs {
                 shadow_map_size: self.shadow_map_size,
                 shadow_map_filter: self.shadow_map_filter,
                 quantity: self.quantity.frame(),
-                sky_visibility: SkyVisibility::Grid,
+                visibility_rule: VisibilityRule::Grid,
             },
         }
     }

@@ -10,7 +10,7 @@ use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, ShadowMapFilter, SkyVisibility, SunModel};
+use crate::shading::{DiskModel, ShadowMapFilter, SunModel, VisibilityRule};
 
 /// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference"), with its
 /// predicted error.
@@ -56,8 +56,8 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "samples_per_material": settings.lobes_per_material.iter().map(|k| k.map(|k| k * k)).collect::<Vec<_>>(),
         "shadows": sh.shadows.name(),
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
-        // The sky's visible fraction through occluders: the ray grid, or the reference's slices.
-        "sky_visibility": match sh.sky_visibility { SkyVisibility::Grid => "grid", SkyVisibility::Slices => "slices" },
+        // The sky's and the sun's visible fractions through occluders: the ray grids, or the reference's slices.
+        "visibility_rule": match sh.visibility_rule { VisibilityRule::Grid => "grid", VisibilityRule::Slices => "slices" },
         "shadow_map_size": sh.shadow_map_size,
         "shadow_map_filter": match sh.shadow_map_filter { ShadowMapFilter::Pcss => "pcss", ShadowMapFilter::Nearest => "nearest" },
         "quantity": sh.quantity.name(),

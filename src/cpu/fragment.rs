@@ -18,7 +18,7 @@ use crate::shading::surface::{
 use crate::shading::visibility::shadow_ray_origin;
 use crate::shading::{
     irradiance_visible, radiance_out, radiance_out_visible, safe_normalize, Occlusion, Quantity, ShadowedLights,
-    Shadowing, SkyVisibility, SurfacePoint,
+    Shadowing, SurfacePoint, VisibilityRule,
 };
 
 /// The pixel's surface inputs ([`SurfaceSample`]): each set's texture coordinates at the pixel centre and at
@@ -104,7 +104,7 @@ pub(super) fn shade(
         occluders,
         samples_per_axis: settings.shading.shadow_samples_per_axis,
         lights,
-        sky_slices: settings.shading.sky_visibility == SkyVisibility::Slices,
+        slices: settings.shading.visibility_rule == VisibilityRule::Slices,
     };
     if irradiance {
         return irradiance_visible(&point, &settings.lights, &shading, Some(&shadow));

@@ -122,7 +122,7 @@ impl MapReach {
             occluders,
             samples_per_axis: self.samples_per_axis,
             lights: ShadowedLights::ALL,
-            sky_slices: false,
+            slices: false,
         };
         if let Some(sun) = &self.sun {
             let v = if sun.delta {

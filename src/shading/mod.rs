@@ -14,6 +14,7 @@ pub mod radiometry;
 mod shade;
 pub mod sky_lune;
 pub mod sky_slices;
+pub mod sun_slices;
 pub mod surface;
 pub mod texture_filter;
 pub mod visibility;
@@ -26,6 +27,6 @@ pub use shade::{
     DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{
-    Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, SkyVisibility, Unoccluded, DEFAULT_SHADOW_MAP_SIZE,
-    DEFAULT_SHADOW_SAMPLES_PER_AXIS, MAPPED_DISKS,
+    Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, Unoccluded, VisibilityRule,
+    DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS, MAPPED_DISKS,
 };

@@ -90,8 +90,8 @@ pub struct ShadingOptions {
     pub shadow_map_filter: ShadowMapFilter,
     /// What the pixels hold: radiance, or the irradiance at the surface.
     pub quantity: super::Quantity,
-    /// How the reference takes the sky's visible fraction (the GPU's grid, or slices).
-    pub sky_visibility: super::visibility::SkyVisibility,
+    /// How the reference takes the sky's and the sun's visible fractions (the GPU's grid, or slices).
+    pub visibility_rule: super::visibility::VisibilityRule,
 }
 
 impl Default for ShadingOptions {
@@ -106,7 +106,7 @@ impl Default for ShadingOptions {
             shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
             shadow_map_filter: ShadowMapFilter::Pcss,
             quantity: super::Quantity::Radiance,
-            sky_visibility: super::visibility::SkyVisibility::Grid,
+            visibility_rule: super::visibility::VisibilityRule::Grid,
         }
     }
 }

@@ -40,7 +40,7 @@ pub const SLICE_AXIS: [f64; 3] = [0.33232518133916444, 0.8023039599071088, 0.495
 
 /// Rows of the sliced sky for a shadow-ray grid of `k²`: `4 k²` (each row one plane walk of the occluders' tree,
 /// costing about what a few rays do); refining `k → ⌈k√2⌉` at least doubles them, as it does every grid's count.
-pub fn sky_rows(k: u32) -> u32 {
+pub fn slice_rows(k: u32) -> u32 {
     4 * k.max(1).saturating_mul(k.max(1))
 }
 
@@ -202,7 +202,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
         }
         let m = c.cross(p);
         blocked.clear();
-        let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n] };
+        let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n], cone: None };
         let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
             if let Some(b) = blocked_interval(tri.map(|q| q - s.origin), c, p, m) {
                 blocked.push(b);
@@ -230,7 +230,7 @@ mod tests {
             occluders: occ,
             samples_per_axis: k,
             lights: ShadowedLights::ALL,
-            sky_slices: false,
+            slices: false,
         }
     }
 

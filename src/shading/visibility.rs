@@ -19,8 +19,9 @@
 //! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
 //! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
 //! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
-//! light's centre: a hard shadow. The reference can take the sky's fraction by slices instead (`sky_slices`,
-//! `reference --sky-visibility`), exact along one angle, for a truth that the grid converges on too slowly.
+//! light's centre: a hard shadow. The reference can take the sky's and the sun's fractions by slices instead
+//! (`sky_slices`, `sun_slices`, `reference --visibility`), exact along one angle, for a truth that the grid
+//! converges on too slowly in penumbrae.
 //!
 //! **Specular part.** The lobe integrals already sample each light (`shade.rs`); each of their samples casts its
 //! own shadow ray, so the lobe sees exactly the part of the light that is visible. A delta sun and a small-source
@@ -57,24 +58,25 @@ use super::shade::orthonormal_to;
 /// and 6.7–6.8 s. Shadow maps filter on the same grid (PCSS, `k²` taps).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 6;
 
-/// How the reference takes the sky's visible fraction where it casts rays (`reference --sky-visibility`).
+/// How the reference takes the visible fractions of the sky and the sun where it casts rays (`reference
+/// --visibility`; disk lights keep the grid).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum SkyVisibility {
+pub enum VisibilityRule {
     /// The located grid of shadow rays the GPU casts too (`grid_fraction`; second order, `--shadow-samples`).
     #[default]
     Grid,
-    /// Slices exact along one angle of the lune (`sky_slices`; second order with 4 rows a grid ray, no rays):
-    /// the converged reference's, where every occluder is opaque. No GPU mirror.
+    /// Slices exact along one angle of the light (`sky_slices`, `sun_slices`; second order with 4 rows a grid
+    /// ray, no rays): the converged reference's, where every occluder is opaque. No GPU mirror.
     Slices,
 }
 
-impl std::str::FromStr for SkyVisibility {
+impl std::str::FromStr for VisibilityRule {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s {
-            "grid" => Ok(SkyVisibility::Grid),
-            "slices" => Ok(SkyVisibility::Slices),
-            _ => Err(format!("'{s}' is not a sky visibility (grid, slices)")),
+            "grid" => Ok(VisibilityRule::Grid),
+            "slices" => Ok(VisibilityRule::Slices),
+            _ => Err(format!("'{s}' is not a visibility rule (grid, slices)")),
         }
     }
 }
@@ -172,6 +174,9 @@ pub struct Slice {
     pub m: DVec3,
     pub d: DVec3,
     pub above: [DVec3; 2],
+    /// A cone of directions (unit axis, half-angle \[rad\]) from `origin` outside which nothing counts (the sun's
+    /// disk), if any.
+    pub cone: Option<(DVec3, f64)>,
 }
 
 /// Nothing occludes anything.
@@ -229,9 +234,10 @@ pub struct Shadowing<'a> {
     pub samples_per_axis: u32,
     /// The lights these rays shadow; the others are unoccluded.
     pub lights: ShadowedLights,
-    /// Whether the sky's visible fraction is taken by slices (`sky_slices`, the reference's exact-in-one-angle
-    /// rule) where the occluders allow it, rather than by the located grid the GPU mirrors.
-    pub sky_slices: bool,
+    /// Whether the sky's and the sun's visible fractions are taken by slices (`sky_slices`, `sun_slices`: the
+    /// reference's exact-in-one-angle rule) where the occluders allow it, rather than by the located grids the
+    /// GPU mirrors.
+    pub slices: bool,
 }
 
 impl<'a> Shadowing<'a> {
@@ -537,7 +543,16 @@ pub fn disk_sample(
 
 /// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ \[rad\]) from a point
 /// with unit normal `n`.
+///
+/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
+/// (`sun_slices`), which the GPU does not mirror.
 pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
+    if s.slices {
+        let rows = super::sky_slices::slice_rows(s.samples_per_axis);
+        if let Some(v) = super::sun_slices::sun_visible_fraction_sliced(s, n, l, angular_diameter, rows) {
+            return v;
+        }
+    }
     let radius = (0.5 * angular_diameter).tan();
     let t = orthonormal_to(l);
     let b = l.cross(t);
@@ -619,12 +634,12 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 /// their error is second order with the rest. The rays along the ground's horizon (`u = 0`) are horizontal: they
 /// reach what stands at the point's own height, the limit of the sky's rays just above it.
 ///
-/// Where `s.sky_slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
+/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
 /// slices instead (`sky_slices`: exact along one angle, second order in its rows), which the GPU does not mirror.
 pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
-    use super::sky_slices::{sky_rows, sky_visible_fraction_sliced};
-    if s.sky_slices {
-        if let Some(v) = sky_visible_fraction_sliced(s, n, sky_rows(s.samples_per_axis)) {
+    use super::sky_slices::{sky_visible_fraction_sliced, slice_rows};
+    if s.slices {
+        if let Some(v) = sky_visible_fraction_sliced(s, n, slice_rows(s.samples_per_axis)) {
             return v;
         }
     }
@@ -682,7 +697,7 @@ mod tests {
             occluders: occ,
             samples_per_axis: k,
             lights: ShadowedLights::ALL,
-            sky_slices: false,
+            slices: false,
         }
     }
 

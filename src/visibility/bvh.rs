@@ -205,6 +205,19 @@ impl Bvh {
 /// costed by the surface-area heuristic, `area(left box) · left count + area(right box) · right count`; the
 /// cheapest boundary that leaves at least a quarter of the triangles on each side wins, else (all centroids in
 /// one bin, or no balanced boundary) the median along the longest axis.
+/// Whether the sphere of centre `centre` (relative to the cone's apex) and radius `r` \[m\] may meet the cone of unit
+/// `axis` and half-angle `angle` \[rad\]: the apex inside the sphere, or the centre's angle from the axis (by
+/// `atan2`, which keeps small angles that `acos` of a cosine near 1 would lose) within `angle` plus the sphere's
+/// angular radius `asin(r/|centre|)`, widened by a relative 1e-9 as the boxes are.
+pub(crate) fn sphere_meets_cone(centre: DVec3, r: f64, axis: DVec3, angle: f64) -> bool {
+    let dist = centre.length();
+    if dist <= r {
+        return true;
+    }
+    let off_axis = centre.cross(axis).length().atan2(centre.dot(axis));
+    off_axis <= (angle + (r / dist).asin()) * (1.0 + 1e-9) + 1e-12
+}
+
 fn sah_split(items: &mut [u32], triangles: &[[DVec3; 3]], centroid: &impl Fn(u32) -> DVec3) -> usize {
     let count = items.len();
     let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
@@ -309,6 +322,7 @@ impl Bvh {
             if centre.dot(m).abs() > half.dot(m.abs())
                 || centre.dot(d) + half.dot(d.abs()) < 0.0
                 || !slice.above.iter().all(|&k| reaches(centre, half, k))
+                || slice.cone.is_some_and(|(axis, angle)| !sphere_meets_cone(centre, half.length(), axis, angle))
             {
                 continue;
             }
@@ -425,7 +439,7 @@ mod tests {
                 let m = rng.v(1.0).normalize();
                 let d = m.any_orthonormal_vector();
                 let above = [rng.v(1.0).normalize(), rng.v(1.0).normalize()];
-                let slice = crate::shading::visibility::Slice { origin, m, d, above };
+                let slice = crate::shading::visibility::Slice { origin, m, d, above, cone: None };
                 let mut visited = vec![false; count];
                 bvh.near_half_plane(&slice, |i| visited[i] = true);
                 for (i, t) in tris.iter().enumerate() {
