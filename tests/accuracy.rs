@@ -122,34 +122,43 @@ fn the_sky_through_occluders_converges_by_slices() {
     assert!(e.max_rel < step, "{:.2e} against {step:.2e}", e.max_rel);
 }
 
-/// The sun's penumbrae by slices (`shading::sun_slices`): sunset.glb's converged reference converges in them where
-/// the located grid leaves pixels moving, and agrees with a grid of 96² shadow rays within that grid's step from
-/// 48² (second order: about a third of it). Measured 2026-12-04 at 48 × 36: slices converged after two doublings
-/// (last change 6.9e-7), the grid left 22 of 1040 pixels moving after six (up to 9.4e-5); 1.2e-5 from 96² rays,
-/// whose step from 48² is 3.7e-5.
+/// The penumbrae of the sun and of disk lights by slices (`shading::sun_slices`, `shading::disk_slices`):
+/// sunset.glb's (the sun) and room.gltf's (a disk skylight) converged references converge in them where the
+/// located grid leaves pixels moving, and agree with a grid of 96² shadow rays within that grid's step from 48²
+/// (second order: about a third of it). Measured 2026-12-04: sunset.glb at 48 × 36, slices converged after two
+/// doublings (last change 6.9e-7), the grid left 22 of 1040 pixels moving after six (up to 9.4e-5), 1.2e-5 from
+/// 96² rays whose step from 48² is 3.7e-5; room.gltf at 32 × 24, slices left 3 of 768 pixels moving by up to
+/// 1.1e-5, the grid 30 by up to 6.0e-4, 1.5e-4 from 96² rays whose step from 48² is 4.3e-4.
 #[test]
-fn the_suns_penumbrae_converge_by_slices() {
-    let scene = common::load(std::path::Path::new("models/sunset.glb"));
-    let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
-    s.shading.shadows = Shadows::Ray;
-    let reference = ReferenceOptions::default();
-    let options = ConvergenceOptions { accuracy: 1e-4, max_refinements: 6 };
-    let mut sliced = s.clone();
-    sliced.shading.visibility_rule = VisibilityRule::Slices;
-    let c = render_converged(&scene, &sliced, &reference, &options);
-    let g = render_converged(&scene, &s, &reference, &options);
-    eprintln!("slices: {}\ngrid: {}", c.summary(), g.summary());
-    assert!(c.unconverged.len() * 4 < g.unconverged.len(), "slices: {}\ngrid: {}", c.summary(), g.summary());
-    let grid = |k: u32| {
-        let mut g = s.clone();
-        g.shading.shadow_samples_per_axis = k;
-        cpu::render(&scene, &g, &reference)
-    };
-    let (coarse, fine) = (grid(48), grid(96));
-    let step = sunshade::accuracy::error::image_error(&coarse, &fine, None).unwrap().max_rel;
-    let e = sunshade::accuracy::error::image_error(&c.image, &fine, Some(&c.unconverged_mask())).unwrap();
-    eprintln!("slices' converged image against 96² located shadow rays: {:.2e} (48² to 96²: {step:.2e})", e.max_rel);
-    assert!(e.max_rel < step, "{:.2e} against {step:.2e}", e.max_rel);
+fn penumbrae_converge_by_slices() {
+    for (model, w, h) in [("models/sunset.glb", 48, 36), ("models/room.gltf", 32, 24)] {
+        let scene = common::load(std::path::Path::new(model));
+        let mut s = settings::resolve(&scene, w, h, &CameraOptions::default(), &SunOptions::default()).unwrap();
+        s.shading.shadows = Shadows::Ray;
+        let reference = ReferenceOptions::default();
+        let options = ConvergenceOptions { accuracy: 1e-4, max_refinements: 6 };
+        let mut sliced = s.clone();
+        sliced.shading.visibility_rule = VisibilityRule::Slices;
+        let c = render_converged(&scene, &sliced, &reference, &options);
+        let g = render_converged(&scene, &s, &reference, &options);
+        eprintln!("{model}: slices: {}\ngrid: {}", c.summary(), g.summary());
+        assert!(
+            c.unconverged.len() * 4 < g.unconverged.len(),
+            "{model}: slices: {}\ngrid: {}",
+            c.summary(),
+            g.summary()
+        );
+        let grid = |k: u32| {
+            let mut g = s.clone();
+            g.shading.shadow_samples_per_axis = k;
+            cpu::render(&scene, &g, &reference)
+        };
+        let (coarse, fine) = (grid(48), grid(96));
+        let step = sunshade::accuracy::error::image_error(&coarse, &fine, None).unwrap().max_rel;
+        let e = sunshade::accuracy::error::image_error(&c.image, &fine, Some(&c.unconverged_mask())).unwrap();
+        eprintln!("{model}: slices against 96² located shadow rays: {:.2e} (48² to 96²: {step:.2e})", e.max_rel);
+        assert!(e.max_rel < step, "{model}: {:.2e} against {step:.2e}", e.max_rel);
+    }
 }
 
 /// `--tolerance` on the reference where it takes the sky through occluders by slices (`reference --tolerance`'s

@@ -56,7 +56,7 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "samples_per_material": settings.lobes_per_material.iter().map(|k| k.map(|k| k * k)).collect::<Vec<_>>(),
         "shadows": sh.shadows.name(),
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
-        // The sky's and the sun's visible fractions through occluders: the ray grids, or the reference's slices.
+        // The lights' visible fractions through occluders: the ray grids, or the reference's slices.
         "visibility_rule": match sh.visibility_rule { VisibilityRule::Grid => "grid", VisibilityRule::Slices => "slices" },
         "shadow_map_size": sh.shadow_map_size,
         "shadow_map_filter": match sh.shadow_map_filter { ShadowMapFilter::Pcss => "pcss", ShadowMapFilter::Nearest => "nearest" },

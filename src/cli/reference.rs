@@ -60,10 +60,10 @@ pub struct ReferenceCommand {
     /// Refinements of the converged reference at most (each doubles the samples of the pixels still moving).
     #[arg(long, value_name = "N", default_value_t = converged::DEFAULT_MAX_REFINEMENTS, value_parser = clap::value_parser!(u32).range(1..=12), requires = "converged", help_heading = "Quality")]
     pub max_refinements: u32,
-    /// How the visible fractions of the sky and the sun through occluders are taken: `grid` (the located grids
-    /// of shadow rays the GPU casts, --shadow-samples) or `slices` (exact along one angle of the light, a
-    /// midpoint rule of 4k² rows along the other, for k² = --shadow-samples: second order in the rows, where every
-    /// occluder is opaque; the grid otherwise; disk lights keep the grid). Default: slices with --converged, and
+    /// How the lights' visible fractions through occluders are taken: `grid` (the located grids of shadow rays
+    /// the GPU casts, --shadow-samples) or `slices` (exact along one angle of the light, a midpoint rule of 4k²
+    /// rows along the other, for k² = --shadow-samples: second order in the rows, where every occluder is opaque;
+    /// the grid otherwise). Default: slices with --converged, and
     /// with --tolerance where it holds in penumbrae (--tolerance-in-penumbrae, or a sky, whose penumbra is the
     /// image): overcast.glb at 64² converges where the grid leaves 1938 of 2461 pixels moving, and --tolerance
     /// keeps 1e-2 there at 9², where the grid refused it or took 56² in penumbrae. The grid otherwise (what the

@@ -7,6 +7,7 @@
 pub mod albedo;
 pub mod brdf;
 pub mod brdf_fit;
+pub mod disk_slices;
 pub mod measured;
 pub mod quadrature;
 pub mod quantity;

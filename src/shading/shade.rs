@@ -90,7 +90,7 @@ pub struct ShadingOptions {
     pub shadow_map_filter: ShadowMapFilter,
     /// What the pixels hold: radiance, or the irradiance at the surface.
     pub quantity: super::Quantity,
-    /// How the reference takes the sky's and the sun's visible fractions (the GPU's grid, or slices).
+    /// How the reference takes the lights' visible fractions (the GPU's grids, or slices).
     pub visibility_rule: super::visibility::VisibilityRule,
 }
 

@@ -76,11 +76,10 @@ pub fn angle_of(k: f64) -> f64 {
     (1.0 - k.abs()).max(0.0).atan2(-k)
 }
 
-/// The interval of β (the angle from `c` in the half-plane `{s c + t p : t ≥ 0}`, origin at the rays' origin) that
-/// the triangle `tri` (corners relative to the rays' origin, in metres) blocks, as pseudo-angles
-/// ([`pseudo_angle`]), if it meets the half-plane in a segment that does not pass through the origin. `m = c × p`
-/// is the plane's unit normal.
-pub fn blocked_interval(tri: [DVec3; 3], c: DVec3, p: DVec3, m: DVec3) -> Option<(f64, f64)> {
+/// The segment in which the plane through the rays' origin of unit normal `m` cuts the triangle `tri` (corners
+/// relative to that origin, in metres), in the plane's coordinates `(s, t) = (q·c, q·p)`; `None` where the plane
+/// misses it, touches a corner, or holds it (which only a measure-zero set of rows meets).
+pub fn slice_segment(tri: [DVec3; 3], c: DVec3, p: DVec3, m: DVec3) -> Option<[(f64, f64); 2]> {
     let dist = tri.map(|p| p.dot(m));
     let mut points = [(0.0, 0.0); 3];
     let mut n = 0;
@@ -98,15 +97,32 @@ pub fn blocked_interval(tri: [DVec3; 3], c: DVec3, p: DVec3, m: DVec3) -> Option
             n += 1;
         }
     }
-    // Two points: a segment (three: the triangle lies in the plane, which only a measure-zero set of rows meets).
-    if n != 2 {
+    (n == 2).then_some([points[0], points[1]])
+}
+
+/// The part of `segment` where `a·(s, t) < b`, if any (`a` and `b` of a line of the slice's plane).
+pub fn clip_segment(segment: [(f64, f64); 2], a: (f64, f64), b: f64) -> Option<[(f64, f64); 2]> {
+    let [(s0, t0), (s1, t1)] = segment;
+    let (f0, f1) = (a.0 * s0 + a.1 * t0 - b, a.0 * s1 + a.1 * t1 - b);
+    if f0 >= 0.0 && f1 >= 0.0 {
         return None;
     }
-    let [(mut s0, mut t0), (mut s1, mut t1), _] = points;
+    if f0 < 0.0 && f1 < 0.0 {
+        return Some(segment);
+    }
+    let r = f0 / (f0 - f1);
+    let cut = (s0 + r * (s1 - s0), t0 + r * (t1 - t0));
+    Some(if f0 < 0.0 { [(s0, t0), cut] } else { [cut, (s1, t1)] })
+}
+
+/// The interval of β (the angle from `c` in the half-plane `{s c + t p : t ≥ 0}`, origin at the rays' origin) that
+/// a segment of the slice's plane blocks, as pseudo-angles ([`pseudo_angle`]), if it does not pass through the
+/// origin (rays towards a light at infinity, or a segment already clipped to what lies before a finite one).
+pub fn segment_interval([(mut s0, mut t0), (mut s1, mut t1)]: [(f64, f64); 2]) -> Option<(f64, f64)> {
     if t0 < 0.0 && t1 < 0.0 {
         return None;
     }
-    // Clipped to t ≥ 0: the part below the axis line is behind the lune (β would leave [0, π]).
+    // Clipped to t ≥ 0: the part below the axis line is behind the half-plane (β would leave [0, π]).
     if t0 < 0.0 {
         s0 += (s1 - s0) * (-t0 / (t1 - t0));
         t0 = 0.0;
@@ -121,6 +137,13 @@ pub fn blocked_interval(tri: [DVec3; 3], c: DVec3, p: DVec3, m: DVec3) -> Option
     }
     let (k0, k1) = (pseudo_angle(s0, t0), pseudo_angle(s1, t1));
     Some((k0.min(k1), k0.max(k1)))
+}
+
+/// The interval of β that the triangle `tri` (corners relative to the rays' origin, in metres) blocks for rays
+/// towards a light at infinity: [`slice_segment`], then [`segment_interval`]. `m = c × p` is the plane's unit
+/// normal.
+pub fn blocked_interval(tri: [DVec3; 3], c: DVec3, p: DVec3, m: DVec3) -> Option<(f64, f64)> {
+    slice_segment(tri, c, p, m).and_then(segment_interval)
 }
 
 /// The interval of β on the half circle `cos β c + sin β p` where `k·ω ≥ 0`: `k·ω = R cos(β − φ)` with
@@ -202,7 +225,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
         }
         let m = c.cross(p);
         blocked.clear();
-        let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n], cone: None };
+        let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n], cone: None, beyond: None };
         let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
             if let Some(b) = blocked_interval(tri.map(|q| q - s.origin), c, p, m) {
                 blocked.push(b);

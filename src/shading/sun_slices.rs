@@ -55,9 +55,9 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let q = c.cross(l);
     let rows = rows.max(1);
     // One walk over the sun's cone first: where no triangle comes near it, every row would be clear (the same 1).
-    let cone = Some((l, sigma));
+    let cone = Some((l, sigma.cos(), sigma.sin()));
     let mut near = false;
-    let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, l], cone };
+    let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, l], cone, beyond: None };
     if !s.occluders.slice_triangles(&whole_cone, &mut |_| near = true) {
         return None;
     }
@@ -84,7 +84,7 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
         }
         let m = c.cross(p);
         blocked.clear();
-        let slice = Slice { origin: s.origin, m, d: p, above: [n, l], cone };
+        let slice = Slice { origin: s.origin, m, d: p, above: [n, l], cone, beyond: None };
         let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
             if let Some(b) = blocked_interval(tri.map(|x| x - s.origin), c, p, m) {
                 blocked.push(b);

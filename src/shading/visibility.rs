@@ -19,8 +19,8 @@
 //! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
 //! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
 //! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
-//! light's centre: a hard shadow. The reference can take the sky's and the sun's fractions by slices instead
-//! (`sky_slices`, `sun_slices`, `reference --visibility`), exact along one angle, for a truth that the grid
+//! light's centre: a hard shadow. The reference can take the fractions by slices instead (`sky_slices`,
+//! `sun_slices`, `disk_slices`, `reference --visibility`), exact along one angle, for a truth that the grid
 //! converges on too slowly in penumbrae.
 //!
 //! **Specular part.** The lobe integrals already sample each light (`shade.rs`); each of their samples casts its
@@ -58,15 +58,14 @@ use super::shade::orthonormal_to;
 /// and 6.7–6.8 s. Shadow maps filter on the same grid (PCSS, `k²` taps).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 6;
 
-/// How the reference takes the visible fractions of the sky and the sun where it casts rays (`reference
-/// --visibility`; disk lights keep the grid).
+/// How the reference takes the lights' visible fractions where it casts rays (`reference --visibility`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum VisibilityRule {
     /// The located grid of shadow rays the GPU casts too (`grid_fraction`; second order, `--shadow-samples`).
     #[default]
     Grid,
-    /// Slices exact along one angle of the light (`sky_slices`, `sun_slices`; second order with 4 rows a grid
-    /// ray, no rays): the converged reference's, where every occluder is opaque. No GPU mirror.
+    /// Slices exact along one angle of the light (`sky_slices`, `sun_slices`, `disk_slices`; second order with 4
+    /// rows a grid ray, no rays): the converged reference's, where every occluder is opaque. No GPU mirror.
     Slices,
 }
 
@@ -174,9 +173,12 @@ pub struct Slice {
     pub m: DVec3,
     pub d: DVec3,
     pub above: [DVec3; 2],
-    /// A cone of directions (unit axis, half-angle \[rad\]) from `origin` outside which nothing counts (the sun's
-    /// disk), if any.
-    pub cone: Option<(DVec3, f64)>,
+    /// A cone of directions from `origin` outside which nothing counts (the sun's disk, a disk light's bounding
+    /// sphere), if any: its unit axis and the cosine and sine of its half-angle.
+    pub cone: Option<(DVec3, f64, f64)>,
+    /// A half-space `k·(x − origin) > b` (`(k, b)`) that a triangle must reach into to count (the near side of
+    /// a disk light, where its rays end), if any.
+    pub beyond: Option<(DVec3, f64)>,
 }
 
 /// Nothing occludes anything.
@@ -234,7 +236,7 @@ pub struct Shadowing<'a> {
     pub samples_per_axis: u32,
     /// The lights these rays shadow; the others are unoccluded.
     pub lights: ShadowedLights,
-    /// Whether the sky's and the sun's visible fractions are taken by slices (`sky_slices`, `sun_slices`: the
+    /// Whether the lights' visible fractions are taken by slices (`sky_slices`, `sun_slices`, `disk_slices`: the
     /// reference's exact-in-one-angle rule) where the occluders allow it, rather than by the located grids the
     /// GPU mirrors.
     pub slices: bool,
@@ -561,7 +563,16 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
 
 /// The visible fraction of a disk light (centre \[m\], unit emission direction `d`, radius \[m\]), weighted by
 /// projected solid angle, from the point `x` with unit normal `n`.
+///
+/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
+/// (`disk_slices`), which the GPU does not mirror.
 pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
+    if s.slices {
+        let rows = super::sky_slices::slice_rows(s.samples_per_axis);
+        if let Some(v) = super::disk_slices::disk_visible_fraction_sliced(s, n, center, d, radius, rows) {
+            return v;
+        }
+    }
     let a = orthonormal_to(d);
     let b = d.cross(a);
     grid_fraction(s, &GridLight::Disk { x, n, center, d, a, b, radius })

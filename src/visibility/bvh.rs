@@ -206,16 +206,25 @@ impl Bvh {
 /// cheapest boundary that leaves at least a quarter of the triangles on each side wins, else (all centroids in
 /// one bin, or no balanced boundary) the median along the longest axis.
 /// Whether the sphere of centre `centre` (relative to the cone's apex) and radius `r` \[m\] may meet the cone of unit
-/// `axis` and half-angle `angle` \[rad\]: the apex inside the sphere, or the centre's angle from the axis (by
-/// `atan2`, which keeps small angles that `acos` of a cosine near 1 would lose) within `angle` plus the sphere's
-/// angular radius `asin(r/|centre|)`, widened by a relative 1e-9 as the boxes are.
-pub(crate) fn sphere_meets_cone(centre: DVec3, r: f64, axis: DVec3, angle: f64) -> bool {
+/// `axis` whose half-angle has cosine `cos_a` and sine `sin_a`: the apex inside the sphere, or the centre's angle
+/// from the axis within the cone's half-angle plus the sphere's angular radius `asin(r/|centre|)`, compared by
+/// their sines below a right angle (`|centre × axis|` keeps the small angles of the sun's half-degree, which a
+/// cosine near 1 would lose) and by their cosines above, with a relative slack of 1e-9 as the boxes' padding.
+pub(crate) fn sphere_meets_cone(centre: DVec3, r: f64, axis: DVec3, cos_a: f64, sin_a: f64) -> bool {
     let dist = centre.length();
     if dist <= r {
         return true;
     }
-    let off_axis = centre.cross(axis).length().atan2(centre.dot(axis));
-    off_axis <= (angle + (r / dist).asin()) * (1.0 + 1e-9) + 1e-12
+    let sin_p = r / dist;
+    let cos_p = (1.0 - sin_p * sin_p).sqrt();
+    let (sin_t, cos_t) = (sin_a * cos_p + cos_a * sin_p, cos_a * cos_p - sin_a * sin_p);
+    let (along, across) = (centre.dot(axis), centre.cross(axis).length());
+    let slack = 1e-9 * dist;
+    if cos_t > 0.0 {
+        along > -slack && across <= sin_t * dist + slack
+    } else {
+        along >= cos_t * dist - slack
+    }
 }
 
 fn sah_split(items: &mut [u32], triangles: &[[DVec3; 3]], centroid: &impl Fn(u32) -> DVec3) -> usize {
@@ -322,7 +331,8 @@ impl Bvh {
             if centre.dot(m).abs() > half.dot(m.abs())
                 || centre.dot(d) + half.dot(d.abs()) < 0.0
                 || !slice.above.iter().all(|&k| reaches(centre, half, k))
-                || slice.cone.is_some_and(|(axis, angle)| !sphere_meets_cone(centre, half.length(), axis, angle))
+                || slice.cone.is_some_and(|(axis, cos, sin)| !sphere_meets_cone(centre, half.length(), axis, cos, sin))
+                || slice.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b)
             {
                 continue;
             }
@@ -439,7 +449,7 @@ mod tests {
                 let m = rng.v(1.0).normalize();
                 let d = m.any_orthonormal_vector();
                 let above = [rng.v(1.0).normalize(), rng.v(1.0).normalize()];
-                let slice = crate::shading::visibility::Slice { origin, m, d, above, cone: None };
+                let slice = crate::shading::visibility::Slice { origin, m, d, above, cone: None, beyond: None };
                 let mut visited = vec![false; count];
                 bvh.near_half_plane(&slice, |i| visited[i] = true);
                 for (i, t) in tris.iter().enumerate() {
