@@ -93,7 +93,7 @@ impl Occlusion for Occluders<'_> {
         self.bvh.any_hit_where(&ray, 0.0, t_max, |i, t| self.blocks(i, origin, direction, t).0)
     }
 
-    /// The sky's slices need opaque triangles: with an alpha-masked occluder the reference casts rays instead.
+    /// The slices need opaque triangles: with an alpha-masked occluder the reference casts rays instead.
     fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
         self.masked.is_empty() && self.bvh.slice_triangles(slice, visit)
     }

@@ -154,19 +154,19 @@ pub trait Occlusion: Sync {
     /// Whether any occluder meets `origin + t direction` for `0 < t < t_max` (`direction` need not be unit).
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool;
 
-    /// Calls `visit` with (at least) every occluding triangle (corners \[m\]) that meets the half-plane through
-    /// `origin` of unit normal `m` on the side `d·(x − origin) ≥ 0` and reaches into both half-spaces
-    /// `k·(x − origin) > 0` of `above` (`sky_slices`: the sky's and the surface's sides), and returns true; false,
-    /// visiting nothing, where the occluders are not all opaque triangles (then the caller casts rays).
+    /// Calls `visit` with (at least) every occluding triangle (corners \[m\]) that meets the slice ([`Slice`]: its
+    /// half-plane, within its half-spaces and cone) and returns true; false, visiting nothing, where the
+    /// occluders are not all opaque triangles (then the caller casts rays).
     fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
         let _ = (slice, visit);
         false
     }
 }
 
-/// One slice of the sky's slices (`sky_slices`): the half-plane through `origin` \[m\] of unit normal `m` on the
-/// side `d·(x − origin) ≥ 0`, and the half-spaces `k·(x − origin) > 0` (`above`) outside which nothing can
-/// block a direction that counts.
+/// One slice of a light (`sky_slices`, `sun_slices`, `disk_slices`): the half-plane through `origin` \[m\] of
+/// unit normal `m` on the side `d·(x − origin) ≥ 0`, and the half-spaces `k·(x − origin) > 0` (`above`: the
+/// sky's and the surface's sides, or the light's) outside which nothing can block a direction that counts. A
+/// zero `m` and `d` make it the whole of what the half-spaces and the cone keep (a first walk over a light's cone).
 #[derive(Clone, Copy, Debug)]
 pub struct Slice {
     pub origin: DVec3,

@@ -200,11 +200,6 @@ impl Bvh {
     }
 }
 
-/// Where to split `items` (more than [`LEAF_SIZE`] triangles): reordered in place so that the first `mid` go left.
-/// Along each axis of the centroids' box, the centroids are binned ([`BINS`]) and every boundary between bins
-/// costed by the surface-area heuristic, `area(left box) · left count + area(right box) · right count`; the
-/// cheapest boundary that leaves at least a quarter of the triangles on each side wins, else (all centroids in
-/// one bin, or no balanced boundary) the median along the longest axis.
 /// Whether the sphere of centre `centre` (relative to the cone's apex) and radius `r` \[m\] may meet the cone of unit
 /// `axis` whose half-angle has cosine `cos_a` and sine `sin_a`: the apex inside the sphere, or the centre's angle
 /// from the axis within the cone's half-angle plus the sphere's angular radius `asin(r/|centre|)`, compared by
@@ -227,6 +222,11 @@ pub(crate) fn sphere_meets_cone(centre: DVec3, r: f64, axis: DVec3, cos_a: f64, 
     }
 }
 
+/// Where to split `items` (more than [`LEAF_SIZE`] triangles): reordered in place so that the first `mid` go left.
+/// Along each axis of the centroids' box, the centroids are binned ([`BINS`]) and every boundary between bins
+/// costed by the surface-area heuristic, `area(left box) · left count + area(right box) · right count`; the
+/// cheapest boundary that leaves at least a quarter of the triangles on each side wins, else (all centroids in
+/// one bin, or no balanced boundary) the median along the longest axis.
 fn sah_split(items: &mut [u32], triangles: &[[DVec3; 3]], centroid: &impl Fn(u32) -> DVec3) -> usize {
     let count = items.len();
     let (mut clo, mut chi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
@@ -311,10 +311,11 @@ impl crate::shading::Occlusion for Bvh {
 
 impl Bvh {
     /// Visits (the index as given to [`Bvh::new`] of) every triangle in a leaf whose box meets the slice's
-    /// half-plane and reaches into its half-spaces `above` (the sky's slices, `shading::sky_slices`). A box
-    /// meets the plane where its centre's distance is at most its half-extent projected on the normal, and
-    /// reaches into a half-space where its centre's signed distance plus that extent is positive; the boxes'
-    /// padding (a relative 1e-9) covers the rounding of those tests.
+    /// half-plane, reaches into its half-spaces `above` and `beyond`, and whose bounding sphere may meet its cone
+    /// (the lights' slices: `shading::sky_slices`, `sun_slices`, `disk_slices`). A box meets the plane where its
+    /// centre's distance is at most its half-extent projected on the normal, and reaches into a half-space where
+    /// its centre's signed distance plus that extent is positive; the boxes' padding (a relative 1e-9) covers the
+    /// rounding of those tests.
     pub fn near_half_plane(&self, slice: &crate::shading::visibility::Slice, mut visit: impl FnMut(usize)) {
         let (origin, m, d) = (slice.origin, slice.m, slice.d);
         let reaches = |centre: DVec3, half: DVec3, k: DVec3| centre.dot(k) + half.dot(k.abs()) > 0.0;
@@ -434,7 +435,8 @@ mod tests {
     #[test]
     fn the_half_plane_walk_visits_every_triangle_the_slice_can_meet() {
         // Every triangle with a corner on each side of the plane (or on it), a corner on the half-plane's side of
-        // the axis and a corner in each half-space `above` must be visited (the walk may visit more).
+        // the axis, a corner in each half-space `above` and in `beyond`, and a corner inside the cone must be
+        // visited (the walk may visit more).
         let mut rng = Rng(11);
         for (count, size) in [(1usize, 0.5), (200, 0.2), (3000, 0.05)] {
             let tris: Vec<[DVec3; 3]> = (0..count)
@@ -449,7 +451,11 @@ mod tests {
                 let m = rng.v(1.0).normalize();
                 let d = m.any_orthonormal_vector();
                 let above = [rng.v(1.0).normalize(), rng.v(1.0).normalize()];
-                let slice = crate::shading::visibility::Slice { origin, m, d, above, cone: None, beyond: None };
+                let (axis, angle) = (rng.v(1.0).normalize(), 0.01 + 1.5 * rng.f());
+                let cone = (rng.f() < 0.5).then_some((axis, angle.cos(), angle.sin()));
+                let k = rng.v(1.0).normalize();
+                let beyond = (rng.f() < 0.5).then_some((k, rng.f() - 0.5));
+                let slice = crate::shading::visibility::Slice { origin, m, d, above, cone, beyond };
                 let mut visited = vec![false; count];
                 bvh.near_half_plane(&slice, |i| visited[i] = true);
                 for (i, t) in tris.iter().enumerate() {
@@ -457,7 +463,12 @@ mod tests {
                     let (dm, dd) = (side(m), side(d));
                     let cut = dm.iter().any(|&x| x >= 0.0) && dm.iter().any(|&x| x <= 0.0);
                     let reaches = |k: DVec3| side(k).iter().any(|&x| x > 0.0);
-                    if cut && dd.iter().any(|&x| x >= 0.0) && above.iter().all(|&k| reaches(k)) {
+                    // A corner inside the cone (by its angle from the axis), a corner beyond the half-space.
+                    let in_cone =
+                        cone.is_none_or(|(a, cos, _)| t.iter().any(|&p| (p - origin).normalize().dot(a) > cos));
+                    let is_beyond = beyond.is_none_or(|(k, b)| side(k).iter().any(|&x| x > b));
+                    let counts = in_cone && is_beyond;
+                    if counts && cut && dd.iter().any(|&x| x >= 0.0) && above.iter().all(|&k| reaches(k)) {
                         assert!(visited[i], "{count} triangles: triangle {i} missed");
                     }
                 }
