@@ -20,7 +20,9 @@
 
 use glam::DVec3;
 
-use super::sky_slices::{above, clip_segment, segment_interval, slice_segment, visible_weight, weight_integral};
+use super::sky_slices::{
+    above, clip_segment, row_visible_weight, rows_fraction, segment_interval, slice_segment, weight_integral,
+};
 use super::sun_slices::sun_slice_axis;
 use super::visibility::{Shadowing, Slice};
 
@@ -101,11 +103,12 @@ pub fn disk_visible_fraction_sliced(
     });
     // Only a triangle with a corner before where the rays end can block: `d·(x − C) > 2⁻¹² d·(o − C)` (a ray's
     // points have `d·(x − C) = (1 − t) d·(o − C)`, `t < 1 − 2⁻¹²`); a ceiling in the disk's plane has none.
-    let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - center) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
+    // (Corners relative to `o`: `x − C = x_rel − D`.)
+    let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let mut near = false;
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
     let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, dhat], cone, beyond };
-    if !s.occluders.slice_triangles(&whole_cone, &mut |tri| near |= before(&tri)) {
+    if !s.occluders.slice_triangles(&whole_cone, &mut |tri| near |= before(&tri.map(|x| x - s.origin))) {
         return None;
     }
     if !near {
@@ -131,7 +134,8 @@ pub fn disk_visible_fraction_sliced(
         let surface = above(n, c, p);
         let span = (b0.min(b1).max(surface.0), b0.max(b1).min(surface.1));
         let (n_c, n_p) = (n.dot(c), n.dot(p));
-        let whole = jacobian * weight_integral(n_c, n_p, span.0, span.1);
+        let unscaled = weight_integral(n_c, n_p, span.0, span.1);
+        let whole = jacobian * unscaled;
         if whole <= 0.0 {
             continue;
         }
@@ -140,35 +144,26 @@ pub fn disk_visible_fraction_sliced(
         let b_line = a.0 * e0.0 + a.1 * e0.1;
         let (a, b_line) = if b_line < 0.0 { ((-a.0, -a.1), -b_line) } else { (a, b_line) };
         let b_line = SEGMENT_T_MAX * b_line;
-        blocked.clear();
         let slice = Slice { origin: s.origin, m, d: p, above: [n, dhat], cone, beyond };
-        let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
-            if !before(&tri) {
-                return;
-            }
-            let segment = slice_segment(tri.map(|x| x - s.origin), c, p, m);
-            if let Some(b) = segment.and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval) {
-                blocked.push(b);
-            }
-        });
-        if !sliced {
-            return None;
-        }
+        let row = |tri: [DVec3; 3]| {
+            let segment = before(&tri).then(|| slice_segment(tri, c, p, m)).flatten();
+            segment.and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval)
+        };
+        visible += jacobian * row_visible_weight(s, &slice, (n_c, n_p), (span, unscaled), &mut blocked, row)?;
         total += whole;
-        visible += if blocked.is_empty() { whole } else { jacobian * visible_weight(n_c, n_p, span, &mut blocked) };
     }
-    Some(if visible == total || total <= 0.0 { 1.0 } else { visible / total })
+    Some(rows_fraction(visible, total))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::visibility::{disk_visible_fraction, ShadowedLights};
+    use crate::shading::visibility::{disk_visible_fraction, test_shadowing};
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 
     fn shadowing(occ: &dyn Occlusion, origin: DVec3, k: u32) -> Shadowing<'_> {
-        Shadowing { origin, occluders: occ, samples_per_axis: k, lights: ShadowedLights::ALL, slices: false }
+        test_shadowing(occ, origin, k)
     }
 
     /// A square plate of side `2h` at height `y`, centred at `(x, y, z)`.

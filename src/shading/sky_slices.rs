@@ -200,6 +200,40 @@ pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(
     visible
 }
 
+/// One row of a light's slices: the visible weight over `span` (β) of the half circle in `slice`'s plane, whose
+/// unoccluded weight is `whole`, each triangle that the slice's walk visits blocking the interval `interval`
+/// gives it (corners relative to the rays' origin); `None` where the occluders cannot be sliced. `blocked` is the
+/// rows' shared buffer.
+pub fn row_visible_weight(
+    s: &Shadowing,
+    slice: &Slice,
+    (n_c, n_p): (f64, f64),
+    (span, whole): ((f64, f64), f64),
+    blocked: &mut Vec<(f64, f64)>,
+    interval: impl Fn([DVec3; 3]) -> Option<(f64, f64)>,
+) -> Option<f64> {
+    blocked.clear();
+    let sliced = s.occluders.slice_triangles(slice, &mut |tri| {
+        if let Some(b) = interval(tri.map(|x| x - slice.origin)) {
+            blocked.push(b);
+        }
+    });
+    if !sliced {
+        return None;
+    }
+    Some(if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, blocked) })
+}
+
+/// `Σ visible / Σ total` over a light's rows: exactly 1 where every row was clear (the same sums), and 1 where the
+/// light gives nothing.
+pub fn rows_fraction(visible: f64, total: f64) -> f64 {
+    if visible == total || total <= 0.0 {
+        1.0
+    } else {
+        visible / total
+    }
+}
+
 /// The sky's cosine-weighted visible fraction from `s.origin` on a surface of unit normal `n`, by `rows` slices
 /// (module text), or `None` where the occluders cannot be sliced (a triangle partly cut away by an alpha mask):
 /// then the caller casts rays. Exactly 1 where no row meets an occluder (the same sums), and 1 where the sky
@@ -224,37 +258,23 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
             continue;
         }
         let m = c.cross(p);
-        blocked.clear();
         let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n], cone: None, beyond: None };
-        let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
-            if let Some(b) = blocked_interval(tri.map(|q| q - s.origin), c, p, m) {
-                blocked.push(b);
-            }
-        });
-        if !sliced {
-            return None;
-        }
+        let row = |tri| blocked_interval(tri, c, p, m);
+        visible += row_visible_weight(s, &slice, (n_c, n_p), (span, whole), &mut blocked, row)?;
         total += whole;
-        visible += if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, &mut blocked) };
     }
-    Some(if visible == total || total <= 0.0 { 1.0 } else { visible / total })
+    Some(rows_fraction(visible, total))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::visibility::{sky_visible_fraction, ShadowedLights};
+    use crate::shading::visibility::{sky_visible_fraction, test_shadowing};
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 
     fn shadowing(occ: &dyn Occlusion, k: u32) -> Shadowing<'_> {
-        Shadowing {
-            origin: DVec3::ZERO,
-            occluders: occ,
-            samples_per_axis: k,
-            lights: ShadowedLights::ALL,
-            slices: false,
-        }
+        test_shadowing(occ, DVec3::ZERO, k)
     }
 
     /// The roof `{y = 1, x cos θ + z sin θ < e}` as two triangles reaching `r` metres.

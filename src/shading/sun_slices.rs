@@ -22,7 +22,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::DVec3;
 
-use super::sky_slices::{above, blocked_interval, visible_weight, weight_integral, SLICE_AXIS};
+use super::sky_slices::{above, blocked_interval, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS};
 use super::visibility::{Shadowing, Slice};
 
 /// The slices' axis for the sun in direction `l`: the sky's oblique axis ([`SLICE_AXIS`]) made perpendicular to
@@ -78,42 +78,29 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
         let surface = above(n, c, p);
         let span = ((FRAC_PI_2 - chi).max(surface.0), (FRAC_PI_2 + chi).min(surface.1));
         let (n_c, n_p) = (n.dot(c), n.dot(p));
-        let whole = jacobian * weight_integral(n_c, n_p, span.0, span.1);
+        let unscaled = weight_integral(n_c, n_p, span.0, span.1);
+        let whole = jacobian * unscaled;
         if whole <= 0.0 {
             continue;
         }
         let m = c.cross(p);
-        blocked.clear();
         let slice = Slice { origin: s.origin, m, d: p, above: [n, l], cone, beyond: None };
-        let sliced = s.occluders.slice_triangles(&slice, &mut |tri| {
-            if let Some(b) = blocked_interval(tri.map(|x| x - s.origin), c, p, m) {
-                blocked.push(b);
-            }
-        });
-        if !sliced {
-            return None;
-        }
+        let row = |tri| blocked_interval(tri, c, p, m);
+        visible += jacobian * row_visible_weight(s, &slice, (n_c, n_p), (span, unscaled), &mut blocked, row)?;
         total += whole;
-        visible += if blocked.is_empty() { whole } else { jacobian * visible_weight(n_c, n_p, span, &mut blocked) };
     }
-    Some(if visible == total || total <= 0.0 { 1.0 } else { visible / total })
+    Some(rows_fraction(visible, total))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::visibility::{sun_visible_fraction, ShadowedLights};
+    use crate::shading::visibility::{sun_visible_fraction, test_shadowing};
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 
     fn shadowing(occ: &dyn Occlusion, k: u32) -> Shadowing<'_> {
-        Shadowing {
-            origin: DVec3::ZERO,
-            occluders: occ,
-            samples_per_axis: k,
-            lights: ShadowedLights::ALL,
-            slices: false,
-        }
+        test_shadowing(occ, DVec3::ZERO, k)
     }
 
     /// A wall's edge: the half-plane `{x = 1, y < h}` (two triangles reaching 1e4 m) seen from the origin, the

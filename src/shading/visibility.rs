@@ -682,6 +682,12 @@ pub fn shadow_ray_origin(p: &[DVec3; 3], normals: &[DVec3; 3], b: [f64; 3], x: D
     }
 }
 
+/// Shadow rays from `origin` against `occ` on `k²` grids for every light, by the grids (tests).
+#[cfg(test)]
+pub(crate) fn test_shadowing(occ: &dyn Occlusion, origin: DVec3, k: u32) -> Shadowing<'_> {
+    Shadowing { origin, occluders: occ, samples_per_axis: k, lights: ShadowedLights::ALL, slices: false }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -702,14 +708,8 @@ mod tests {
         }
     }
 
-    fn shadowing<'a>(occ: &'a dyn Occlusion, k: u32) -> Shadowing<'a> {
-        Shadowing {
-            origin: DVec3::ZERO,
-            occluders: occ,
-            samples_per_axis: k,
-            lights: ShadowedLights::ALL,
-            slices: false,
-        }
+    fn shadowing(occ: &dyn Occlusion, k: u32) -> Shadowing<'_> {
+        test_shadowing(occ, DVec3::ZERO, k)
     }
 
     #[test]
