@@ -22,7 +22,7 @@ use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
-use crate::scene::{AlphaMode, Scene};
+use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::{Shadows, SunModel, VisibilityRule};
 
@@ -285,5 +285,5 @@ pub fn sky_by_slices(scene: &Scene, settings: &RenderSettings, scene_can_occlude
         && scene_can_occlude
         && settings.shading.shadows == Shadows::Ray
         && settings.shading.visibility_rule == VisibilityRule::Slices
-        && !scene.materials.iter().any(|m| matches!(m.alpha, AlphaMode::Mask(_)))
+        && !scene.has_alpha_masks()
 }

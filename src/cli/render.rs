@@ -257,9 +257,7 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     }
     let may_be_fragile = {
         let scene = session.scene_ref(job.scene);
-        job.settings.shading.shadows == Shadows::Ray
-            || !scene.textures.is_empty()
-            || scene.materials.iter().any(|m| matches!(m.alpha, crate::scene::AlphaMode::Mask(_)))
+        job.settings.shading.shadows == Shadows::Ray || !scene.textures.is_empty() || scene.has_alpha_masks()
     };
     if may_be_fragile && !report.over_tolerance_pixels.is_empty() && !a.json {
         // Which of the differences lie where the GPU's f32 geometry or texture coordinates may decide the other way.

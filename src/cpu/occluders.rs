@@ -33,8 +33,7 @@ pub struct Occluders<'a> {
 
 impl<'a> Occluders<'a> {
     pub fn new(scene: &'a Scene) -> Self {
-        let any_mask = scene.materials.iter().any(|m| matches!(m.alpha, AlphaMode::Mask(_)));
-        let masked = if !any_mask {
+        let masked = if !scene.has_alpha_masks() {
             Vec::new()
         } else {
             scene

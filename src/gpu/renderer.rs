@@ -387,7 +387,7 @@ impl Renderer {
                 )
             })
             .transpose()?;
-        let masked = scene.materials.iter().any(|m| matches!(m.alpha, crate::scene::AlphaMode::Mask(_)));
+        let masked = scene.has_alpha_masks();
         let accel = match &vertices {
             Some(vb) if rq && !global_indices.is_empty() => Some(SceneAccel::build(
                 &self.dev,

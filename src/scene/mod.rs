@@ -126,6 +126,12 @@ impl Scene {
         self.meshes.iter().map(Mesh::triangle_count).sum()
     }
 
+    /// Whether a material is alpha-masked (`alphaMode: MASK`): its triangles let light and the camera through
+    /// where the mask cuts them away, so occlusion needs their texture, not their geometry alone.
+    pub fn has_alpha_masks(&self) -> bool {
+        self.materials.iter().any(|m| matches!(m.alpha, AlphaMode::Mask(_)))
+    }
+
     /// The box around every vertex that a triangle uses, or `None` for a scene without triangles.
     pub fn bounds(&self) -> Option<Aabb> {
         let mut used = self.meshes.iter().flat_map(|m| m.indices.iter().map(move |&i| m.positions[i as usize]));

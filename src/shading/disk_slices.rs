@@ -11,8 +11,8 @@
 //! first, the line drawn `1 − 2⁻¹²` of the way from `o`, as the grid's rays to the disk end short of it
 //! (`visibility::SEGMENT_T_MAX`), so that a ceiling around a skylight does not block it. The weight is the grid's,
 //! `(n·ω)⁺` per solid angle (`visibility::disk_sample`'s `(n·ω)⁺ (−d·ω)⁺ / |y − x|²` per area), closed-form along
-//! the chord ([`visible_weight`]); the rows run along `ψ = ψ_mid − ψ_half cos u` so that the chords' square-root
-//! ends leave a smooth integrand, midpoints in `u`.
+//! the chord ([`visible_weight`](super::sky_slices::visible_weight)); the rows run along
+//! `ψ = ψ_mid − ψ_half cos u` so that the chords' square-root ends leave a smooth integrand, midpoints in `u`.
 //!
 //! Weights are taken from `o`, the grid's from the shading point (which `o` is pushed off by `2⁻¹⁶` of the
 //! coordinates): the two fractions differ by that much of the weight's variation across the disk, far below what
@@ -21,7 +21,8 @@
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, clip_segment, row_visible_weight, rows_fraction, segment_interval, slice_segment, weight_integral,
+    above, anything_near, clip_segment, cosine_row, row_visible_weight, rows_fraction, segment_interval, slice_segment,
+    weight_integral,
 };
 use super::sun_slices::sun_slice_axis;
 use super::visibility::{Shadowing, Slice};
@@ -105,13 +106,9 @@ pub fn disk_visible_fraction_sliced(
     // points have `d·(x − C) = (1 − t) d·(o − C)`, `t < 1 − 2⁻¹²`); a ceiling in the disk's plane has none.
     // (Corners relative to `o`: `x − C = x_rel − D`.)
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
-    let mut near = false;
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
     let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, dhat], cone, beyond };
-    if !s.occluders.slice_triangles(&whole_cone, &mut |tri| near |= before(&tri.map(|x| x - s.origin))) {
-        return None;
-    }
-    if !near {
+    if !anything_near(s, &whole_cone, |tri| before(&tri))? {
         return Some(1.0);
     }
     let rows = rows.max(1);
@@ -119,8 +116,7 @@ pub fn disk_visible_fraction_sliced(
     let mut total = 0.0;
     let mut blocked = Vec::new();
     for i in 0..rows {
-        let u = std::f64::consts::PI * (i as f64 + 0.5) / rows as f64;
-        let (sin_u, cos_u) = u.sin_cos();
+        let (sin_u, cos_u) = cosine_row(i, rows);
         let psi = mid - half * cos_u;
         let jacobian = half * sin_u;
         let (sin_p, cos_p) = psi.sin_cos();

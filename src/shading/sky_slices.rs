@@ -224,6 +224,22 @@ pub fn row_visible_weight(
     Some(if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, blocked) })
 }
 
+/// Whether any triangle that `slice` keeps (a whole cone, with zero `m` and `d`: a first walk over a small light's
+/// directions) passes `counts` (corners relative to the rays' origin); `None` where the occluders cannot be
+/// sliced. Where none does, every row of the light would be clear and its fraction exactly 1.
+pub fn anything_near(s: &Shadowing, slice: &Slice, counts: impl Fn([DVec3; 3]) -> bool) -> Option<bool> {
+    let mut near = false;
+    let sliced = s.occluders.slice_triangles(slice, &mut |tri| near |= counts(tri.map(|x| x - slice.origin)));
+    sliced.then_some(near)
+}
+
+/// Row `i` of `rows` at the midpoint `u = π (i + ½) / rows` of `[0, π]`: `(sin u, cos u)`. A light's rows run along
+/// `ψ = ψ_mid − ψ_half cos u` (weight `ψ_half sin u`), so that chords whose length falls to zero like a square root
+/// at both ends of `ψ` leave a smooth integrand in `u` (`sun_slices`, `disk_slices`).
+pub fn cosine_row(i: u32, rows: u32) -> (f64, f64) {
+    (std::f64::consts::PI * (i as f64 + 0.5) / rows as f64).sin_cos()
+}
+
 /// `Σ visible / Σ total` over a light's rows: exactly 1 where every row was clear (the same sums), and 1 where the
 /// light gives nothing.
 pub fn rows_fraction(visible: f64, total: f64) -> f64 {

@@ -7,9 +7,9 @@
 //! `β ∈ [π/2 − χ, π/2 + χ]`, `cos χ = cos σ / cos ψ`. Each chord is cut by the surface's horizon ([`above`]) and
 //! by the intervals the occluding triangles in its plane block ([`blocked_interval`]; the sun is infinitely far,
 //! so a triangle anywhere in front blocks), and its visible share of `(n·ω) sin β dβ` is closed-form
-//! ([`visible_weight`]). Along `ψ` the chords' lengths fall to zero at `±σ` like a square root; with
-//! `ψ = −σ cos u` (`dψ = σ sin u du`) the integrand over `u ∈ [0, π]` is smooth where no occluder's outline is,
-//! and midpoints in `u` converge at the second order in the rows, as the sky's do.
+//! ([`visible_weight`](super::sky_slices::visible_weight)). Along `ψ` the chords' lengths fall to zero at `±σ`
+//! like a square root; with `ψ = −σ cos u` (`dψ = σ sin u du`) the integrand over `u ∈ [0, π]` is smooth where no
+//! occluder's outline is, and midpoints in `u` converge at the second order in the rows, as the sky's do.
 //!
 //! Why an axis across the sun rather than through it: slices through `l` would make every occluder edge whose
 //! line passes through the sun's centre (seen from the point) a jump of the rows' integrand, at the middle of
@@ -22,7 +22,9 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::DVec3;
 
-use super::sky_slices::{above, blocked_interval, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS};
+use super::sky_slices::{
+    above, anything_near, blocked_interval, cosine_row, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS,
+};
 use super::visibility::{Shadowing, Slice};
 
 /// The slices' axis for the sun in direction `l`: the sky's oblique axis ([`SLICE_AXIS`]) made perpendicular to
@@ -56,20 +58,15 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let rows = rows.max(1);
     // One walk over the sun's cone first: where no triangle comes near it, every row would be clear (the same 1).
     let cone = Some((l, sigma.cos(), sigma.sin()));
-    let mut near = false;
     let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, l], cone, beyond: None };
-    if !s.occluders.slice_triangles(&whole_cone, &mut |_| near = true) {
-        return None;
-    }
-    if !near {
+    if !anything_near(s, &whole_cone, |_| true)? {
         return Some(1.0);
     }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
     for i in 0..rows {
-        let u = std::f64::consts::PI * (i as f64 + 0.5) / rows as f64;
-        let (sin_u, cos_u) = u.sin_cos();
+        let (sin_u, cos_u) = cosine_row(i, rows);
         let psi = -sigma * cos_u;
         let jacobian = sigma * sin_u;
         let chi = chord_half_width(sigma, psi);
