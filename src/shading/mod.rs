@@ -15,6 +15,7 @@ pub mod radiometry;
 mod shade;
 pub mod sky_lune;
 pub mod sky_slices;
+pub mod slice_buckets;
 pub mod sun_slices;
 pub mod surface;
 pub mod texture_filter;

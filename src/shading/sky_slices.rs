@@ -28,10 +28,11 @@
 //! ends graze an edge and have zero measure. The triangle containing `o` is never met: `o` is pushed off its
 //! surface along the face normal (`visibility::shadow_ray_origin`).
 
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
 
+use super::slice_buckets::{midpoint_rows, RowBuckets};
 use super::visibility::{Shadowing, Slice};
 
 /// The slices' axis: along no direction a scene is likely built on (module text), `(√2 − 1, 1, (√5 − 1)/2)`
@@ -171,7 +172,7 @@ pub fn weight_integral(n_c: f64, n_p: f64, b0: f64, b1: f64) -> f64 {
 /// The weight over `[lo, hi]` (β) less the union of `blocked` (pseudo-angles, sorted here), by the gaps between
 /// them; a gap's end at the span's own end keeps its exact β.
 pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
-    blocked.sort_by(|x, y| x.0.total_cmp(&y.0));
+    blocked.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
     let key = |b: f64| pseudo_angle(b.cos(), b.sin());
     let (key_lo, key_hi) = (key(lo), key(hi));
     let mut visible = 0.0;
@@ -258,12 +259,19 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     let c = DVec3::from_array(SLICE_AXIS);
     let p1 = c.cross(DVec3::Z).normalize();
     let p2 = c.cross(p1);
-    let rows = rows.max(1);
+    let psi: Vec<f64> = midpoint_rows(rows.max(1)).collect();
+    // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
+    // holds (`slice_buckets`); a row then tests only its own.
+    let walk =
+        Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [DVec3::Y, n], cone: None, beyond: None };
+    let mut buckets = RowBuckets::default();
+    if !buckets.fill(s, &walk, (p1, p2), &psi) {
+        return None;
+    }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for i in 0..rows {
-        let psi = TAU * (i as f64 + 0.5) / rows as f64;
+    for (i, &psi) in psi.iter().enumerate() {
         let (sin_p, cos_p) = psi.sin_cos();
         let p = cos_p * p1 + sin_p * p2;
         let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
@@ -274,9 +282,9 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
             continue;
         }
         let m = c.cross(p);
-        let slice = Slice { origin: s.origin, m, d: p, above: [DVec3::Y, n], cone: None, beyond: None };
-        let row = |tri| blocked_interval(tri, c, p, m);
-        visible += row_visible_weight(s, &slice, (n_c, n_p), (span, whole), &mut blocked, row)?;
+        blocked.clear();
+        blocked.extend(buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m)));
+        visible += if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, &mut blocked) };
         total += whole;
     }
     Some(rows_fraction(visible, total))
@@ -348,6 +356,52 @@ mod tests {
                 let sliced = sky_visible_fraction_sliced(&shadowing(&occ, 6), n, 2048).unwrap();
                 assert!((grid - sliced).abs() < 1.5e-5, "edge {edge} θ {theta} n {n}: grid {grid} slices {sliced}");
             }
+        }
+    }
+
+    /// The rows' buckets (`slice_buckets`) leave out no triangle a row's half-plane cuts: the fraction equals,
+    /// to the bit, every row testing every triangle.
+    #[test]
+    fn buckets_give_what_every_row_testing_every_triangle_gives() {
+        let mut seed = 0x9e3779b97f4a7c15u64;
+        let mut r = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let tris: Vec<[DVec3; 3]> = (0..300)
+            .map(|_| {
+                let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
+                [0, 1, 2].map(|_| centre + 0.6 * DVec3::new(r(), r(), r()))
+            })
+            .collect();
+        let occ = Bvh::new(tris.clone());
+        let c = DVec3::from_array(SLICE_AXIS);
+        let p1 = c.cross(DVec3::Z).normalize();
+        let p2 = c.cross(p1);
+        for n in [DVec3::Y, DVec3::new(0.3, 1.0, 0.2).normalize(), DVec3::new(-0.8, 0.3, 0.2).normalize()] {
+            let rows = 96;
+            let (mut visible, mut total) = (0.0, 0.0);
+            for psi in midpoint_rows(rows) {
+                let (sin_p, cos_p) = psi.sin_cos();
+                let p = cos_p * p1 + sin_p * p2;
+                let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
+                let span = (ground.0.max(surface.0), ground.1.min(surface.1));
+                let (n_c, n_p) = (n.dot(c), n.dot(p));
+                let whole = weight_integral(n_c, n_p, span.0, span.1);
+                if whole <= 0.0 {
+                    continue;
+                }
+                let m = c.cross(p);
+                let mut blocked: Vec<_> = tris.iter().filter_map(|&t| blocked_interval(t, c, p, m)).collect();
+                visible += if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, &mut blocked) };
+                total += whole;
+            }
+            let every = rows_fraction(visible, total);
+            let got = sky_visible_fraction_sliced(&shadowing(&occ, 6), n, rows).unwrap();
+            assert!(every > 0.05 && every < 0.95, "{n}: {every}");
+            assert_eq!(got, every, "{n}");
         }
     }
 
