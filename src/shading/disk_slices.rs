@@ -21,9 +21,10 @@
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, anything_near, clip_segment, cosine_row, row_visible_weight, rows_fraction, segment_interval, slice_segment,
+    above, clip_segment, cosine_row, row_visible_weight, rows_fraction, segment_interval, slice_segment,
     weight_integral,
 };
+use super::slice_buckets::{frame_about, RowBuckets};
 use super::sun_slices::sun_slice_axis;
 use super::visibility::{Shadowing, Slice};
 
@@ -107,17 +108,25 @@ pub fn disk_visible_fraction_sliced(
     // (Corners relative to `o`: `x − C = x_rel − D`.)
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
+    let rows = rows.max(1) as usize;
+    let psi: Vec<f64> = (0..rows).map(|i| mid - half * cosine_row(i as u32, rows as u32).1).collect();
+    let directions: Vec<DVec3> = psi.iter().map(|&psi| psi.cos() * dhat + psi.sin() * q).collect();
+    // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
+    // where none has a corner before the rays' ends, every row is clear (the same 1).
     let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, dhat], cone, beyond };
-    if !anything_near(s, &whole_cone, |tri| before(&tri))? {
+    let mut buckets = RowBuckets::default();
+    if !buckets.fill(s, &whole_cone, frame_about(dhat, q), &directions) {
+        return None;
+    }
+    if !buckets.any(before) {
         return Some(1.0);
     }
-    let rows = rows.max(1);
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
     for i in 0..rows {
-        let (sin_u, cos_u) = cosine_row(i, rows);
-        let psi = mid - half * cos_u;
+        let (sin_u, _) = cosine_row(i as u32, rows as u32);
+        let psi = psi[i];
         let jacobian = half * sin_u;
         let (sin_p, cos_p) = psi.sin_cos();
         let p = cos_p * dhat + sin_p * q;
@@ -140,12 +149,11 @@ pub fn disk_visible_fraction_sliced(
         let b_line = a.0 * e0.0 + a.1 * e0.1;
         let (a, b_line) = if b_line < 0.0 { ((-a.0, -a.1), -b_line) } else { (a, b_line) };
         let b_line = SEGMENT_T_MAX * b_line;
-        let slice = Slice { origin: s.origin, m, d: p, above: [n, dhat], cone, beyond };
-        let row = |tri: [DVec3; 3]| {
-            let segment = before(&tri).then(|| slice_segment(tri, c, p, m)).flatten();
+        let row = buckets.row(i).filter_map(|tri| {
+            let segment = before(tri).then(|| slice_segment(*tri, c, p, m)).flatten();
             segment.and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval)
-        };
-        visible += jacobian * row_visible_weight(s, &slice, (n_c, n_p), (span, unscaled), &mut blocked, row)?;
+        });
+        visible += jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), &mut blocked);
         total += whole;
     }
     Some(rows_fraction(visible, total))

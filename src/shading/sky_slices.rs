@@ -201,38 +201,24 @@ pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(
     visible
 }
 
-/// One row of a light's slices: the visible weight over `span` (β) of the half circle in `slice`'s plane, whose
-/// unoccluded weight is `whole`, each triangle that the slice's walk visits blocking the interval `interval`
-/// gives it (corners relative to the rays' origin); `None` where the occluders cannot be sliced. `blocked` is the
-/// rows' shared buffer.
+/// One row of a light's slices: the visible weight over `span` (β) of the half circle in the row's plane, whose
+/// unoccluded weight is `whole`, less the union of the `intervals` its triangles block. `blocked` is the rows'
+/// shared buffer.
 pub fn row_visible_weight(
-    s: &Shadowing,
-    slice: &Slice,
+    intervals: impl Iterator<Item = (f64, f64)>,
     (n_c, n_p): (f64, f64),
     (span, whole): ((f64, f64), f64),
     blocked: &mut Vec<(f64, f64)>,
-    interval: impl Fn([DVec3; 3]) -> Option<(f64, f64)>,
-) -> Option<f64> {
+) -> f64 {
     blocked.clear();
-    let sliced = s.occluders.slice_triangles(slice, &mut |tri| {
-        if let Some(b) = interval(tri.map(|x| x - slice.origin)) {
-            blocked.push(b);
-        }
-    });
-    if !sliced {
-        return None;
+    blocked.extend(intervals);
+    if blocked.is_empty() {
+        whole
+    } else {
+        visible_weight(n_c, n_p, span, blocked)
     }
-    Some(if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, blocked) })
 }
 
-/// Whether any triangle that `slice` keeps (a whole cone, with zero `m` and `d`: a first walk over a small light's
-/// directions) passes `counts` (corners relative to the rays' origin); `None` where the occluders cannot be
-/// sliced. Where none does, every row of the light would be clear and its fraction exactly 1.
-pub fn anything_near(s: &Shadowing, slice: &Slice, counts: impl Fn([DVec3; 3]) -> bool) -> Option<bool> {
-    let mut near = false;
-    let sliced = s.occluders.slice_triangles(slice, &mut |tri| near |= counts(tri.map(|x| x - slice.origin)));
-    sliced.then_some(near)
-}
 
 /// Row `i` of `rows` at the midpoint `u = π (i + ½) / rows` of `[0, π]`: `(sin u, cos u)`. A light's rows run along
 /// `ψ = ψ_mid − ψ_half cos u` (weight `ψ_half sin u`), so that chords whose length falls to zero like a square root
@@ -259,21 +245,23 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     let c = DVec3::from_array(SLICE_AXIS);
     let p1 = c.cross(DVec3::Z).normalize();
     let p2 = c.cross(p1);
-    let psi: Vec<f64> = midpoint_rows(rows.max(1)).collect();
+    let rows: Vec<DVec3> = midpoint_rows(rows.max(1))
+        .map(|psi| {
+            let (sin_p, cos_p) = psi.sin_cos();
+            cos_p * p1 + sin_p * p2
+        })
+        .collect();
     // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
     // holds (`slice_buckets`); a row then tests only its own.
-    let walk =
-        Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [DVec3::Y, n], cone: None, beyond: None };
+    let walk = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [DVec3::Y, n], cone: None, beyond: None };
     let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &walk, (p1, p2), &psi) {
+    if !buckets.fill(s, &walk, (p1, p2), &rows) {
         return None;
     }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for (i, &psi) in psi.iter().enumerate() {
-        let (sin_p, cos_p) = psi.sin_cos();
-        let p = cos_p * p1 + sin_p * p2;
+    for (i, &p) in rows.iter().enumerate() {
         let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
         let span = (ground.0.max(surface.0), ground.1.min(surface.1));
         let (n_c, n_p) = (n.dot(c), n.dot(p));
@@ -282,9 +270,8 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
             continue;
         }
         let m = c.cross(p);
-        blocked.clear();
-        blocked.extend(buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m)));
-        visible += if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, &mut blocked) };
+        let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
+        visible += row_visible_weight(row, (n_c, n_p), (span, whole), &mut blocked);
         total += whole;
     }
     Some(rows_fraction(visible, total))

@@ -98,27 +98,25 @@ pub struct RowBuckets {
 
 impl RowBuckets {
     /// Gathers the triangles of one walk (`walk`: the slices' half-spaces, cone and near side, its `m` and `d`
-    /// zero) and files each under the rows of `psi` (ascending in [0, 2π), the rows' angles \[rad\]) inside its
-    /// arc about `c` (`p1`, `p2` completing the frame). False where the occluders cannot be sliced.
-    pub fn fill(&mut self, s: &Shadowing, walk: &Slice, (p1, p2): (DVec3, DVec3), psi: &[f64]) -> bool {
+    /// zero) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
+    /// the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
+    /// ascending in [0, 2π). False where the occluders cannot be sliced.
+    pub fn fill(&mut self, s: &Shadowing, walk: &Slice, (e1, e2): (DVec3, DVec3), rows: &[DVec3]) -> bool {
         self.triangles.clear();
         let origin = walk.origin;
         let triangles = &mut self.triangles;
         if !s.occluders.slice_triangles(walk, &mut |tri| triangles.push(tri.map(|x| x - origin))) {
             return false;
         }
-        let rows = psi.len();
         self.row_angles.clear();
-        self.row_angles.extend(psi.iter().map(|&p| {
-            let (sin, cos) = p.sin_cos();
-            diamond_angle(cos, sin)
-        }));
+        self.row_angles.extend(rows.iter().map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
+        let rows = rows.len();
         // Each triangle's rows as a range of indices (two where its arc wraps past angle 0), found once.
         let angles = &self.row_angles;
         let from = |x: f64| angles.partition_point(|&r| r < x);
         let to = |x: f64| angles.partition_point(|&r| r <= x);
         self.ranges.clear();
-        self.ranges.extend(self.triangles.iter().map(|tri| match azimuth_arc(tri, p1, p2) {
+        self.ranges.extend(self.triangles.iter().map(|tri| match azimuth_arc(tri, e1, e2) {
             None => [(0, rows), (0, 0)],
             Some((start, length)) => {
                 let lo = start.rem_euclid(4.0);
@@ -155,6 +153,11 @@ impl RowBuckets {
         true
     }
 
+    /// Whether the walk gathered a triangle that `counts`.
+    pub fn any(&self, counts: impl Fn(&[DVec3; 3]) -> bool) -> bool {
+        self.triangles.iter().any(counts)
+    }
+
     /// The triangles row `i` may cut, corners relative to the origin \[m\].
     pub fn row(&self, i: usize) -> impl Iterator<Item = &[DVec3; 3]> {
         let (a, b) = (self.start[i] as usize, self.start[i + 1] as usize);
@@ -165,6 +168,13 @@ impl RowBuckets {
 /// The angles of `rows` midpoint rows over the whole circle \[rad\], ascending in (0, 2π).
 pub fn midpoint_rows(rows: u32) -> impl Iterator<Item = f64> {
     (0..rows).map(move |i| TAU * (i as f64 + 0.5) / rows as f64)
+}
+
+/// The frame across an axis in which rows `p(ψ) = cos ψ h + sin ψ q`, `ψ ∈ (−π/2, π/2)` ascending (the sun's and
+/// disk lights' slices about an axis across the light's direction `h`), have ascending azimuths: `(−q, h)`, in
+/// which `p(ψ)` lies at `π/2 + ψ`.
+pub fn frame_about(h: DVec3, q: DVec3) -> (DVec3, DVec3) {
+    (-q, h)
 }
 
 #[cfg(test)]

@@ -23,8 +23,9 @@ use std::f64::consts::FRAC_PI_2;
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, anything_near, blocked_interval, cosine_row, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS,
+    above, blocked_interval, cosine_row, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS,
 };
+use super::slice_buckets::{frame_about, RowBuckets};
 use super::visibility::{Shadowing, Slice};
 
 /// The slices' axis for the sun in direction `l`: the sky's oblique axis ([`SLICE_AXIS`]) made perpendicular to
@@ -55,19 +56,27 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let sigma = 0.5 * angular_diameter;
     let c = sun_slice_axis(l);
     let q = c.cross(l);
-    let rows = rows.max(1);
-    // One walk over the sun's cone first: where no triangle comes near it, every row would be clear (the same 1).
+    let rows = rows.max(1) as usize;
+    // The rows, ψ = −σ cos u, ascending.
+    let psi: Vec<f64> = (0..rows).map(|i| -sigma * cosine_row(i as u32, rows as u32).1).collect();
+    let directions: Vec<DVec3> = psi.iter().map(|&psi| psi.cos() * l + psi.sin() * q).collect();
+    // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
+    // (`slice_buckets`); where it finds none, every row is clear (the same 1).
     let cone = Some((l, sigma.cos(), sigma.sin()));
     let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, l], cone, beyond: None };
-    if !anything_near(s, &whole_cone, |_| true)? {
+    let mut buckets = RowBuckets::default();
+    if !buckets.fill(s, &whole_cone, frame_about(l, q), &directions) {
+        return None;
+    }
+    if !buckets.any(|_| true) {
         return Some(1.0);
     }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
     for i in 0..rows {
-        let (sin_u, cos_u) = cosine_row(i, rows);
-        let psi = -sigma * cos_u;
+        let (sin_u, _) = cosine_row(i as u32, rows as u32);
+        let psi = psi[i];
         let jacobian = sigma * sin_u;
         let chi = chord_half_width(sigma, psi);
         let (sin_p, cos_p) = psi.sin_cos();
@@ -81,9 +90,8 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
             continue;
         }
         let m = c.cross(p);
-        let slice = Slice { origin: s.origin, m, d: p, above: [n, l], cone, beyond: None };
-        let row = |tri| blocked_interval(tri, c, p, m);
-        visible += jacobian * row_visible_weight(s, &slice, (n_c, n_p), (span, unscaled), &mut blocked, row)?;
+        let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
+        visible += jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), &mut blocked);
         total += whole;
     }
     Some(rows_fraction(visible, total))
