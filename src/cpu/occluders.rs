@@ -10,7 +10,7 @@ use glam::DVec3;
 
 use crate::scene::{AlphaMode, Scene};
 use crate::shading::surface::{masked_hit_blocks, SurfaceSample};
-use crate::shading::visibility::Slice;
+use crate::shading::visibility::SliceReach;
 use crate::shading::Occlusion;
 use crate::visibility::{occluder_bvh, Bvh, WatertightRay};
 
@@ -93,7 +93,7 @@ impl Occlusion for Occluders<'_> {
     }
 
     /// The slices need opaque triangles: with an alpha-masked occluder the reference casts rays instead.
-    fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
-        self.masked.is_empty() && self.bvh.slice_triangles(slice, visit)
+    fn slice_triangles(&self, reach: &SliceReach, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
+        self.masked.is_empty() && self.bvh.slice_triangles(reach, visit)
     }
 }

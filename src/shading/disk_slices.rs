@@ -26,7 +26,7 @@ use super::sky_slices::{
 };
 use super::slice_buckets::{frame_about, RowBuckets};
 use super::sun_slices::sun_slice_axis;
-use super::visibility::{Shadowing, Slice};
+use super::visibility::{Shadowing, SliceReach};
 
 /// The share of the way to the disk where the rays end (`visibility::SEGMENT_T_MAX`).
 const SEGMENT_T_MAX: f64 = 1.0 - 1.0 / 4096.0;
@@ -113,7 +113,7 @@ pub fn disk_visible_fraction_sliced(
     let directions: Vec<DVec3> = psi.iter().map(|&psi| psi.cos() * dhat + psi.sin() * q).collect();
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
     // where none has a corner before the rays' ends, every row is clear (the same 1).
-    let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, dhat], cone, beyond };
+    let whole_cone = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
     let mut buckets = RowBuckets::default();
     if !buckets.fill(s, &whole_cone, frame_about(dhat, q), &directions) {
         return None;

@@ -33,14 +33,15 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::slice_buckets::{midpoint_rows, RowBuckets};
-use super::visibility::{Shadowing, Slice};
+use super::visibility::{Shadowing, SliceReach};
 
 /// The slices' axis: along no direction a scene is likely built on (module text), `(√2 − 1, 1, (√5 − 1)/2)`
 /// normalised.
 pub const SLICE_AXIS: [f64; 3] = [0.33232518133916444, 0.8023039599071088, 0.4958511165312262];
 
-/// Rows of the sliced sky for a shadow-ray grid of `k²`: `4 k²` (each row one plane walk of the occluders' tree,
-/// costing about what a few rays do); refining `k → ⌈k√2⌉` at least doubles them, as it does every grid's count.
+/// Rows of the sliced sky for a shadow-ray grid of `k²`: `4 k²` (each row cutting the triangles its bucket
+/// holds, `slice_buckets`, costing about what a ray does); refining `k → ⌈k√2⌉` at least doubles them, as it does
+/// every grid's count.
 pub fn slice_rows(k: u32) -> u32 {
     4 * k.max(1).saturating_mul(k.max(1))
 }
@@ -219,7 +220,6 @@ pub fn row_visible_weight(
     }
 }
 
-
 /// Row `i` of `rows` at the midpoint `u = π (i + ½) / rows` of `[0, π]`: `(sin u, cos u)`. A light's rows run along
 /// `ψ = ψ_mid − ψ_half cos u` (weight `ψ_half sin u`), so that chords whose length falls to zero like a square root
 /// at both ends of `ψ` leave a smooth integrand in `u` (`sun_slices`, `disk_slices`).
@@ -253,7 +253,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
         .collect();
     // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
     // holds (`slice_buckets`); a row then tests only its own.
-    let walk = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [DVec3::Y, n], cone: None, beyond: None };
+    let walk = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
     let mut buckets = RowBuckets::default();
     if !buckets.fill(s, &walk, (p1, p2), &rows) {
         return None;

@@ -25,7 +25,7 @@ use std::f64::consts::TAU;
 
 use glam::DVec3;
 
-use super::visibility::{Shadowing, Slice};
+use super::visibility::{Shadowing, SliceReach};
 
 /// The widening of each arc on both sides, in diamond-angle units (4 a turn): far above the rounding of a corner's
 /// azimuth (a few ulps of its coordinates relative to its distance from the axis), far below a row's spacing.
@@ -97,11 +97,10 @@ pub struct RowBuckets {
 }
 
 impl RowBuckets {
-    /// Gathers the triangles of one walk (`walk`: the slices' half-spaces, cone and near side, its `m` and `d`
-    /// zero) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
+    /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
     /// the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
     /// ascending in [0, 2π). False where the occluders cannot be sliced.
-    pub fn fill(&mut self, s: &Shadowing, walk: &Slice, (e1, e2): (DVec3, DVec3), rows: &[DVec3]) -> bool {
+    pub fn fill(&mut self, s: &Shadowing, walk: &SliceReach, (e1, e2): (DVec3, DVec3), rows: &[DVec3]) -> bool {
         self.triangles.clear();
         let origin = walk.origin;
         let triangles = &mut self.triangles;

@@ -26,7 +26,7 @@ use super::sky_slices::{
     above, blocked_interval, cosine_row, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS,
 };
 use super::slice_buckets::{frame_about, RowBuckets};
-use super::visibility::{Shadowing, Slice};
+use super::visibility::{Shadowing, SliceReach};
 
 /// The slices' axis for the sun in direction `l`: the sky's oblique axis ([`SLICE_AXIS`]) made perpendicular to
 /// `l` (or `x̂`'s, where `l` is nearly that axis).
@@ -63,7 +63,7 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
     // (`slice_buckets`); where it finds none, every row is clear (the same 1).
     let cone = Some((l, sigma.cos(), sigma.sin()));
-    let whole_cone = Slice { origin: s.origin, m: DVec3::ZERO, d: DVec3::ZERO, above: [n, l], cone, beyond: None };
+    let whole_cone = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
     let mut buckets = RowBuckets::default();
     if !buckets.fill(s, &whole_cone, frame_about(l, q), &directions) {
         return None;

@@ -154,24 +154,22 @@ pub trait Occlusion: Sync {
     /// Whether any occluder meets `origin + t direction` for `0 < t < t_max` (`direction` need not be unit).
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool;
 
-    /// Calls `visit` with (at least) every occluding triangle (corners \[m\]) that meets the slice ([`Slice`]: its
-    /// half-plane, within its half-spaces and cone) and returns true; false, visiting nothing, where the
-    /// occluders are not all opaque triangles (then the caller casts rays).
-    fn slice_triangles(&self, slice: &Slice, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
-        let _ = (slice, visit);
+    /// Calls `visit` with (at least) every occluding triangle (corners \[m\]) that a point's slices of a light can
+    /// meet ([`SliceReach`]: within its half-spaces, cone and near side) and returns true; false, visiting nothing,
+    /// where the occluders are not all opaque triangles (then the caller casts rays).
+    fn slice_triangles(&self, reach: &SliceReach, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
+        let _ = (reach, visit);
         false
     }
 }
 
-/// One slice of a light (`sky_slices`, `sun_slices`, `disk_slices`): the half-plane through `origin` \[m\] of
-/// unit normal `m` on the side `d·(x − origin) ≥ 0`, and the half-spaces `k·(x − origin) > 0` (`above`: the
-/// sky's and the surface's sides, or the light's) outside which nothing can block a direction that counts. A
-/// zero `m` and `d` make it the whole of what the half-spaces and the cone keep (a first walk over a light's cone).
+/// What the slices of a light (`sky_slices`, `sun_slices`, `disk_slices`) from the rays' origin `origin` \[m\] can
+/// meet: the half-spaces `k·(x − origin) > 0` (`above`: the sky's and the surface's sides, or the light's), the
+/// light's cone and its near side, outside which nothing can block a direction that counts. One walk a point
+/// gathers what lies within (`slice_buckets`), which each row then cuts.
 #[derive(Clone, Copy, Debug)]
-pub struct Slice {
+pub struct SliceReach {
     pub origin: DVec3,
-    pub m: DVec3,
-    pub d: DVec3,
     pub above: [DVec3; 2],
     /// A cone of directions from `origin` outside which nothing counts (the sun's disk, a disk light's bounding
     /// sphere), if any: its unit axis and the cosine and sine of its half-angle.
@@ -189,7 +187,7 @@ impl Occlusion for Unoccluded {
         false
     }
 
-    fn slice_triangles(&self, _: &Slice, _: &mut dyn FnMut([DVec3; 3])) -> bool {
+    fn slice_triangles(&self, _: &SliceReach, _: &mut dyn FnMut([DVec3; 3])) -> bool {
         true
     }
 }
