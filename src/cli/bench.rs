@@ -101,6 +101,12 @@ pub struct BenchArgs {
     /// With --pareto: refinements of the converged reference at most.
     #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=12))]
     pub max_refinements: u32,
+    /// With --pareto: how the converged reference takes the lights' visible fractions through occluders: `grid`
+    /// (the located grids of shadow rays; quick, but in penumbrae it leaves pixels unconverged, and they are left
+    /// out of the error) or `slices` (`reference --visibility slices`: converges there, at a cost; docs/accuracy.md,
+    /// "The converged reference").
+    #[arg(long = "visibility", value_name = "grid|slices", default_value = "grid", requires = "pareto")]
+    pub visibility_rule: crate::shading::VisibilityRule,
     /// Print the tables as JSON (rows by column title) instead of Markdown; --update still writes Markdown.
     #[arg(long)]
     pub json: bool,

@@ -64,7 +64,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let mut out = format!(
         "Measured by `sunshade bench --pareto` on {}: {}; Vulkan device {}{}; {} build; {width}×{height} pixels; \
          GPU frame: median of {} warm runs, spread = slowest − fastest. Error against the converged reference \
-         (claimed accuracy {:.0e}, at most {} doublings): per pixel |L − L_conv| / max(|L|, |L_conv|, 1% of the \
+         (claimed accuracy {:.0e}, at most {} doublings, visible fractions by {}): per pixel |L − L_conv| / max(|L|, |L_conv|, 1% of the \
          peak), largest over RGB; the pixels where the reference itself did not converge are left out (counted per \
          scene). Predicted: the bound `-v` prints for the setting (`accuracy::predicted`); † where part of the image \
          has no bound (disk lights, the sky, penumbrae, shadow maps, f32 or device interpolation), the number \
@@ -77,6 +77,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         a.repeat,
         a.accuracy,
         a.max_refinements,
+        a.visibility_rule.name(),
     );
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     bar.set_style(
@@ -96,6 +97,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let t = Instant::now();
         let mut truth_settings = s.clone();
         truth_settings.shading.shadows = if can_occlude { Shadows::Ray } else { Shadows::None };
+        truth_settings.shading.visibility_rule = a.visibility_rule;
         let truth = render_converged(&scene, &truth_settings, &reference, &convergence);
         let truth_time = t.elapsed();
         let excluded = truth.unconverged_mask();
@@ -113,6 +115,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
                 settings::resolve(&scene, size.0, size.1, &CameraOptions::default(), &SunOptions::default())
                     .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
             small.shading.shadows = truth_settings.shading.shadows;
+            small.shading.visibility_rule = a.visibility_rule;
             let truth = render_converged(&scene, &small, &reference, &convergence);
             Some((small, truth, t.elapsed().as_secs_f64()))
         } else {

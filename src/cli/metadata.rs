@@ -10,7 +10,7 @@ use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::{DiskModel, ShadowMapFilter, SunModel, VisibilityRule};
+use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
 
 /// The metadata of a render by `renderer` ("gpu: llvmpipe ...; interpolation f64" or "cpu reference"), with its
 /// predicted error.
@@ -57,7 +57,7 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
         "shadows": sh.shadows.name(),
         "shadow_samples": sh.shadow_samples_per_axis * sh.shadow_samples_per_axis,
         // The lights' visible fractions through occluders: the ray grids, or the reference's slices.
-        "visibility_rule": match sh.visibility_rule { VisibilityRule::Grid => "grid", VisibilityRule::Slices => "slices" },
+        "visibility_rule": sh.visibility_rule.name(),
         "shadow_map_size": sh.shadow_map_size,
         "shadow_map_filter": match sh.shadow_map_filter { ShadowMapFilter::Pcss => "pcss", ShadowMapFilter::Nearest => "nearest" },
         "quantity": sh.quantity.name(),

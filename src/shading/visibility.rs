@@ -69,6 +69,16 @@ pub enum VisibilityRule {
     Slices,
 }
 
+impl VisibilityRule {
+    /// Its name on the command line and in images' metadata.
+    pub fn name(self) -> &'static str {
+        match self {
+            VisibilityRule::Grid => "grid",
+            VisibilityRule::Slices => "slices",
+        }
+    }
+}
+
 impl std::str::FromStr for VisibilityRule {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
