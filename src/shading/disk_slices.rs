@@ -97,8 +97,7 @@ pub fn disk_visible_fraction_sliced(
     let q = c.cross(dhat);
     let (psi0, psi1) = psi_range(dist, radius, q.dot(d), dhat.dot(d))?;
     let (mid, half) = (0.5 * (psi0 + psi1), 0.5 * (psi1 - psi0));
-    // The cone about D̂ that holds the disk's bounding sphere, where the origin is outside it; one walk over it
-    // first: where no triangle comes near it, every row would be clear (the same 1).
+    // The cone about D̂ that holds the disk's bounding sphere, where the origin is outside it.
     let cone = (dist > radius).then(|| {
         let sin = radius / dist;
         (dhat, (1.0 - sin * sin).sqrt(), sin)
@@ -109,27 +108,30 @@ pub fn disk_visible_fraction_sliced(
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
     let rows = rows.max(1) as usize;
-    let psi: Vec<f64> = (0..rows).map(|i| mid - half * cosine_row(i as u32, rows as u32).1).collect();
-    let directions: Vec<DVec3> = psi.iter().map(|&psi| psi.cos() * dhat + psi.sin() * q).collect();
+    // The rows, ψ = mid − half cos u ascending: (sin u, sin ψ, cos ψ), and their directions.
+    let row_angles: Vec<(f64, f64, f64)> = (0..rows)
+        .map(|i| {
+            let (sin_u, cos_u) = cosine_row(i as u32, rows as u32);
+            let (sin_p, cos_p) = (mid - half * cos_u).sin_cos();
+            (sin_u, sin_p, cos_p)
+        })
+        .collect();
+    let directions: Vec<DVec3> = row_angles.iter().map(|&(_, sin_p, cos_p)| cos_p * dhat + sin_p * q).collect();
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
     // where none has a corner before the rays' ends, every row is clear (the same 1).
     let whole_cone = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
     let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &whole_cone, frame_about(dhat, q), &directions) {
+    if !buckets.fill(s, &whole_cone, frame_about(dhat, q), &directions, before) {
         return None;
     }
-    if !buckets.any(before) {
+    if buckets.is_empty() {
         return Some(1.0);
     }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for i in 0..rows {
-        let (sin_u, _) = cosine_row(i as u32, rows as u32);
-        let psi = psi[i];
+    for (i, (&(sin_u, sin_p, cos_p), &p)) in row_angles.iter().zip(&directions).enumerate() {
         let jacobian = half * sin_u;
-        let (sin_p, cos_p) = psi.sin_cos();
-        let p = cos_p * dhat + sin_p * q;
         let m = cos_p * q - sin_p * dhat;
         let Some([y0, y1]) = chord(d_vec, d, radius, m) else { continue };
         let in_plane = |y: DVec3| (y.dot(c), y.dot(p));
@@ -149,9 +151,8 @@ pub fn disk_visible_fraction_sliced(
         let b_line = a.0 * e0.0 + a.1 * e0.1;
         let (a, b_line) = if b_line < 0.0 { ((-a.0, -a.1), -b_line) } else { (a, b_line) };
         let b_line = SEGMENT_T_MAX * b_line;
-        let row = buckets.row(i).filter_map(|tri| {
-            let segment = before(tri).then(|| slice_segment(*tri, c, p, m)).flatten();
-            segment.and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval)
+        let row = buckets.row(i).filter_map(|&tri| {
+            slice_segment(tri, c, p, m).and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval)
         });
         visible += jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), &mut blocked);
         total += whole;

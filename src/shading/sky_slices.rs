@@ -255,7 +255,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     // holds (`slice_buckets`); a row then tests only its own.
     let walk = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
     let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &walk, (p1, p2), &rows) {
+    if !buckets.fill(s, &walk, (p1, p2), &rows, |_| true) {
         return None;
     }
     let mut visible = 0.0;

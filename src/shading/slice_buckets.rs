@@ -97,14 +97,28 @@ pub struct RowBuckets {
 }
 
 impl RowBuckets {
-    /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
+    /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) that `keep`
+    /// keeps (a light's own test of a whole triangle, once rather than once a row) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
     /// the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
     /// ascending in [0, 2π). False where the occluders cannot be sliced.
-    pub fn fill(&mut self, s: &Shadowing, walk: &SliceReach, (e1, e2): (DVec3, DVec3), rows: &[DVec3]) -> bool {
+    pub fn fill(
+        &mut self,
+        s: &Shadowing,
+        walk: &SliceReach,
+        (e1, e2): (DVec3, DVec3),
+        rows: &[DVec3],
+        keep: impl Fn(&[DVec3; 3]) -> bool,
+    ) -> bool {
         self.triangles.clear();
         let origin = walk.origin;
         let triangles = &mut self.triangles;
-        if !s.occluders.slice_triangles(walk, &mut |tri| triangles.push(tri.map(|x| x - origin))) {
+        let gather = &mut |tri: [DVec3; 3]| {
+            let tri = tri.map(|x| x - origin);
+            if keep(&tri) {
+                triangles.push(tri);
+            }
+        };
+        if !s.occluders.slice_triangles(walk, gather) {
             return false;
         }
         self.row_angles.clear();
@@ -152,9 +166,9 @@ impl RowBuckets {
         true
     }
 
-    /// Whether the walk gathered a triangle that `counts`.
-    pub fn any(&self, counts: impl Fn(&[DVec3; 3]) -> bool) -> bool {
-        self.triangles.iter().any(counts)
+    /// Whether the walk kept no triangle (then every row is clear).
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
     }
 
     /// The triangles row `i` may cut, corners relative to the origin \[m\].

@@ -57,30 +57,37 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let c = sun_slice_axis(l);
     let q = c.cross(l);
     let rows = rows.max(1) as usize;
-    // The rows, ψ = −σ cos u, ascending.
-    let psi: Vec<f64> = (0..rows).map(|i| -sigma * cosine_row(i as u32, rows as u32).1).collect();
-    let directions: Vec<DVec3> = psi.iter().map(|&psi| psi.cos() * l + psi.sin() * q).collect();
+    // The rows, ψ = −σ cos u ascending: (sin u, ψ), and their directions.
+    let row_angles: Vec<(f64, f64)> = (0..rows)
+        .map(|i| {
+            let (sin_u, cos_u) = cosine_row(i as u32, rows as u32);
+            (sin_u, -sigma * cos_u)
+        })
+        .collect();
+    let directions: Vec<DVec3> = row_angles
+        .iter()
+        .map(|&(_, psi)| {
+            let (sin_p, cos_p) = psi.sin_cos();
+            cos_p * l + sin_p * q
+        })
+        .collect();
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
     // (`slice_buckets`); where it finds none, every row is clear (the same 1).
     let cone = Some((l, sigma.cos(), sigma.sin()));
     let whole_cone = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
     let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &whole_cone, frame_about(l, q), &directions) {
+    if !buckets.fill(s, &whole_cone, frame_about(l, q), &directions, |_| true) {
         return None;
     }
-    if !buckets.any(|_| true) {
+    if buckets.is_empty() {
         return Some(1.0);
     }
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for i in 0..rows {
-        let (sin_u, _) = cosine_row(i as u32, rows as u32);
-        let psi = psi[i];
+    for (i, (&(sin_u, psi), &p)) in row_angles.iter().zip(&directions).enumerate() {
         let jacobian = sigma * sin_u;
         let chi = chord_half_width(sigma, psi);
-        let (sin_p, cos_p) = psi.sin_cos();
-        let p = cos_p * l + sin_p * q;
         let surface = above(n, c, p);
         let span = ((FRAC_PI_2 - chi).max(surface.0), (FRAC_PI_2 + chi).min(surface.1));
         let (n_c, n_p) = (n.dot(c), n.dot(p));
