@@ -712,6 +712,42 @@ fn bench_pareto_keeps_the_tolerance_of_a_scene_that_shadows_itself() {
     }
 }
 
+/// `bench --pareto --visibility slices`: the truth takes the lights' visible fractions by slices and converges in
+/// the sun's penumbrae, where the grid's truth leaves pixels out of every error.
+#[test]
+fn bench_pareto_by_slices_leaves_no_penumbra_out() {
+    let left_out = |rule: &str| {
+        let o = sunshade(&[
+            "bench",
+            "--pareto",
+            "models/sunset.glb",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--repeat",
+            "1",
+            "--max-refinements",
+            "4",
+            "--json",
+            "--visibility",
+            rule,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let caption = json["tables"][0]["caption"].as_str().unwrap().to_owned();
+        assert!(caption.contains(&format!("visible fractions by {rule}")), "{caption}");
+        let count = caption.split(" of ").next().unwrap().rsplit(' ').next().unwrap().parse::<u32>();
+        count.unwrap_or_else(|e| panic!("{caption}: {e}"))
+    };
+    let (grid, slices) = (left_out("grid"), left_out("slices"));
+    assert!(grid > 0, "the grid's truth converged everywhere: the test no longer compares anything");
+    assert_eq!(slices, 0);
+    // The rule needs --pareto.
+    let o = sunshade(&["bench", "--visibility", "slices"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
 #[test]
 fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
     let dir = TempDir::new("tolerance-cli");

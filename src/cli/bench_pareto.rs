@@ -160,9 +160,10 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let front = pareto_front(&rows.iter().map(|r| (r.frame_ms, r.error.max_rel)).collect::<Vec<_>>());
         let front_p99 = pareto_front(&rows.iter().map(|r| (r.frame_ms, r.error.p99)).collect::<Vec<_>>());
         out += &format!(
-            "**{name}** ({} triangles; truth: {}; {} of {} covered pixels left out as unconverged; the reference \
-             took {:.1} s):\n\n",
+            "**{name}** ({} triangles; truth, visible fractions by {}: {}; {} of {} covered pixels left out as \
+             unconverged; the reference took {:.1} s):\n\n",
             scene.triangle_count(),
+            truth_settings.shading.visibility_rule.name(),
             truth.summary_counts(),
             truth.unconverged.len(),
             truth.covered,
