@@ -137,6 +137,15 @@ pub(super) fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
+/// The documentation region `bench --pareto --update` writes: `pareto` for the grid's truth, `pareto-slices` for
+/// the slices' (a separate table: the two truths leave different pixels out).
+pub fn pareto_region(rule: crate::shading::VisibilityRule) -> &'static str {
+    match rule {
+        crate::shading::VisibilityRule::Grid => "pareto",
+        crate::shading::VisibilityRule::Slices => "pareto-slices",
+    }
+}
+
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let region = if a.brdf_chart {
         "brdf-chart"
@@ -145,7 +154,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     } else if a.textures {
         "textures"
     } else if a.pareto {
-        "pareto"
+        pareto_region(a.visibility_rule)
     } else if a.measured {
         "measured-fit"
     } else {

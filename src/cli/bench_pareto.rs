@@ -223,7 +223,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     print_output(&out, a.json);
     for doc in &a.update {
-        update_region(doc, "pareto", &out)?;
+        update_region(doc, super::bench::pareto_region(a.visibility_rule), &out)?;
         eprintln!("sunshade bench: updated {}", doc.display());
     }
     Ok(())

@@ -21,8 +21,8 @@
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, clip_segment, cosine_row, row_visible_weight, rows_fraction, segment_interval, slice_segment,
-    weight_integral,
+    above, clip_segment, cosine_rows, row_visible_weight, rows_fraction, segment_interval, slice_segment,
+    weight_integral, CosineRow,
 };
 use super::slice_buckets::{frame_about, RowBuckets};
 use super::sun_slices::sun_slice_axis;
@@ -107,16 +107,9 @@ pub fn disk_visible_fraction_sliced(
     // (Corners relative to `o`: `x − C = x_rel − D`.)
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
-    let rows = rows.max(1) as usize;
-    // The rows, ψ = mid − half cos u ascending: (sin u, sin ψ, cos ψ), and their directions.
-    let row_angles: Vec<(f64, f64, f64)> = (0..rows)
-        .map(|i| {
-            let (sin_u, cos_u) = cosine_row(i as u32, rows as u32);
-            let (sin_p, cos_p) = (mid - half * cos_u).sin_cos();
-            (sin_u, sin_p, cos_p)
-        })
-        .collect();
-    let directions: Vec<DVec3> = row_angles.iter().map(|&(_, sin_p, cos_p)| cos_p * dhat + sin_p * q).collect();
+    // The rows, ψ = mid − half cos u ascending.
+    let rows = cosine_rows(dhat, q, (mid, half), rows.max(1));
+    let directions: Vec<DVec3> = rows.iter().map(|r| r.p).collect();
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
     // where none has a corner before the rays' ends, every row is clear (the same 1).
     let whole_cone = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
@@ -130,7 +123,7 @@ pub fn disk_visible_fraction_sliced(
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for (i, (&(sin_u, sin_p, cos_p), &p)) in row_angles.iter().zip(&directions).enumerate() {
+    for (i, &CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. }) in rows.iter().enumerate() {
         let jacobian = half * sin_u;
         let m = cos_p * q - sin_p * dhat;
         let Some([y0, y1]) = chord(d_vec, d, radius, m) else { continue };

@@ -227,6 +227,30 @@ pub fn cosine_row(i: u32, rows: u32) -> (f64, f64) {
     (std::f64::consts::PI * (i as f64 + 0.5) / rows as f64).sin_cos()
 }
 
+/// One of a light's rows across it ([`cosine_rows`]): `sin u` (its weight's factor), `ψ`, `sin ψ`, `cos ψ` and its
+/// direction `p = cos ψ h + sin ψ q`.
+#[derive(Clone, Copy, Debug)]
+pub struct CosineRow {
+    pub sin_u: f64,
+    pub psi: f64,
+    pub sin_psi: f64,
+    pub cos_psi: f64,
+    pub p: DVec3,
+}
+
+/// The `rows` rows [`cosine_row`] spaces along `ψ = ψ_mid − ψ_half cos u` across a light in direction `h`, `q`
+/// across it, ascending in ψ.
+pub fn cosine_rows(h: DVec3, q: DVec3, (psi_mid, psi_half): (f64, f64), rows: u32) -> Vec<CosineRow> {
+    (0..rows)
+        .map(|i| {
+            let (sin_u, cos_u) = cosine_row(i, rows);
+            let psi = psi_mid - psi_half * cos_u;
+            let (sin_psi, cos_psi) = psi.sin_cos();
+            CosineRow { sin_u, psi, sin_psi, cos_psi, p: cos_psi * h + sin_psi * q }
+        })
+        .collect()
+}
+
 /// `Σ visible / Σ total` over a light's rows: exactly 1 where every row was clear (the same sums), and 1 where the
 /// light gives nothing.
 pub fn rows_fraction(visible: f64, total: f64) -> f64 {

@@ -1,15 +1,16 @@
 //! Which rows of a point's slices may cut each occluding triangle, from one walk of the occluders a point instead
 //! of one a row.
 //!
-//! A light's slices (`sky_slices`) are half-planes `{o + s c + t p(ψ) : t ≥ 0}` about one axis `c` through the
-//! rays' origin `o`, `p(ψ) = cos ψ p₁ + sin ψ p₂`. A triangle is cut by the half-plane of row ψ only if ψ lies in
-//! the triangle's **azimuth range** about the axis: projected along `c` onto the plane of `p₁, p₂`, the triangle
-//! is a triangle in 2D whose directions from the origin form an arc. That arc is the shortest one holding its
-//! three corners' azimuths when it is shorter than a half-turn; a longer one means that the projection surrounds
-//! (or touches) the origin, so that every half-plane may cut the triangle. So one walk of the occluders' tree
-//! (culled by the slices' half-spaces, not by any plane) gathers the triangles, and each goes to the rows inside
-//! its arc ([`RowBuckets::fill`]); a row then cuts only its own triangles, which the exact per-row test
-//! (`sky_slices::blocked_interval`) still decides.
+//! A light's slices (`sky_slices`, `sun_slices`, `disk_slices`) are half-planes `{o + s c + t p : t ≥ 0}` about
+//! one axis `c` through the rays' origin `o`, the rows' directions `p` turning about it (the sky's over the whole
+//! turn, the sun's and a disk light's across the light). A triangle is cut by a row's half-plane only if the row's
+//! azimuth lies in the triangle's **azimuth range** about the axis: projected along `c` onto the plane across it,
+//! the triangle is a triangle in 2D whose directions from the origin form an arc. That arc is the shortest one
+//! holding its three corners' azimuths when it is shorter than a half-turn; a longer one means that the projection
+//! surrounds (or touches) the origin, so that every half-plane may cut the triangle. So one walk of the occluders'
+//! tree (culled by the slices' half-spaces, cone and near side, not by any plane) gathers the triangles, and each
+//! goes to the rows inside its arc ([`RowBuckets::fill`]); a row then cuts only its own triangles, which the exact
+//! per-row test (`sky_slices::blocked_interval`, `disk_slices`' clipped one) still decides.
 //!
 //! The walk per row cost 42% of a sliced reference (overcast.glb at 128², 324 rows a pixel, `perf`), and grows
 //! with the rows, where this one walk does not.
@@ -80,7 +81,7 @@ pub fn azimuth_arc(tri: &[DVec3; 3], p1: DVec3, p2: DVec3) -> Option<(f64, f64)>
     Some((start - ARC_MARGIN, length + 2.0 * ARC_MARGIN))
 }
 
-/// The triangles each row may cut: a counting sort of (row, triangle) pairs, reused from point to point.
+/// The triangles each row may cut: a counting sort of (row, triangle) pairs, filled once a point.
 #[derive(Default)]
 pub struct RowBuckets {
     /// The gathered triangles, corners relative to the origin \[m\].
@@ -88,7 +89,7 @@ pub struct RowBuckets {
     /// Row `i`'s triangles are `members[start[i]..start[i + 1]]`.
     start: Vec<u32>,
     members: Vec<u32>,
-    /// The rows' diamond angles, ascending (the rows' ψ ascending in [0, 2π)).
+    /// The rows' diamond angles, ascending (their azimuths ascend in [0, 2π)).
     row_angles: Vec<f64>,
     /// Each triangle's rows: two ranges of indices (the second empty unless its arc wraps past angle 0).
     ranges: Vec<[(usize, usize); 2]>,
@@ -98,9 +99,10 @@ pub struct RowBuckets {
 
 impl RowBuckets {
     /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) that `keep`
-    /// keeps (a light's own test of a whole triangle, once rather than once a row) and files each under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair across
-    /// the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
-    /// ascending in [0, 2π). False where the occluders cannot be sliced.
+    /// keeps (a light's own test of a whole triangle, once rather than once a row) and files each under the rows
+    /// inside its arc about the axis, `(e1, e2)` an orthonormal pair across the axis and `rows` the rows' unit
+    /// directions `p` across it, their azimuths from `e1` towards `e2` ascending in [0, 2π). False where the
+    /// occluders cannot be sliced.
     pub fn fill(
         &mut self,
         s: &Shadowing,

@@ -23,7 +23,7 @@ use std::f64::consts::FRAC_PI_2;
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, blocked_interval, cosine_row, row_visible_weight, rows_fraction, weight_integral, SLICE_AXIS,
+    above, blocked_interval, cosine_rows, row_visible_weight, rows_fraction, weight_integral, CosineRow, SLICE_AXIS,
 };
 use super::slice_buckets::{frame_about, RowBuckets};
 use super::visibility::{Shadowing, SliceReach};
@@ -56,21 +56,9 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let sigma = 0.5 * angular_diameter;
     let c = sun_slice_axis(l);
     let q = c.cross(l);
-    let rows = rows.max(1) as usize;
-    // The rows, ψ = −σ cos u ascending: (sin u, ψ), and their directions.
-    let row_angles: Vec<(f64, f64)> = (0..rows)
-        .map(|i| {
-            let (sin_u, cos_u) = cosine_row(i as u32, rows as u32);
-            (sin_u, -sigma * cos_u)
-        })
-        .collect();
-    let directions: Vec<DVec3> = row_angles
-        .iter()
-        .map(|&(_, psi)| {
-            let (sin_p, cos_p) = psi.sin_cos();
-            cos_p * l + sin_p * q
-        })
-        .collect();
+    // The rows, ψ = −σ cos u ascending.
+    let rows = cosine_rows(l, q, (0.0, sigma), rows.max(1));
+    let directions: Vec<DVec3> = rows.iter().map(|r| r.p).collect();
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
     // (`slice_buckets`); where it finds none, every row is clear (the same 1).
     let cone = Some((l, sigma.cos(), sigma.sin()));
@@ -85,7 +73,7 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let mut visible = 0.0;
     let mut total = 0.0;
     let mut blocked = Vec::new();
-    for (i, (&(sin_u, psi), &p)) in row_angles.iter().zip(&directions).enumerate() {
+    for (i, &CosineRow { sin_u, psi, p, .. }) in rows.iter().enumerate() {
         let jacobian = sigma * sin_u;
         let chi = chord_half_width(sigma, psi);
         let surface = above(n, c, p);
