@@ -68,7 +68,8 @@ impl Setting {
         }
         if r.shadows {
             parts.push(match (s.shadows, s.shadow_map_filter) {
-                (Shadows::Ray, _) => format!("shadows ray {}²", s.shadow_samples_per_axis),
+                (Shadows::Ray, _) if r.ray_queries => format!("shadows ray {}²", s.shadow_samples_per_axis),
+                (Shadows::Ray, _) => format!("shadows ray {}² (BVH walk)", s.shadow_samples_per_axis),
                 (Shadows::Map, ShadowMapFilter::Pcss) => format!("shadows map {} pcss", s.shadow_map_size),
                 (Shadows::Map, ShadowMapFilter::Nearest) => format!("shadows map {} nearest", s.shadow_map_size),
                 (other, _) => format!("shadows {}", other.name()),
@@ -128,6 +129,12 @@ pub fn sweep(r: &Relevance, default_mode: Interpolation, modes: &[Interpolation]
             for n in [1, 2, 4, 16] {
                 v.push(at(ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: n, ..base }));
             }
+        } else if r.sky {
+            // Without ray queries the maps leave the sky unoccluded (every setting above errs by its whole light
+            // where an occluder hides it); the fragment shader's walk of the occluders' BVH is the one technique
+            // that shadows it on such a device, seconds a frame at 256²: one row, the default rays, so that the
+            // table shows what shadowing the sky costs and buys here.
+            v.push(at(ShadingOptions { shadows: Shadows::Ray, ..base }));
         }
     }
     // The ladder: every count raised together, with the exact models at the default interpolation and with the
@@ -171,6 +178,22 @@ mod tests {
         {
             assert!(labels.iter().any(|l| l.contains(knob)), "{knob} missing from {labels:?}");
         }
+    }
+
+    #[test]
+    fn without_ray_queries_a_sky_through_occluders_gets_the_walk() {
+        // Shadow maps leave the sky unoccluded: the one setting that shadows it is the BVH walk's rays.
+        let sky = Relevance { sun: false, disks: false, sky: true, lobes: false, shadows: true, ray_queries: false };
+        let labels: Vec<String> =
+            sweep(&sky, Interpolation::BarycentricF64, &MODES).iter().map(|s| s.label(&sky)).collect();
+        assert_eq!(labels.iter().filter(|l| l.contains("shadows ray")).count(), 1, "{labels:?}");
+        assert!(labels.contains(&"shadows ray 6² (BVH walk), f64".to_string()), "{labels:?}");
+        assert!(labels[0].contains("shadows map"), "the default stays auto's maps: {labels:?}");
+        // Under the sun alone the maps shadow every light: no walk.
+        let sun = Relevance { sky: false, sun: true, ..sky };
+        let labels: Vec<String> =
+            sweep(&sun, Interpolation::BarycentricF64, &MODES).iter().map(|s| s.label(&sun)).collect();
+        assert!(labels.iter().all(|l| !l.contains("shadows ray")), "{labels:?}");
     }
 
     #[test]
