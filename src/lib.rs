@@ -21,6 +21,8 @@ pub mod plot;
 pub mod scene;
 pub mod settings;
 pub mod shading;
+#[cfg(test)]
+mod test_rng;
 pub mod testing;
 pub mod visibility;
 

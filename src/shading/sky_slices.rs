@@ -261,6 +261,24 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
     }
 }
 
+/// The sky's row of direction `p` about the axis `c` for a surface of unit normal `n` ([`sky_row`]).
+struct SkyRow {
+    /// `(n·c, n·p)`.
+    n_cp: (f64, f64),
+    /// The span of β above both horizons, and its unoccluded weight.
+    span: (f64, f64),
+    whole: f64,
+}
+
+/// The sky's row of direction `p`, or `None` where it gives the sky nothing.
+fn sky_row(n: DVec3, c: DVec3, p: DVec3) -> Option<SkyRow> {
+    let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
+    let span = (ground.0.max(surface.0), ground.1.min(surface.1));
+    let (n_c, n_p) = (n.dot(c), n.dot(p));
+    let whole = weight_integral(n_c, n_p, span.0, span.1);
+    (whole > 0.0).then_some(SkyRow { n_cp: (n_c, n_p), span, whole })
+}
+
 /// The sky's cosine-weighted visible fraction from `s.origin` on a surface of unit normal `n`, by `rows` slices
 /// (module text), or `None` where the occluders cannot be sliced (a triangle partly cut away by an alpha mask):
 /// then the caller casts rays. Exactly 1 where no row meets an occluder (the same sums), and 1 where the sky
@@ -286,13 +304,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     let mut total = 0.0;
     let mut blocked = Vec::new();
     for (i, &p) in rows.iter().enumerate() {
-        let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
-        let span = (ground.0.max(surface.0), ground.1.min(surface.1));
-        let (n_c, n_p) = (n.dot(c), n.dot(p));
-        let whole = weight_integral(n_c, n_p, span.0, span.1);
-        if whole <= 0.0 {
-            continue;
-        }
+        let Some(SkyRow { n_cp: (n_c, n_p), span, whole }) = sky_row(n, c, p) else { continue };
         let m = c.cross(p);
         let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
         visible += row_visible_weight(row, (n_c, n_p), (span, whole), &mut blocked);
@@ -374,13 +386,7 @@ mod tests {
     /// to the bit, every row testing every triangle.
     #[test]
     fn buckets_give_what_every_row_testing_every_triangle_gives() {
-        let mut seed = 0x9e3779b97f4a7c15u64;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut r = crate::test_rng::uniform(0x9e3779b97f4a7c15);
         let tris: Vec<[DVec3; 3]> = (0..300)
             .map(|_| {
                 let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
@@ -397,13 +403,7 @@ mod tests {
             for psi in midpoint_rows(rows) {
                 let (sin_p, cos_p) = psi.sin_cos();
                 let p = cos_p * p1 + sin_p * p2;
-                let (ground, surface) = (above(DVec3::Y, c, p), above(n, c, p));
-                let span = (ground.0.max(surface.0), ground.1.min(surface.1));
-                let (n_c, n_p) = (n.dot(c), n.dot(p));
-                let whole = weight_integral(n_c, n_p, span.0, span.1);
-                if whole <= 0.0 {
-                    continue;
-                }
+                let Some(SkyRow { n_cp: (n_c, n_p), span, whole }) = sky_row(n, c, p) else { continue };
                 let m = c.cross(p);
                 let mut blocked: Vec<_> = tris.iter().filter_map(|&t| blocked_interval(t, c, p, m)).collect();
                 visible += if blocked.is_empty() { whole } else { visible_weight(n_c, n_p, span, &mut blocked) };

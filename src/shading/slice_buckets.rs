@@ -215,13 +215,7 @@ mod tests {
     #[test]
     fn every_row_that_cuts_a_triangle_lies_in_its_arc() {
         let (p1, p2) = (DVec3::X, DVec3::Y);
-        let mut seed = 0x2545f4914f6cdd1du64;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut r = crate::test_rng::uniform(0x2545f4914f6cdd1d);
         let mut surrounding = 0;
         for _ in 0..2000 {
             let tri = [0, 1, 2].map(|_| DVec3::new(r(), r(), r()) * 3.0);

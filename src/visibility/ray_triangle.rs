@@ -268,13 +268,7 @@ mod tests {
     /// boundary (the reference's "fragile" margin), on random triangles and rays; its barycentrics are the hit's.
     #[test]
     fn the_f32_test_agrees_with_f64_away_from_edges() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut next = crate::test_rng::uniform(0x2545_f491_4f6c_dd1d);
         let (mut checked, mut hits) = (0, 0);
         for _ in 0..200_000 {
             let scale = 10f64.powf(3.0 * next());
