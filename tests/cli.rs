@@ -896,6 +896,8 @@ fn shadow_flags_warnings_and_refusals() {
     let o = sunshade(&["render", s(&overcast), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "map"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("the sky has no shadow map"), "{}", stderr(&o));
+    // ... and says which technique would shadow it.
+    assert!(stderr(&o).contains("--shadows ray shadows it"), "{}", stderr(&o));
     let o = sunshade(&["render", s(&room), "-o", s(&out), "--width", "32", "--height", "24", "--shadows", "map"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));

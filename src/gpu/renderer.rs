@@ -463,7 +463,12 @@ impl Renderer {
                 choice.warning = true;
             }
             if settings.lights.sky.is_some() {
-                choice.reason += "; the sky has no shadow map: it is unoccluded";
+                choice.reason += "; the sky has no shadow map: it is unoccluded (--shadows ray shadows it";
+                choice.reason += if self.pipeline.has_ray_queries() {
+                    ")"
+                } else {
+                    ", by the fragment shader's walk of the occluders' BVH: seconds a frame on lavapipe)"
+                };
                 choice.warning = true;
             }
         }
