@@ -21,10 +21,10 @@
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, clip_segment, cosine_rows, row_visible_weight, rows_fraction, segment_interval, slice_segment,
+    above, clip_segment, cosine_rows, row_visible_weight, segment_interval, slice_segment, sliced_fraction,
     weight_integral, CosineRow,
 };
-use super::slice_buckets::{frame_about, RowBuckets};
+use super::slice_buckets::frame_about;
 use super::sun_slices::sun_slice_axis;
 use super::visibility::{Shadowing, SliceReach};
 
@@ -109,24 +109,15 @@ pub fn disk_visible_fraction_sliced(
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
     // The rows, ψ = mid − half cos u ascending.
     let rows = cosine_rows(dhat, q, (mid, half), rows.max(1));
-    let directions: Vec<DVec3> = rows.iter().map(|r| r.p).collect();
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
-    // where none has a corner before the rays' ends, every row is clear (the same 1).
-    let whole_cone = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
-    let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &whole_cone, frame_about(dhat, q), &directions, before) {
-        return None;
-    }
-    if buckets.is_empty() {
-        return Some(1.0);
-    }
-    let mut visible = 0.0;
-    let mut total = 0.0;
-    let mut blocked = Vec::new();
-    for (i, &CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. }) in rows.iter().enumerate() {
+    // only triangles with a corner before the rays' ends kept.
+    let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
+    let directions = rows.iter().map(|r| r.p);
+    sliced_fraction(s, &reach, frame_about(dhat, q), directions, before, |i, buckets, blocked| {
+        let CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. } = rows[i];
         let jacobian = half * sin_u;
         let m = cos_p * q - sin_p * dhat;
-        let Some([y0, y1]) = chord(d_vec, d, radius, m) else { continue };
+        let [y0, y1] = chord(d_vec, d, radius, m)?;
         let in_plane = |y: DVec3| (y.dot(c), y.dot(p));
         let (e0, e1) = (in_plane(y0), in_plane(y1));
         let angle = |(s, t): (f64, f64)| t.max(0.0).atan2(s);
@@ -137,7 +128,7 @@ pub fn disk_visible_fraction_sliced(
         let unscaled = weight_integral(n_c, n_p, span.0, span.1);
         let whole = jacobian * unscaled;
         if whole <= 0.0 {
-            continue;
+            return None;
         }
         // The chord's line `a·(s, t) = b` (a its normal, towards the far side), pulled in to where the rays end.
         let a = (e1.1 - e0.1, e0.0 - e1.0);
@@ -147,10 +138,8 @@ pub fn disk_visible_fraction_sliced(
         let row = buckets.row(i).filter_map(|&tri| {
             slice_segment(tri, c, p, m).and_then(|g| clip_segment(g, a, b_line)).and_then(segment_interval)
         });
-        visible += jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), &mut blocked);
-        total += whole;
-    }
-    Some(rows_fraction(visible, total))
+        Some((jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), blocked), whole))
+    })
 }
 
 #[cfg(test)]

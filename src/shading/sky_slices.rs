@@ -261,6 +261,38 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
     }
 }
 
+/// A light's visible fraction by its rows, the part the sky's, the sun's and disk lights' slices share: one walk
+/// within `reach` fills the rows' buckets ([`RowBuckets::fill`]: `frame` across the axis, the rows' `directions`,
+/// `keep` a light's own test of a whole triangle), then `row(i, buckets, blocked)` gives row `i`'s visible and
+/// unoccluded weights (`None` where the row gives nothing; `blocked` the rows' shared buffer), summed in the
+/// rows' order into [`rows_fraction`]. Exactly 1 at once where the walk keeps no triangle (every row would be
+/// clear: the same sums); `None` where the occluders cannot be sliced.
+pub fn sliced_fraction(
+    s: &Shadowing,
+    reach: &SliceReach,
+    frame: (DVec3, DVec3),
+    directions: impl Iterator<Item = DVec3>,
+    keep: impl Fn(&[DVec3; 3]) -> bool,
+    mut row: impl FnMut(usize, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
+) -> Option<f64> {
+    let mut buckets = RowBuckets::default();
+    if !buckets.fill(s, reach, frame, directions, keep) {
+        return None;
+    }
+    if buckets.is_empty() {
+        return Some(1.0);
+    }
+    let (mut visible, mut total) = (0.0, 0.0);
+    let mut blocked = Vec::new();
+    for i in 0..buckets.rows() {
+        if let Some((v, w)) = row(i, &buckets, &mut blocked) {
+            visible += v;
+            total += w;
+        }
+    }
+    Some(rows_fraction(visible, total))
+}
+
 /// The sky's row of direction `p` about the axis `c` for a surface of unit normal `n` ([`sky_row`]).
 struct SkyRow {
     /// `(n·c, n·p)`.
@@ -295,22 +327,21 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
         .collect();
     // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
     // holds (`slice_buckets`); a row then tests only its own.
-    let walk = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
-    let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &walk, (p1, p2), &rows, |_| true) {
-        return None;
-    }
-    let mut visible = 0.0;
-    let mut total = 0.0;
-    let mut blocked = Vec::new();
-    for (i, &p) in rows.iter().enumerate() {
-        let Some(SkyRow { n_cp: (n_c, n_p), span, whole }) = sky_row(n, c, p) else { continue };
-        let m = c.cross(p);
-        let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
-        visible += row_visible_weight(row, (n_c, n_p), (span, whole), &mut blocked);
-        total += whole;
-    }
-    Some(rows_fraction(visible, total))
+    let reach = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
+    sliced_fraction(
+        s,
+        &reach,
+        (p1, p2),
+        rows.iter().copied(),
+        |_| true,
+        |i, buckets, blocked| {
+            let p = rows[i];
+            let SkyRow { n_cp: (n_c, n_p), span, whole } = sky_row(n, c, p)?;
+            let m = c.cross(p);
+            let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
+            Some((row_visible_weight(row, (n_c, n_p), (span, whole), blocked), whole))
+        },
+    )
 }
 
 #[cfg(test)]

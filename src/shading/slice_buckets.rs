@@ -108,7 +108,7 @@ impl RowBuckets {
         s: &Shadowing,
         walk: &SliceReach,
         (e1, e2): (DVec3, DVec3),
-        rows: &[DVec3],
+        rows: impl Iterator<Item = DVec3>,
         keep: impl Fn(&[DVec3; 3]) -> bool,
     ) -> bool {
         self.triangles.clear();
@@ -124,8 +124,8 @@ impl RowBuckets {
             return false;
         }
         self.row_angles.clear();
-        self.row_angles.extend(rows.iter().map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
-        let rows = rows.len();
+        self.row_angles.extend(rows.map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
+        let rows = self.row_angles.len();
         // Each triangle's rows as a range of indices (two where its arc wraps past angle 0), found once.
         let angles = &self.row_angles;
         let from = |x: f64| angles.partition_point(|&r| r < x);
@@ -166,6 +166,11 @@ impl RowBuckets {
             }
         }
         true
+    }
+
+    /// How many rows the buckets were filled for.
+    pub fn rows(&self) -> usize {
+        self.row_angles.len()
     }
 
     /// Whether the walk kept no triangle (then every row is clear).

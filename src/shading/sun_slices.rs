@@ -23,9 +23,9 @@ use std::f64::consts::FRAC_PI_2;
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, blocked_interval, cosine_rows, row_visible_weight, rows_fraction, weight_integral, CosineRow, SLICE_AXIS,
+    above, blocked_interval, cosine_rows, row_visible_weight, sliced_fraction, weight_integral, CosineRow, SLICE_AXIS,
 };
-use super::slice_buckets::{frame_about, RowBuckets};
+use super::slice_buckets::frame_about;
 use super::visibility::{Shadowing, SliceReach};
 
 /// The slices' axis for the sun in direction `l`: the sky's oblique axis ([`SLICE_AXIS`]) made perpendicular to
@@ -58,38 +58,34 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let q = c.cross(l);
     // The rows, ψ = −σ cos u ascending.
     let rows = cosine_rows(l, q, (0.0, sigma), rows.max(1));
-    let directions: Vec<DVec3> = rows.iter().map(|r| r.p).collect();
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
-    // (`slice_buckets`); where it finds none, every row is clear (the same 1).
+    // (`slice_buckets`).
     let cone = Some((l, sigma.cos(), sigma.sin()));
-    let whole_cone = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
-    let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, &whole_cone, frame_about(l, q), &directions, |_| true) {
-        return None;
-    }
-    if buckets.is_empty() {
-        return Some(1.0);
-    }
-    let mut visible = 0.0;
-    let mut total = 0.0;
-    let mut blocked = Vec::new();
-    for (i, &CosineRow { sin_u, psi, p, .. }) in rows.iter().enumerate() {
-        let jacobian = sigma * sin_u;
-        let chi = chord_half_width(sigma, psi);
-        let surface = above(n, c, p);
-        let span = ((FRAC_PI_2 - chi).max(surface.0), (FRAC_PI_2 + chi).min(surface.1));
-        let (n_c, n_p) = (n.dot(c), n.dot(p));
-        let unscaled = weight_integral(n_c, n_p, span.0, span.1);
-        let whole = jacobian * unscaled;
-        if whole <= 0.0 {
-            continue;
-        }
-        let m = c.cross(p);
-        let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
-        visible += jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), &mut blocked);
-        total += whole;
-    }
-    Some(rows_fraction(visible, total))
+    let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
+    let directions = rows.iter().map(|r| r.p);
+    sliced_fraction(
+        s,
+        &reach,
+        frame_about(l, q),
+        directions,
+        |_| true,
+        |i, buckets, blocked| {
+            let CosineRow { sin_u, psi, p, .. } = rows[i];
+            let jacobian = sigma * sin_u;
+            let chi = chord_half_width(sigma, psi);
+            let surface = above(n, c, p);
+            let span = ((FRAC_PI_2 - chi).max(surface.0), (FRAC_PI_2 + chi).min(surface.1));
+            let (n_c, n_p) = (n.dot(c), n.dot(p));
+            let unscaled = weight_integral(n_c, n_p, span.0, span.1);
+            let whole = jacobian * unscaled;
+            if whole <= 0.0 {
+                return None;
+            }
+            let m = c.cross(p);
+            let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));
+            Some((jacobian * row_visible_weight(row, (n_c, n_p), (span, unscaled), blocked), whole))
+        },
+    )
 }
 
 #[cfg(test)]
