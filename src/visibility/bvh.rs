@@ -169,21 +169,38 @@ impl Bvh {
         &self,
         ray: &WatertightRay,
         t_min: f64,
-        mut t_max: f64,
+        t_max: f64,
         pad: f64,
         mut triangle: impl FnMut(usize, &mut f64) -> bool,
     ) {
+        let inv = ray.direction.recip();
+        // The ray is shortened by `triangle` as the boxes are tested against it: one value read by both.
+        let t_max = std::cell::Cell::new(t_max);
+        self.descend(
+            |node| slab(node, pad, ray.origin, inv, t_min, t_max.get()),
+            |i| {
+                let mut t = t_max.get();
+                let stop = triangle(i, &mut t);
+                t_max.set(t);
+                stop
+            },
+        );
+    }
+
+    /// The trees' one descent, depth first with an explicit stack: a node is entered where `enter` says so (its
+    /// box meets what is sought), an inner node's children stacked, an entered leaf's triangles (the index as
+    /// given to [`Bvh::new`]) handed to `leaf`, which returns whether to stop. The depth is below 78 (module text)
+    /// and the stack holds at most one pending sibling per level.
+    fn descend(&self, mut enter: impl FnMut(&Node) -> bool, mut leaf: impl FnMut(usize) -> bool) {
         if self.order.is_empty() {
             return;
         }
-        let inv = ray.direction.recip();
-        // The depth is below 78 (module text) and the stack holds at most one pending sibling per level.
         let mut stack = [0u32; STACK_SIZE];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
-            if !slab(node, pad, ray.origin, inv, t_min, t_max) {
+            if !enter(node) {
                 continue;
             }
             if node.count == 0 {
@@ -193,7 +210,7 @@ impl Bvh {
                 continue;
             }
             for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                if triangle(i as usize, &mut t_max) {
+                if leaf(i as usize) {
                     return;
                 }
             }
@@ -319,32 +336,19 @@ impl Bvh {
     pub fn within_reach(&self, reach: &SliceReach, mut visit: impl FnMut(usize)) {
         let origin = reach.origin;
         let reaches = |centre: DVec3, half: DVec3, k: DVec3| centre.dot(k) + half.dot(k.abs()) > 0.0;
-        if self.order.is_empty() {
-            return;
-        }
-        let mut stack = [0u32; STACK_SIZE];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
+        let enter = |node: &Node| {
             let centre = 0.5 * (node.min + node.max) - origin;
             let half = 0.5 * (node.max - node.min);
-            if !reach.above.iter().all(|&k| reaches(centre, half, k))
+            // The culls as written (a NaN distance keeps the box: no comparison culls it).
+            let culled = !reach.above.iter().all(|&k| reaches(centre, half, k))
                 || reach.cone.is_some_and(|(axis, cos, sin)| !sphere_meets_cone(centre, half.length(), axis, cos, sin))
-                || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b)
-            {
-                continue;
-            }
-            if node.count == 0 {
-                stack[top] = node.first;
-                stack[top + 1] = node.first + 1;
-                top += 2;
-                continue;
-            }
-            for &i in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                visit(i as usize);
-            }
-        }
+                || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b);
+            !culled
+        };
+        self.descend(enter, |i| {
+            visit(i);
+            false
+        });
     }
 }
 
