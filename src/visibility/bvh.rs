@@ -432,6 +432,15 @@ mod tests {
         fn v(&mut self, s: f64) -> DVec3 {
             DVec3::new(self.f() - 0.5, self.f() - 0.5, self.f() - 0.5) * s
         }
+        /// `count` triangles of corners within `size` of centres within 2 m of the origin.
+        fn soup(&mut self, count: usize, size: f64) -> Vec<[DVec3; 3]> {
+            (0..count)
+                .map(|_| {
+                    let c = self.v(2.0);
+                    [c + self.v(size), c + self.v(size), c + self.v(size)]
+                })
+                .collect()
+        }
     }
 
     #[test]
@@ -441,12 +450,7 @@ mod tests {
         let mut rng = Rng(11);
         let mut left_out = 0;
         for (count, size) in [(1usize, 0.5), (200, 0.2), (3000, 0.05)] {
-            let tris: Vec<[DVec3; 3]> = (0..count)
-                .map(|_| {
-                    let c = rng.v(2.0);
-                    [c + rng.v(size), c + rng.v(size), c + rng.v(size)]
-                })
-                .collect();
+            let tris = rng.soup(count, size);
             let bvh = Bvh::new(tris.clone());
             for _ in 0..500 {
                 let origin = rng.v(3.0);
@@ -479,12 +483,7 @@ mod tests {
     fn agrees_with_brute_force_on_random_soups() {
         let mut rng = Rng(7);
         for (count, size) in [(1usize, 0.5), (3, 0.5), (200, 0.2), (3000, 0.05)] {
-            let tris: Vec<[DVec3; 3]> = (0..count)
-                .map(|_| {
-                    let c = rng.v(2.0);
-                    [c + rng.v(size), c + rng.v(size), c + rng.v(size)]
-                })
-                .collect();
+            let tris = rng.soup(count, size);
             let bvh = Bvh::new(tris.clone());
             assert_eq!(bvh.triangle_count(), count);
             for _ in 0..2000 {
