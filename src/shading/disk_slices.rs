@@ -108,13 +108,12 @@ pub fn disk_visible_fraction_sliced(
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
     // The rows, ψ = mid − half cos u ascending.
-    let rows = cosine_rows(dhat, q, (mid, half), rows.max(1));
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
-    // only triangles with a corner before the rays' ends kept.
+    // only triangles with a corner before the rays' ends kept, the rows made only where the walk keeps one.
     let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
-    let directions = rows.iter().map(|r| r.p);
-    sliced_fraction(s, &reach, frame_about(dhat, q), directions, before, |i, buckets, blocked| {
-        let CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. } = rows[i];
+    let rows = || cosine_rows(dhat, q, (mid, half), rows.max(1));
+    sliced_fraction(s, &reach, before, (frame_about(dhat, q), rows, |r: &CosineRow| r.p), |i, row, buckets, blocked| {
+        let &CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. } = row;
         let jacobian = half * sin_u;
         let m = cos_p * q - sin_p * dhat;
         let [y0, y1] = chord(d_vec, d, radius, m)?;

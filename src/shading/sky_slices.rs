@@ -262,30 +262,33 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
 }
 
 /// A light's visible fraction by its rows, the part the sky's, the sun's and disk lights' slices share: one walk
-/// within `reach` fills the rows' buckets ([`RowBuckets::fill`]: `frame` across the axis, the rows' `directions`,
-/// `keep` a light's own test of a whole triangle), then `row(i, buckets, blocked)` gives row `i`'s visible and
-/// unoccluded weights (`None` where the row gives nothing; `blocked` the rows' shared buffer), summed in the
-/// rows' order into [`rows_fraction`]. Exactly 1 at once where the walk keeps no triangle (every row would be
-/// clear: the same sums); `None` where the occluders cannot be sliced.
-pub fn sliced_fraction(
+/// within `reach` gathers the triangles `keep` keeps (a light's own test of a whole triangle,
+/// [`RowBuckets::gather`]); where it keeps none the fraction is exactly 1 at once (every row would be clear: the
+/// same sums), before any row is made. Otherwise `rows()` makes the rows, each filed with its triangles
+/// ([`RowBuckets::file`]: `frame` across the axis, `direction` a row's unit direction), and `row(i, row,
+/// buckets, blocked)` gives row `i`'s visible and unoccluded weights (`None` where the row gives nothing;
+/// `blocked` the rows' shared buffer), summed in the rows' order into [`rows_fraction`]. `None` where the
+/// occluders cannot be sliced.
+pub fn sliced_fraction<R>(
     s: &Shadowing,
     reach: &SliceReach,
-    frame: (DVec3, DVec3),
-    directions: impl Iterator<Item = DVec3>,
     keep: impl Fn(&[DVec3; 3]) -> bool,
-    mut row: impl FnMut(usize, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
+    (frame, rows, direction): ((DVec3, DVec3), impl FnOnce() -> Vec<R>, impl Fn(&R) -> DVec3),
+    mut row: impl FnMut(usize, &R, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
 ) -> Option<f64> {
     let mut buckets = RowBuckets::default();
-    if !buckets.fill(s, reach, frame, directions, keep) {
+    if !buckets.gather(s, reach, keep) {
         return None;
     }
     if buckets.is_empty() {
         return Some(1.0);
     }
+    let rows = rows();
+    buckets.file(frame, rows.iter().map(direction));
     let (mut visible, mut total) = (0.0, 0.0);
     let mut blocked = Vec::new();
-    for i in 0..buckets.rows() {
-        if let Some((v, w)) = row(i, &buckets, &mut blocked) {
+    for (i, r) in rows.iter().enumerate() {
+        if let Some((v, w)) = row(i, r, &buckets, &mut blocked) {
             visible += v;
             total += w;
         }
@@ -319,23 +322,23 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     let c = DVec3::from_array(SLICE_AXIS);
     let p1 = c.cross(DVec3::Z).normalize();
     let p2 = c.cross(p1);
-    let rows: Vec<DVec3> = midpoint_rows(rows.max(1))
-        .map(|psi| {
-            let (sin_p, cos_p) = psi.sin_cos();
-            cos_p * p1 + sin_p * p2
-        })
-        .collect();
+    let rows = || {
+        midpoint_rows(rows.max(1))
+            .map(|psi| {
+                let (sin_p, cos_p) = psi.sin_cos();
+                cos_p * p1 + sin_p * p2
+            })
+            .collect()
+    };
     // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
     // holds (`slice_buckets`); a row then tests only its own.
     let reach = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
     sliced_fraction(
         s,
         &reach,
-        (p1, p2),
-        rows.iter().copied(),
         |_| true,
-        |i, buckets, blocked| {
-            let p = rows[i];
+        ((p1, p2), rows, |&p: &DVec3| p),
+        |i, &p, buckets, blocked| {
             let SkyRow { n_cp: (n_c, n_p), span, whole } = sky_row(n, c, p)?;
             let m = c.cross(p);
             let row = buckets.row(i).filter_map(|&tri| blocked_interval(tri, c, p, m));

@@ -9,8 +9,9 @@
 //! holding its three corners' azimuths when it is shorter than a half-turn; a longer one means that the projection
 //! surrounds (or touches) the origin, so that every half-plane may cut the triangle. So one walk of the occluders'
 //! tree (culled by the slices' half-spaces, cone and near side, not by any plane) gathers the triangles, and each
-//! goes to the rows inside its arc ([`RowBuckets::fill`]); a row then cuts only its own triangles, which the exact
-//! per-row test (`sky_slices::blocked_interval`, `disk_slices`' clipped one) still decides.
+//! goes to the rows inside its arc ([`RowBuckets::gather`], then [`RowBuckets::file`]); a row then cuts only its
+//! own triangles, which the exact per-row test (`sky_slices::blocked_interval`, `disk_slices`' clipped one) still
+//! decides.
 //!
 //! The walk per row cost 42% of a sliced reference (overcast.glb at 128², 324 rows a pixel, `perf`), and grows
 //! with the rows, where this one walk does not.
@@ -99,18 +100,9 @@ pub struct RowBuckets {
 
 impl RowBuckets {
     /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) that `keep`
-    /// keeps (a light's own test of a whole triangle, once rather than once a row) and files each under the rows
-    /// inside its arc about the axis, `(e1, e2)` an orthonormal pair across the axis and `rows` the rows' unit
-    /// directions `p` across it, their azimuths from `e1` towards `e2` ascending in [0, 2π). False where the
-    /// occluders cannot be sliced.
-    pub fn fill(
-        &mut self,
-        s: &Shadowing,
-        walk: &SliceReach,
-        (e1, e2): (DVec3, DVec3),
-        rows: impl Iterator<Item = DVec3>,
-        keep: impl Fn(&[DVec3; 3]) -> bool,
-    ) -> bool {
+    /// keeps (a light's own test of a whole triangle, once rather than once a row). False where the occluders
+    /// cannot be sliced. [`RowBuckets::file`] then files them under the rows.
+    pub fn gather(&mut self, s: &Shadowing, walk: &SliceReach, keep: impl Fn(&[DVec3; 3]) -> bool) -> bool {
         self.triangles.clear();
         let origin = walk.origin;
         let triangles = &mut self.triangles;
@@ -120,9 +112,13 @@ impl RowBuckets {
                 triangles.push(tri);
             }
         };
-        if !s.occluders.slice_triangles(walk, gather) {
-            return false;
-        }
+        s.occluders.slice_triangles(walk, gather)
+    }
+
+    /// Files each gathered triangle under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair
+    /// across the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
+    /// ascending in [0, 2π).
+    pub fn file(&mut self, (e1, e2): (DVec3, DVec3), rows: impl Iterator<Item = DVec3>) {
         self.row_angles.clear();
         self.row_angles.extend(rows.map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
         let rows = self.row_angles.len();
@@ -165,12 +161,6 @@ impl RowBuckets {
                 }
             }
         }
-        true
-    }
-
-    /// How many rows the buckets were filled for.
-    pub fn rows(&self) -> usize {
-        self.row_angles.len()
     }
 
     /// Whether the walk kept no triangle (then every row is clear).

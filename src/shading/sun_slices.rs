@@ -56,21 +56,18 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let sigma = 0.5 * angular_diameter;
     let c = sun_slice_axis(l);
     let q = c.cross(l);
-    // The rows, ψ = −σ cos u ascending.
-    let rows = cosine_rows(l, q, (0.0, sigma), rows.max(1));
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
-    // (`slice_buckets`).
+    // (`slice_buckets`); the rows, ψ = −σ cos u ascending, made only where the walk keeps a triangle.
     let cone = Some((l, sigma.cos(), sigma.sin()));
     let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
-    let directions = rows.iter().map(|r| r.p);
+    let rows = || cosine_rows(l, q, (0.0, sigma), rows.max(1));
     sliced_fraction(
         s,
         &reach,
-        frame_about(l, q),
-        directions,
         |_| true,
-        |i, buckets, blocked| {
-            let CosineRow { sin_u, psi, p, .. } = rows[i];
+        (frame_about(l, q), rows, |r: &CosineRow| r.p),
+        |i, row, buckets, blocked| {
+            let &CosineRow { sin_u, psi, p, .. } = row;
             let jacobian = sigma * sin_u;
             let chi = chord_half_width(sigma, psi);
             let surface = above(n, c, p);
