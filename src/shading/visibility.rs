@@ -251,6 +251,13 @@ pub struct Shadowing<'a> {
 }
 
 impl<'a> Shadowing<'a> {
+    /// A light's visible fraction by slices (`sliced`, given the rows, `sky_slices::slice_rows` of the grid's
+    /// count), where `slices` asks for it; `None` where it does not or the occluders cannot be sliced (then the
+    /// caller takes the grid).
+    pub fn by_slices(&self, sliced: impl FnOnce(u32) -> Option<f64>) -> Option<f64> {
+        self.slices.then(|| sliced(super::sky_slices::slice_rows(self.samples_per_axis))).flatten()
+    }
+
     /// These rays for the sun, if it is shadowed.
     pub fn for_sun(&self) -> Option<&Self> {
         self.lights.sun.then_some(self)
@@ -557,11 +564,9 @@ pub fn disk_sample(
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
 /// (`sun_slices`), which the GPU does not mirror.
 pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
-    if s.slices {
-        let rows = super::sky_slices::slice_rows(s.samples_per_axis);
-        if let Some(v) = super::sun_slices::sun_visible_fraction_sliced(s, n, l, angular_diameter, rows) {
-            return v;
-        }
+    if let Some(v) = s.by_slices(|rows| super::sun_slices::sun_visible_fraction_sliced(s, n, l, angular_diameter, rows))
+    {
+        return v;
     }
     let radius = (0.5 * angular_diameter).tan();
     let t = orthonormal_to(l);
@@ -575,11 +580,9 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
 /// (`disk_slices`), which the GPU does not mirror.
 pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
-    if s.slices {
-        let rows = super::sky_slices::slice_rows(s.samples_per_axis);
-        if let Some(v) = super::disk_slices::disk_visible_fraction_sliced(s, n, center, d, radius, rows) {
-            return v;
-        }
+    if let Some(v) = s.by_slices(|rows| super::disk_slices::disk_visible_fraction_sliced(s, n, center, d, radius, rows))
+    {
+        return v;
     }
     let a = orthonormal_to(d);
     let b = d.cross(a);
@@ -656,11 +659,8 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
 /// slices instead (`sky_slices`: exact along one angle, second order in its rows), which the GPU does not mirror.
 pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
-    use super::sky_slices::{sky_visible_fraction_sliced, slice_rows};
-    if s.slices {
-        if let Some(v) = sky_visible_fraction_sliced(s, n, slice_rows(s.samples_per_axis)) {
-            return v;
-        }
+    if let Some(v) = s.by_slices(|rows| super::sky_slices::sky_visible_fraction_sliced(s, n, rows)) {
+        return v;
     }
     grid_fraction(s, &GridLight::Sky(sky_lune(n)))
 }
