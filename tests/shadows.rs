@@ -925,6 +925,7 @@ fn gpu_ray_queries_keep_the_sky_through_occluders_under_tolerance() {
     let e = String::from_utf8_lossy(&o.stderr);
     if !ray_query {
         assert!(o.status.success() || e.contains("loop iterations"), "{e}");
+        assert!(o.status.success() || e.contains("`sunshade reference` with the same scene flags has no such"), "{e}");
         if !o.status.success() {
             assert!(!out.exists(), "a refused render left {}", out.display());
             return;

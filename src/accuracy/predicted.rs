@@ -512,7 +512,14 @@ pub(crate) fn techniques_within(
              an occluder above its horizon (nearly the whole image), where its visible fraction has no bound (a \
              shadow-ray grid errs by the share of its cells an occluder's edge crosses): --tolerance-in-penumbrae \
              estimates it by refinement (costly: it converges at first order), --shadows none bounds the render \
-             against the unshadowed truth"
+             against the unshadowed truth{}",
+            match renderer {
+                Renderer::Gpu { .. } => {
+                    "; `sunshade reference` with the same scene flags meets it on the CPU (the sky's visible fraction by \
+                     slices, second order)"
+                }
+                Renderer::Reference => "",
+            }
         ));
     }
     let mut shading = settings.shading;

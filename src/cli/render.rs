@@ -169,9 +169,11 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         (TrialError::Tolerance(why), _) => CliError::Usage(why),
         // A render the device cannot run (`settings` holds its grids, the finest of any material's): the models
         // chosen, or a grid the study went on to; no setting it can render meets the tolerance.
-        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => {
-            CliError::Usage(format!("--tolerance {:e}: {}", t.max_relative, beyond_this_device(&settings, &why)))
-        }
+        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
+            "--tolerance {:e}: {}; `sunshade reference` with the same scene flags has no such limit",
+            t.max_relative,
+            beyond_this_device(&settings, &why)
+        )),
         (TrialError::Render(e), _) => CliError::from(e),
     })?;
     let (image, _) = done.kept;
