@@ -217,6 +217,9 @@ fn lobe_study<T, E>(
         }
     }
     let mut study = Ladder::new(renderer.arithmetic(), sun_grid, shadow_grid);
+    if shadow_grid && penumbrae_by_slices_alone(request, settings, reference) {
+        study = study.with_sliced_penumbrae();
+    }
     let mut previous: Option<T> = None;
     let mut last = None;
     for k in ladder() {
@@ -275,6 +278,17 @@ pub fn reference_within_tolerance(
         Err(TrialError::Tolerance(why)) => Err(why),
         Err(TrialError::Render(never)) => match never {},
     }
+}
+
+/// Whether every visible fraction the study refines is the reference's slices and no lobe sample casts a ray
+/// (`refinement`'s "Penumbrae by slices"): the reference by `--visibility slices` (the GPU casts its grid), no
+/// alpha-masked material (whose occluders send the slices back to the grid), and no specular or measured
+/// material in view (whose lobe samples under the lights cast rays).
+fn penumbrae_by_slices_alone(request: Request, settings: &RenderSettings, reference: &ReferenceOptions) -> bool {
+    matches!(request.renderer, Renderer::Reference)
+        && settings.shading.visibility_rule == VisibilityRule::Slices
+        && !request.scene.has_alpha_masks()
+        && specular_materials(request.scene, settings, reference).is_empty()
 }
 
 /// Whether the reference's shadow rays see the sky through occluders by slices: the sky lit, shadows by rays in a

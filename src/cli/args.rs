@@ -273,7 +273,8 @@ pub struct SceneArgs {
     /// With --tolerance: hold it in penumbrae too. The shadow rays' grids (overriding --shadow-samples) go on the
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
-    /// penumbra, the lights' located edges at second). Light of the sky through occluders is then estimated
+    /// penumbra, the lights' located edges at second; 2 on the reference where every light is taken by slices
+    /// and every material in view is Lambertian). Light of the sky through occluders is then estimated
     /// instead of refused. Costly, and refused where the ladder cannot reach T: in the dark end of a penumbra the
     /// visible fraction must be right to T/100 of the peak (the diff's floor).
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
