@@ -515,8 +515,8 @@ pub(crate) fn techniques_within(
              against the unshadowed truth{}",
             match renderer {
                 Renderer::Gpu { .. } => {
-                    "; `sunshade reference` with the same scene flags meets it on the CPU (the sky's visible fraction by \
-                     slices, second order)"
+                    "; `sunshade reference` with the same scene flags studies it on the CPU instead, by slices (second \
+                     order)"
                 }
                 Renderer::Reference => "",
             }
