@@ -137,7 +137,7 @@ pub fn penumbrae_need_study(settings: &RenderSettings, can_occlude: bool) -> boo
 
 /// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
 /// the closed-form irradiance is then the whole of their light, exact).
-fn only_lambertian(scene: &Scene) -> bool {
+pub(crate) fn only_lambertian(scene: &Scene) -> bool {
     !has_measured(scene) && scene_lobes(scene).iter().all(|l| matches!(l.brdf, Brdf::Lambert { .. }))
 }
 

@@ -55,8 +55,8 @@
 //! the row's plane (a jump), so the weight is piecewise continuous with finitely many pieces. For such a function
 //! Koksma's inequality bounds the error of an equal-weight rule by its variation times the points' star
 //! discrepancy, `1/(2N)` for `N` midpoints: `|error| ≤ V / (2N)`, whatever the jumps. With `N = 4k²` rows that is
-//! `O(k⁻²)`, order 2 on the ladder's `k`: where every light shadowed is taken by slices and every material in
-//! view is Lambertian (no lobe grid, so no lobe sample casting a ray: the ones that make penumbrae first
+//! `O(k⁻²)`, order 2 on the ladder's `k`: where every light shadowed is taken by slices and every material the
+//! meshes use is Lambertian (no lobe grid, so no lobe sample casting a ray: the ones that make penumbrae first
 //! order), the order used is at most [`MAX_ORDER`], as without penumbrae ([`Ladder::with_sliced_penumbrae`]).
 //! Measured on overcast.glb at 512² (2026-12-04): the slices' images for k = 9, 13, 18 (`4k²` rows each) differ
 //! by 3.3e-3 and 1.7e-3 at their largest, an observed order of 1.8 in `k` (first order in the rows), where the
@@ -215,8 +215,8 @@ impl Ladder {
     }
 
     /// The same study where the shadow grids refined are the rows of slices and no lobe sample casts a ray
-    /// (every material in view Lambertian): their error is `O(k⁻²)` however an occluder's edges lie (module text,
-    /// "Penumbrae by slices"), so the order used is at most [`MAX_ORDER`].
+    /// (every material the meshes use Lambertian): their error is `O(k⁻²)` however an occluder's edges lie
+    /// (module text, "Penumbrae by slices"), so the order used is at most [`MAX_ORDER`].
     pub fn with_sliced_penumbrae(mut self) -> Self {
         self.sliced_penumbrae = true;
         self

@@ -15,8 +15,8 @@ use std::convert::Infallible;
 use super::interpolation::f32_interpolation_bound;
 use super::material_study::{specular_materials, study_per_material};
 use super::predicted::{
-    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, penumbrae_need_study, predict_with_peak,
-    sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer, Request,
+    choose_and_predict, choose_sun_within, delta_trial, lobes_need_study, only_lambertian, penumbrae_need_study,
+    predict_with_peak, sun_needs_study, techniques_within, Barycentrics, Prediction, Renderer, Request,
 };
 use super::refinement::{ladder, Ladder};
 use crate::compare::image_peak;
@@ -217,7 +217,7 @@ fn lobe_study<T, E>(
         }
     }
     let mut study = Ladder::new(renderer.arithmetic(), sun_grid, shadow_grid);
-    if shadow_grid && penumbrae_by_slices_alone(request, settings, reference) {
+    if shadow_grid && penumbrae_by_slices_alone(request, settings) {
         study = study.with_sliced_penumbrae();
     }
     let mut previous: Option<T> = None;
@@ -282,13 +282,13 @@ pub fn reference_within_tolerance(
 
 /// Whether every visible fraction the study refines is the reference's slices and no lobe sample casts a ray
 /// (`refinement`'s "Penumbrae by slices"): the reference by `--visibility slices` (the GPU casts its grid), no
-/// alpha-masked material (whose occluders send the slices back to the grid), and no specular or measured
-/// material in view (whose lobe samples under the lights cast rays).
-fn penumbrae_by_slices_alone(request: Request, settings: &RenderSettings, reference: &ReferenceOptions) -> bool {
+/// alpha-masked material (whose occluders send the slices back to the grid), and every material the meshes use
+/// Lambertian at every pixel ([`only_lambertian`]: a lobe's samples under the lights cast rays).
+fn penumbrae_by_slices_alone(request: Request, settings: &RenderSettings) -> bool {
     matches!(request.renderer, Renderer::Reference)
         && settings.shading.visibility_rule == VisibilityRule::Slices
         && !request.scene.has_alpha_masks()
-        && specular_materials(request.scene, settings, reference).is_empty()
+        && only_lambertian(request.scene)
 }
 
 /// Whether the reference's shadow rays see the sky through occluders by slices: the sky lit, shadows by rays in a

@@ -274,7 +274,7 @@ pub struct SceneArgs {
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
     /// penumbra, the lights' located edges at second; 2 on the reference where every light is taken by slices
-    /// and every material in view is Lambertian). Light of the sky through occluders is then estimated
+    /// and every material the meshes use is Lambertian). Light of the sky through occluders is then estimated
     /// instead of refused. Costly, and refused where the ladder cannot reach T: in the dark end of a penumbra the
     /// visible fraction must be right to T/100 of the peak (the diff's floor).
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
