@@ -107,9 +107,9 @@ pub fn disk_visible_fraction_sliced(
     // (Corners relative to `o`: `x − C = x_rel − D`.)
     let before = |tri: &[DVec3; 3]| tri.iter().any(|&x| d.dot(x - d_vec) > (1.0 - SEGMENT_T_MAX) * -d.dot(d_vec));
     let beyond = Some((d, SEGMENT_T_MAX * d.dot(d_vec)));
-    // The rows, ψ = mid − half cos u ascending.
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
-    // only triangles with a corner before the rays' ends kept, the rows made only where the walk keeps one.
+    // only triangles with a corner before the rays' ends kept; the rows, ψ = mid − half cos u ascending, made only
+    // where the walk keeps one.
     let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
     let rows = || cosine_rows(dhat, q, (mid, half), rows.max(1));
     sliced_fraction(s, &reach, before, (frame_about(dhat, q), rows, |r: &CosineRow| r.p), |i, row, buckets, blocked| {
