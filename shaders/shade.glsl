@@ -64,8 +64,21 @@ vec3 irradiance_visible(Frame p) {
         }
         float v = 1.0;
         if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
-            v = VARIANT_SUN == SUN_DELTA ? (visible_along(p.shadow_origin, l) ? 1.0 : 0.0)
-                                         : sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+            if (VARIANT_SUN == SUN_DELTA) {
+                v = visible_along(p.shadow_origin, l) ? 1.0 : 0.0;
+            } else {
+                // By slices where asked and the shader walks the BVH itself (sun_slices.glsl; `4 k^2` rows, as
+                // sky_slices::slice_rows), the grid where they cannot be taken.
+                v = -1.0;
+#ifdef SUNSHADE_RAY_BVH
+                if (lights.sampling.w == VISIBILITY_SLICES) {
+                    v = sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
+                }
+#endif
+                if (v < 0.0) {
+                    v = sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+                }
+            }
             sun_ray_fraction = v;
         }
         if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {

@@ -93,6 +93,10 @@ float fraction(float visible, float total) {
     return (visible == total || total <= 0.0) ? 1.0 : visible / total;
 }
 
+#ifdef SUNSHADE_RAY_BVH
+#include "sun_slices.glsl"
+#endif
+
 // The sun's sample through the point xy of the unit disk, in the frame (t, b) about l: its direction (omega) and
 // weight (n.omega)+ / |p|^3, 0 below the horizon. Shared by the rays and the shadow map.
 float sun_sample(vec3 n, vec3 l, vec3 t, vec3 b, float radius, vec2 xy, out vec3 omega) {

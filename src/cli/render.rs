@@ -33,6 +33,14 @@ pub struct RenderArgs {
     /// ~/.cache/sunshade).
     #[arg(help_heading = "Device", long)]
     pub no_cache: bool,
+    /// How the sun's visible fraction through occluders is taken with shadow rays: `grid` (the located grid of
+    /// --shadow-samples rays, the default) or `slices` (exact across the sun's disk along one angle, a midpoint
+    /// rule of 4k² rows along the other, for k² = --shadow-samples: second order in the rows where every occluder
+    /// is opaque, as `sunshade reference --visibility slices` takes it). On devices without ray queries, whose
+    /// fragment shader walks the occluders' BVH, and for the sun's disk only: refused where a disk light or the sky
+    /// casts shadows (the reference slices those).
+    #[arg(long = "visibility", value_name = "grid|slices", help_heading = "Shadows")]
+    pub visibility_rule: Option<crate::shading::VisibilityRule>,
     /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
     /// encode).
     #[arg(help_heading = "Output", short, long)]
@@ -134,11 +142,26 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
             warning: false,
         };
     }
+    let slices = a.visibility_rule == Some(crate::shading::VisibilityRule::Slices);
+    if slices && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
+        // Slices take the place of shadow rays: `auto` casts them on any device.
+        choice = crate::visibility::ShadowChoice {
+            technique: Shadows::Ray,
+            reason: "auto with --visibility slices: the sun's visible fraction by slices of its disk (the device has \
+                     no ray queries: the fragment shader walks the occluders' BVH)"
+                .into(),
+            warning: false,
+        };
+    }
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
+    if let Some(rule) = a.visibility_rule {
+        // Refused at the render where the GPU cannot take it (`Renderer::shadow_choice`).
+        settings.shading.visibility_rule = rule;
+    }
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     // The reference mirroring the device, for the bound of f32 interpolation.
     let reference = device_reference_options(r.device_info(), a);

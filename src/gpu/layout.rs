@@ -22,6 +22,10 @@ pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
+/// The sun's visibility rule with shadow rays (`lights.sampling.w`): the located grid, or slices
+/// (shaders/sun_slices.glsl, where the fragment shader walks the occluders' BVH; elsewhere the grid).
+pub const VISIBILITY_GRID: u32 = 0;
+pub const VISIBILITY_SLICES: u32 = 1;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
@@ -335,6 +339,10 @@ pub fn lights_bytes(
         ShadowMapFilter::Pcss => 1,
         ShadowMapFilter::Nearest => 2,
     };
+    let visibility_rule = match shading.visibility_rule {
+        crate::shading::VisibilityRule::Grid => VISIBILITY_GRID,
+        crate::shading::VisibilityRule::Slices => VISIBILITY_SLICES,
+    };
     let mut disk_map_from_world = [[0.0f32; 16]; MAX_DISK_MAPS];
     let mut disk_map = [[0.0f32; 4]; MAX_DISK_MAPS];
     for (i, m) in disk_maps.iter().enumerate().take(MAX_DISK_MAPS) {
@@ -358,7 +366,7 @@ pub fn lights_bytes(
         sun,
         sky,
         counts: [lights.disks.len() as u32, 0, super::loop_budget::LOOP_PROBE_ITERATIONS, shading.samples_per_axis],
-        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, 0],
+        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, visibility_rule],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
         sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
         disk_map_from_world,
@@ -414,6 +422,8 @@ mod tests {
             ("SHADOWS_NONE", SHADOWS_NONE),
             ("SHADOWS_RAY", SHADOWS_RAY),
             ("SHADOWS_MAP", SHADOWS_MAP),
+            ("VISIBILITY_GRID", VISIBILITY_GRID),
+            ("VISIBILITY_SLICES", VISIBILITY_SLICES),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
             ("WRAP_REPEAT", WRAP_REPEAT),

@@ -25,7 +25,7 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::surface::{surface_flags, SURFACE_ALPHA_MASK};
 use crate::shading::visibility::MAX_LOCATED_GRID;
-use crate::shading::Shadows;
+use crate::shading::{Shadows, VisibilityRule};
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
 use crate::visibility::ShadowChoice;
 use bytemuck::Zeroable;
@@ -428,6 +428,26 @@ impl Renderer {
         })
     }
 
+    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: without shadow
+    /// rays, on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where a
+    /// disk light or the sky casts shadows (the GPU slices the sun's disk only, shaders/sun_slices.glsl; a
+    /// comparison with the reference would set unlike rules side by side).
+    fn check_slices(&self, technique: Shadows, settings: &RenderSettings) -> Result<(), GpuError> {
+        let why = if technique != Shadows::Ray {
+            "slices take the place of shadow rays (--shadows ray)"
+        } else if !self.pipeline.rays_walk_bvh() {
+            "the GPU takes slices where its fragment shader walks the occluders' BVH (devices without ray queries), \
+             and this one has ray queries"
+        } else if !settings.lights.disks.is_empty() || settings.lights.sky.is_some() {
+            "the GPU slices the sun's disk only, and a disk light or the sky casts shadows here"
+        } else {
+            return Ok(());
+        };
+        Err(GpuError::Unsupported(format!(
+            "--visibility slices: {why}; `sunshade reference --visibility slices` takes them for every light"
+        )))
+    }
+
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
     /// the device has ray queries and reads shadow maps where it has none. `map` shadows the sun and the first
     /// `MAX_DISK_MAPS` disk lights from their maps and leaves the sky (and further disks) unoccluded, with a
@@ -453,6 +473,9 @@ impl Renderer {
         }
         if choice.technique == Shadows::Ray && self.pipeline.rays_walk_bvh() {
             choice.reason += " (the device has no ray queries: the fragment shader walks the occluders' BVH)";
+        }
+        if settings.shading.visibility_rule == VisibilityRule::Slices {
+            self.check_slices(choice.technique, settings)?;
         }
         if choice.technique == Shadows::Map {
             if settings.lights.disks.len() > MAX_DISK_MAPS {

@@ -16,6 +16,7 @@ mod shade;
 pub mod sky_lune;
 pub mod sky_slices;
 pub mod slice_buckets;
+pub mod slices_about_centre;
 pub mod sun_slices;
 pub mod surface;
 pub mod texture_filter;

@@ -1,0 +1,481 @@
+// The sun's visible fraction by slices, on devices whose fragment shader walks the occluders' BVH itself
+// (SUNSHADE_RAY_BVH). Mirrors src/shading/sun_slices.rs (the rule: half great circles through an axis across
+// the sun, rows along psi = -sigma cos u, each chord cut by the surface's horizon and by the intervals that the
+// triangles in its plane block, its visible weight closed-form), sky_slices.rs (segments, pseudo-angles),
+// slices_about_centre.rs (the chords measured by gamma = beta - pi/2, which keeps f32's digits on a chord
+// within 0.0046 rad of beta = pi/2; see its text) and visibility/bvh.rs (within_reach, sphere_meets_cone).
+//
+// One walk a pixel gathers the triangles within the sun's cone above the surface's horizon into a local array of
+// MAX_SLICE_TRIANGLES; every row then cuts those whose row range holds it. Where the walk finds more, or an
+// alpha-masked triangle (which slices cannot cut), the fraction is SLICES_UNSLICEABLE and the caller casts the
+// grid's rays instead.
+//
+// llvmpipe's loop budget (gpu::loop_budget: 65535 iterations a fragment, every loop together) shapes the rows'
+// work. A penumbra's pixel behind a tessellated sphere's limb gathers 100 to 200 triangles, and a row cuts some
+// fifty of them within the sun's chord; the Rust sorts each row's intervals, which here would cost about m^2/4
+// iterations for m intervals. So (measured on sunset.glb at 96 x 72, Mesa 22.3.6): the triangles are ordered once
+// by where they lie along the chords; each row cuts them four an iteration (the loop's body written out four
+// times) and merges its intervals as they come into at most UNION_PIECES sorted disjoint pieces, steps written out
+// (no loop), sorting only where more pieces would be needed. Then 4 k^2 rows fit the budget up to k = 6 there
+// (144 rows; 256 rows cut 8 pixels short, which the renderer refuses), where the sort alone stopped at 64 rows.
+#ifndef SUNSHADE_SUN_SLICES_GLSL
+#define SUNSHADE_SUN_SLICES_GLSL
+
+#include "math.glsl"
+#include "occluders.glsl"
+
+// sky_slices::SLICE_AXIS.
+#define SLICE_AXIS vec3(0.33232518133916444, 0.8023039599071088, 0.4958511165312262)
+// The most triangles one pixel's slices gather (a pixel whose sun cone holds more casts rays).
+#define MAX_SLICE_TRIANGLES 256
+// What a fraction the slices cannot give reads.
+#define SLICES_UNSLICEABLE -1.0
+
+// The gathered triangles' corners relative to the rays' origin [m], three a triangle, and one row's blocked
+// intervals (pseudo-angles).
+vec3 slice_corners[3 * MAX_SLICE_TRIANGLES];
+vec2 slice_blocked[MAX_SLICE_TRIANGLES];
+
+// The slices' axis for the sun in direction l: SLICE_AXIS made perpendicular to l (x's where l is nearly along it).
+vec3 sun_slice_axis(vec3 l) {
+    vec3 c = SLICE_AXIS - dot(SLICE_AXIS, l) * l;
+    if (dot(c, c) > 1e-6) {
+        return normalize(c);
+    }
+    return normalize(vec3(1.0, 0.0, 0.0) - l.x * l);
+}
+
+// The chord's half-width chi at psi: sin^2(chi/2) = sin((sigma + psi)/2) sin((sigma - psi)/2) / cos psi, then
+// chi = 2 asin (as an atan2: lavapipe's asin loses 4e-4).
+float chord_half_width(float sigma, float psi) {
+    float s2 = sin(0.5 * (sigma + psi)) * sin(0.5 * (sigma - psi)) / cos(psi);
+    float x = sqrt(max(s2, 0.0));
+    return 2.0 * atan2_accurate(x, sqrt(max(1.0 - x * x, 0.0)));
+}
+
+// Row i of `rows` at the midpoint u = pi (i + 1/2) / rows: (sin u, cos u).
+vec2 cosine_row(uint i, uint rows) {
+    float u = PI * (float(i) + 0.5) / float(rows);
+    return vec2(sin(u), cos(u));
+}
+
+// The pseudo-angle -s / (|s| + t) of the direction (s, t), t >= 0: monotone in beta, 0 at gamma = 0.
+float pseudo_angle(float s, float t) {
+    return -s / (abs(s) + t);
+}
+
+// gamma of a pseudo-angle: atan2(k, 1 - |k|).
+float gamma_of(float k) {
+    return atan2_accurate(k, max(1.0 - abs(k), 0.0));
+}
+
+// The pseudo-angle of gamma: that of (-sin gamma, cos gamma).
+float pseudo_angle_of_gamma(float g) {
+    return pseudo_angle(-sin(g), cos(g));
+}
+
+// The interval of gamma in [-pi/2, pi/2] where n.omega >= 0 (slices_about_centre::above_about_centre).
+vec2 above_about_centre(float n_c, float n_p) {
+    if (n_c > 0.0) {
+        return vec2(-0.5 * PI, atan2_accurate(n_p, n_c));
+    }
+    if (n_c < 0.0) {
+        return vec2(atan2_accurate(-n_p, -n_c), 0.5 * PI);
+    }
+    return n_p >= 0.0 ? vec2(-0.5 * PI, 0.5 * PI) : vec2(0.5 * PI, -0.5 * PI);
+}
+
+// The integral over [g0, g1] of (n_p cos gamma - n_c sin gamma) cos gamma: no cancellation on a short interval.
+float weight_integral_about_centre(float n_c, float n_p, float g0, float g1) {
+    if (g1 <= g0) {
+        return 0.0;
+    }
+    float d = g1 - g0;
+    float s = g0 + g1;
+    return 0.5 * n_p * (d + sin(d) * cos(s)) - 0.5 * n_c * sin(d) * sin(s);
+}
+
+// One edge j -> k of slice_segment: the corner j where it lies in the plane, the edge's crossing where it
+// crosses, interpolated from the corner below the plane whichever way the edge runs, so that two triangles
+// sharing the edge (running it in opposite directions) find bitwise the same point: their intervals then touch
+// exactly and merge, where rounding would leave an ulp's gap between them (a piece more in the row's union).
+#define SLICE_EDGE(dj, dk, xj, xk) \
+    if (dj == 0.0) { \
+        points[n] = vec2(dot(xj, c), dot(xj, p)); \
+        n += 1u; \
+    } \
+    if ((dj < 0.0 && dk > 0.0) || (dj > 0.0 && dk < 0.0)) { \
+        vec3 below = dj < 0.0 ? (xj) : (xk); \
+        vec3 above_ = dj < 0.0 ? (xk) : (xj); \
+        float d_below = min(dj, dk); \
+        vec3 x = below + (d_below / (d_below - max(dj, dk))) * (above_ - below); \
+        points[n] = vec2(dot(x, c), dot(x, p)); \
+        n += 1u; \
+    }
+
+// The segment in which the plane through the origin of unit normal m cuts the triangle (a, b, d) (corners
+// relative to the origin [m]), in the plane's coordinates (s, t) = (x.c, x.p): false where it misses it, touches
+// a corner or holds it. The three edges written out (a loop would spend llvmpipe's budget).
+bool slice_segment(vec3 a, vec3 b, vec3 d, vec3 c, vec3 p, vec3 m, out vec2 e0, out vec2 e1) {
+    float da = dot(a, m);
+    float db = dot(b, m);
+    float dd = dot(d, m);
+    vec2 points[3];
+    uint n = 0u;
+    SLICE_EDGE(da, db, a, b)
+    SLICE_EDGE(db, dd, b, d)
+    SLICE_EDGE(dd, da, d, a)
+    e0 = points[0];
+    e1 = points[1];
+    return n == 2u;
+}
+
+// The interval of pseudo-angles that the segment (e0, e1) of the half-plane t >= 0 blocks, clipped to t >= 0;
+// false where nothing of it lies there or it passes through the origin.
+bool segment_interval(vec2 e0, vec2 e1, out vec2 interval) {
+    interval = vec2(0.0);
+    if (e0.y < 0.0 && e1.y < 0.0) {
+        return false;
+    }
+    if (e0.y < 0.0) {
+        e0 = vec2(e0.x + (e1.x - e0.x) * (-e0.y / (e1.y - e0.y)), 0.0);
+    } else if (e1.y < 0.0) {
+        e1 = vec2(e1.x + (e0.x - e1.x) * (-e1.y / (e0.y - e1.y)), 0.0);
+    }
+    float cross_ = e0.x * e1.y - e1.x * e0.y;
+    if (e0 == vec2(0.0) || e1 == vec2(0.0) || (cross_ == 0.0 && dot(e0, e1) < 0.0)) {
+        return false;
+    }
+    float k0 = pseudo_angle(e0.x, e0.y);
+    float k1 = pseudo_angle(e1.x, e1.y);
+    interval = vec2(min(k0, k1), max(k0, k1));
+    return true;
+}
+
+// The interval of pseudo-angles that the triangle (a, b, d) blocks for rays to a light at infinity.
+bool blocked_interval(vec3 a, vec3 b, vec3 d, vec3 c, vec3 p, vec3 m, out vec2 interval) {
+    vec2 e0;
+    vec2 e1;
+    interval = vec2(0.0);
+    return slice_segment(a, b, d, c, p, m, e0, e1) && segment_interval(e0, e1, interval);
+}
+
+// The weight over span (gamma) less the union of the row's `count` blocked intervals (slice_blocked, sorted here
+// by their starts: an insertion sort, a row holding a few), by the gaps between them.
+float visible_weight_about_centre(float n_c, float n_p, vec2 span, uint count) {
+    for (uint i = 1u; i < count; ++i) {
+        vec2 x = slice_blocked[i];
+        uint j = i;
+        while (j > 0u && slice_blocked[j - 1u].x > x.x) {
+            slice_blocked[j] = slice_blocked[j - 1u];
+            j -= 1u;
+        }
+        slice_blocked[j] = x;
+    }
+    float key_lo = pseudo_angle_of_gamma(span.x);
+    float key_hi = pseudo_angle_of_gamma(span.y);
+    float visible = 0.0;
+    float reached = key_lo;
+    float at_reached = span.x;
+    for (uint i = 0u; i < count; ++i) {
+        vec2 b = slice_blocked[i];
+        if (b.x >= key_hi) {
+            break;
+        }
+        if (b.x > reached) {
+            visible += weight_integral_about_centre(n_c, n_p, at_reached, gamma_of(b.x));
+        }
+        if (b.y > reached) {
+            reached = b.y;
+            at_reached = gamma_of(b.y);
+        }
+    }
+    if (reached < key_hi) {
+        visible += weight_integral_about_centre(n_c, n_p, at_reached, span.y);
+    }
+    return visible;
+}
+
+// Whether a sphere (centre relative to the apex [m], radius [m]) may meet the cone of unit axis `axis` and
+// half-angle of cosine cos_a and sine sin_a: its angular radius added to the cone's, a slack of 1e-5 of the
+// distance for f32's rounding (the Rust's is 1e-9).
+bool sphere_meets_cone(vec3 centre, float r, vec3 axis, float cos_a, float sin_a) {
+    float dist = length(centre);
+    if (dist <= r) {
+        return true;
+    }
+    float sin_p = r / dist;
+    float cos_p = sqrt(max(1.0 - sin_p * sin_p, 0.0));
+    float sin_t = sin_a * cos_p + cos_a * sin_p;
+    float cos_t = cos_a * cos_p - sin_a * sin_p;
+    float along = dot(centre, axis);
+    float across = length(cross(centre, axis));
+    float slack = 1e-5 * dist;
+    return cos_t > 0.0 ? (along > -slack && across <= sin_t * dist + slack) : along >= cos_t * dist - slack;
+}
+
+// Whether a node's box reaches above the surface (n) and in front of the sun (l) from `origin` and may meet the
+// sun's cone: the box's centre's signed distance plus its half-extent projected on the normal, positive within a
+// slack of 1e-5 of the box's size and distance (f32's rounding; the boxes are padded too).
+bool within_reach(BvhNode node, vec3 origin, vec3 n, vec3 l, float cos_s, float sin_s) {
+    vec3 centre = 0.5 * (node.lo + node.hi) - origin;
+    vec3 half_extent = 0.5 * (node.hi - node.lo);
+    float slack = 1e-5 * (length(centre) + length(half_extent));
+    return dot(centre, n) + dot(half_extent, abs(n)) > -slack && dot(centre, l) + dot(half_extent, abs(l)) > -slack
+        && sphere_meets_cone(centre, length(half_extent), l, cos_s, sin_s);
+}
+
+// A leaf's triangle into the gathered ones: count -1 where it is alpha-masked or the array is full.
+#define GATHER_LEAF(leaf) \
+    { \
+        uvec4 tri = occluder_triangles[(leaf).first]; \
+        if (materials[tri.w & 0x7fffffffu].kind.z != 0u || count >= MAX_SLICE_TRIANGLES) { \
+            return -1; \
+        } \
+        vec3 a = OCCLUDER_CORNER(tri.x) - origin; \
+        vec3 b = OCCLUDER_CORNER(tri.y) - origin; \
+        vec3 d = OCCLUDER_CORNER(tri.z) - origin; \
+        if (max(max(dot(a, n), dot(b, n)), dot(d, n)) > 0.0 && max(max(dot(a, l), dot(b, l)), dot(d, l)) > 0.0) { \
+            slice_corners[3 * count] = a; \
+            slice_corners[3 * count + 1] = b; \
+            slice_corners[3 * count + 2] = d; \
+            count += 1; \
+        } \
+    }
+#define GATHER_CHILD(ch) \
+    { \
+        BvhNode child = bvh_nodes[ch]; \
+        if (within_reach(child, origin, n, l, cos_s, sin_s)) { \
+            if (child.count == 0u) { \
+                stack[top] = (ch); \
+                top += 1u; \
+            } else GATHER_LEAF(child) \
+        } \
+    }
+
+// The triangles of one walk within reach (within_reach) into slice_corners: their count, or -1 (module text).
+// A node taken from the stack is one iteration of the budget, as in any_hit.
+int gather(vec3 origin, vec3 n, vec3 l, float cos_s, float sin_s) {
+    int count = 0;
+    BvhNode root = bvh_nodes[0];
+    if (!within_reach(root, origin, n, l, cos_s, sin_s)) {
+        return 0;
+    }
+    if (root.count > 0u) {
+        GATHER_LEAF(root)
+        return count;
+    }
+    uint stack[BVH_STACK_SIZE];
+    uint top = 1u;
+    stack[0] = 0u;
+    while (top > 0u) {
+        top -= 1u;
+        BvhNode node = bvh_nodes[stack[top]];
+        GATHER_CHILD(node.first)
+        GATHER_CHILD(node.first + 1u)
+    }
+    return count;
+}
+
+// Row i's u = pi (i + 1/2) / rows as a real index, u rows / pi - 1/2, of the direction psi of the rows
+// psi = -sigma cos u (clamped to the rows' range): cos u = -psi / sigma, u = acos as an atan2.
+float row_of_psi(float psi, float sigma, uint rows) {
+    float x = clamp(-psi / sigma, -1.0, 1.0);
+    return atan2_accurate(sqrt(max(1.0 - x * x, 0.0)), x) * float(rows) / PI - 0.5;
+}
+
+// The rows whose half-plane may cut the triangle (a, b, d) (corners relative to the origin [m]), as
+// (first, last): the triangle's azimuth range about the axis c, psi = atan(x.q / x.l) over its corners, where every
+// corner lies in front (x.l > 0: its projection along c then lies in the half-plane x.l > 0, whose azimuths from
+// the origin form an interval); every row otherwise. Widened by a row on each side (floor, ceil) for rounding; an
+// empty range (first > last) where the triangle lies wholly to one side of the rows. (The reference files the
+// triangles under rows by their diamond-angle arcs, slice_buckets; the rows found are the same but at the ends.)
+uvec2 slice_row_range(vec3 a, vec3 b, vec3 d, vec3 l, vec3 q, float sigma, uint rows) {
+    vec3 along = vec3(dot(a, l), dot(b, l), dot(d, l));
+    if (min(min(along.x, along.y), along.z) <= 0.0) {
+        return uvec2(0u, rows - 1u);
+    }
+    vec3 tau = vec3(dot(a, q), dot(b, q), dot(d, q)) / along;
+    float psi_lo = atan2_accurate(min(min(tau.x, tau.y), tau.z), 1.0);
+    float psi_hi = atan2_accurate(max(max(tau.x, tau.y), tau.z), 1.0);
+    if (psi_lo > sigma || psi_hi < -sigma) {
+        return uvec2(1u, 0u);
+    }
+    float lo = floor(row_of_psi(psi_lo, sigma, rows));
+    float hi = ceil(row_of_psi(psi_hi, sigma, rows));
+    return uvec2(uint(clamp(lo, 0.0, float(rows - 1u))), uint(clamp(hi, 0.0, float(rows - 1u))));
+}
+
+// The gathered triangles' row ranges and keys along the chords, and the order of those with rows by key.
+uvec2 slice_ranges[MAX_SLICE_TRIANGLES];
+float slice_keys[MAX_SLICE_TRIANGLES];
+uint slice_order[MAX_SLICE_TRIANGLES];
+
+// A row's blocked intervals as they come, merged into at most UNION_PIECES disjoint pieces sorted by start
+// (`union_piece`); an interval that would make one piece too many is set aside (slice_blocked, `spilled` of
+// them), and the row's walk then takes the pieces and those together, sorted (visible_weight_about_centre: the
+// same union). Eight steps written out, no loop: llvmpipe's budget pays nothing for them, where a sort pays about
+// m^2/4 for m intervals (a penumbra's row through a tessellated sphere's limb holds some fifty, their union one
+// or two pieces, but arriving out of order they make more on the way: with four pieces, most rows there spilled).
+#define UNION_PIECES 8u
+#define UNION_STEP(k) \
+    if (k < pieces) { \
+        vec2 piece = union_piece[k]; \
+        if (piece.y < cur.x) { \
+            merged[merged_count] = piece; \
+            merged_count += 1u; \
+        } else if (piece.x > cur.y) { \
+            if (!placed) { \
+                merged[merged_count] = cur; \
+                merged_count += 1u; \
+                placed = true; \
+            } \
+            merged[merged_count] = piece; \
+            merged_count += 1u; \
+        } else { \
+            cur = vec2(min(cur.x, piece.x), max(cur.y, piece.y)); \
+        } \
+    }
+#define UNION_INSERT(interval) \
+    { \
+        vec2 cur = interval; \
+        vec2 merged[UNION_PIECES + 1u]; \
+        uint merged_count = 0u; \
+        bool placed = false; \
+        UNION_STEP(0u) \
+        UNION_STEP(1u) \
+        UNION_STEP(2u) \
+        UNION_STEP(3u) \
+        UNION_STEP(4u) \
+        UNION_STEP(5u) \
+        UNION_STEP(6u) \
+        UNION_STEP(7u) \
+        if (!placed) { \
+            merged[merged_count] = cur; \
+            merged_count += 1u; \
+        } \
+        if (merged_count > UNION_PIECES) { \
+            slice_blocked[spilled] = interval; \
+            spilled += 1u; \
+        } else { \
+            union_piece[0] = merged[0]; \
+            union_piece[1] = merged[1]; \
+            union_piece[2] = merged[2]; \
+            union_piece[3] = merged[3]; \
+            union_piece[4] = merged[4]; \
+            union_piece[5] = merged[5]; \
+            union_piece[6] = merged[6]; \
+            union_piece[7] = merged[7]; \
+            pieces = merged_count; \
+        } \
+    }
+
+// The triangle at `w` of the order, cut by row i's plane where its row range holds the row: its interval kept
+// where it meets the span, into the union; `hidden` once the union covers the span (an umbra's rows, mostly).
+#define SLICE_TRIANGLE(w) \
+    if (!hidden && (w) < count) { \
+        uint j = slice_order[w]; \
+        vec2 interval; \
+        if (slice_ranges[j].x <= i && slice_ranges[j].y >= i \
+            && blocked_interval(slice_corners[3u * j], slice_corners[3u * j + 1u], slice_corners[3u * j + 2u], c, p, \
+                                m, interval) \
+            && interval.y > key_lo && interval.x < key_hi) { \
+            UNION_INSERT(interval) \
+            hidden = pieces == 1u && union_piece[0].x <= key_lo && union_piece[0].y >= key_hi; \
+        } \
+    }
+
+// The sun's cosine-weighted visible fraction from `origin` on a surface of unit normal n, the sun in unit
+// direction l with angular diameter [rad], by `rows` slices; SLICES_UNSLICEABLE where they cannot be taken
+// (module text). 1 where the walk gathers nothing. The same rows, chords, intervals and gaps as the Rust's, so the
+// same sums but for f32's rounding.
+float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows) {
+    float sigma = 0.5 * angular_diameter;
+    vec3 c = sun_slice_axis(l);
+    vec3 q = cross(c, l);
+    int gathered = gather(origin, n, l, cos(sigma), sin(sigma));
+    if (gathered < 0) {
+        return SLICES_UNSLICEABLE;
+    }
+    // The triangles that some row may cut, sorted by where they lie along the chords (the pseudo-angle of their
+    // centroid about the axis, seen along l): a row then meets its intervals nearly in order, so that the union
+    // grows at its ends rather than in pieces (Shell's sort, Ciura's gaps: about count^1.25 of the budget where
+    // insertion would take count^2 / 4).
+    uint count = 0u;
+    for (uint j = 0u; j < uint(gathered); ++j) {
+        vec3 a = slice_corners[3u * j];
+        vec3 b = slice_corners[3u * j + 1u];
+        vec3 d = slice_corners[3u * j + 2u];
+        uvec2 range = slice_row_range(a, b, d, l, q, sigma, rows);
+        slice_ranges[j] = range;
+        vec3 g = a + b + d;
+        slice_keys[j] = pseudo_angle(dot(g, c), max(dot(g, l), 0.0));
+        if (range.x <= range.y) {
+            slice_order[count] = j;
+            count += 1u;
+        }
+    }
+    if (count == 0u) {
+        return 1.0;
+    }
+    const uint gaps[4] = uint[](23u, 10u, 4u, 1u);
+    for (uint g = 0u; g < 4u; ++g) {
+        uint gap = gaps[g];
+        for (uint a = gap; a < count; ++a) {
+            uint x = slice_order[a];
+            uint b = a;
+            while (b >= gap && slice_keys[slice_order[b - gap]] > slice_keys[x]) {
+                slice_order[b] = slice_order[b - gap];
+                b -= gap;
+            }
+            slice_order[b] = x;
+        }
+    }
+    float n_c = dot(n, c);
+    float visible = 0.0;
+    float total = 0.0;
+    for (uint i = 0u; i < rows; ++i) {
+        vec2 su = cosine_row(i, rows);
+        float psi = -sigma * su.y;
+        vec3 p = cos(psi) * l + sin(psi) * q;
+        float jacobian = sigma * su.x;
+        float chi = chord_half_width(sigma, psi);
+        float n_p = dot(n, p);
+        vec2 surface = above_about_centre(n_c, n_p);
+        vec2 span = vec2(max(-chi, surface.x), min(chi, surface.y));
+        float whole = jacobian * weight_integral_about_centre(n_c, n_p, span.x, span.y);
+        if (whole <= 0.0) {
+            continue;
+        }
+        vec3 m = cross(c, p);
+        float key_lo = pseudo_angle_of_gamma(span.x);
+        float key_hi = pseudo_angle_of_gamma(span.y);
+        uint pieces = 0u;
+        vec2 union_piece[UNION_PIECES];
+        uint spilled = 0u;
+        bool hidden = false;
+        // Four triangles an iteration (SLICE_TRIANGLE written out four times): the budget counts iterations.
+        for (uint w = 0u; w < count && !hidden; w += 4u) {
+            SLICE_TRIANGLE(w)
+            SLICE_TRIANGLE(w + 1u)
+            SLICE_TRIANGLE(w + 2u)
+            SLICE_TRIANGLE(w + 3u)
+        }
+        if (hidden) {
+            total += whole;
+            continue;
+        }
+        // The pieces after the intervals set aside (sorted below with them; alone, the sort moves nothing).
+        uint blocked = spilled + pieces;
+        for (uint k = 0u; k < UNION_PIECES; ++k) {
+            if (k < pieces) {
+                slice_blocked[spilled + k] = union_piece[k];
+            }
+        }
+        visible += blocked == 0u ? whole : jacobian * visible_weight_about_centre(n_c, n_p, span, blocked);
+        total += whole;
+    }
+    return fraction(visible, total);
+}
+
+#endif
