@@ -16,8 +16,9 @@
 // iterations for m intervals. So (measured on sunset.glb at 96 x 72, Mesa 22.3.6): the triangles are ordered once
 // by where they lie along the chords; each row cuts them four an iteration (the loop's body written out four
 // times) and merges its intervals as they come into at most UNION_PIECES sorted disjoint pieces, steps written out
-// (no loop), sorting only where more pieces would be needed. Then 4 k^2 rows fit the budget up to k = 6 there
-// (144 rows; 256 rows cut 8 pixels short, which the renderer refuses), where the sort alone stopped at 64 rows.
+// (no loop), sorting only the intervals that would have made more pieces, with the pieces. Then 4 k^2 rows fit the
+// budget up to k = 13 there (676 rows; 1444 cut 4 pixels short, which the renderer refuses), where sorting every
+// row's intervals stopped at 64 rows.
 #ifndef SUNSHADE_SUN_SLICES_GLSL
 #define SUNSHADE_SUN_SLICES_GLSL
 

@@ -142,7 +142,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
             warning: false,
         };
     }
-    let slices = a.visibility_rule == Some(crate::shading::VisibilityRule::Slices);
+    let rule =
+        a.visibility_rule.unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, r.device_info()));
+    let slices = rule == crate::shading::VisibilityRule::Slices;
     if slices && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
         // Slices take the place of shadow rays: `auto` casts them on any device.
         choice = crate::visibility::ShadowChoice {
@@ -153,15 +155,16 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
             warning: false,
         };
     }
+    if slices {
+        choice.reason += "; the sun's visible fraction by slices of its disk (--visibility slices)";
+    }
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
     }
     let mut settings = settings;
     settings.shading.shadows = choice.technique;
-    if let Some(rule) = a.visibility_rule {
-        // Refused at the render where the GPU cannot take it (`Renderer::shadow_choice`).
-        settings.shading.visibility_rule = rule;
-    }
+    // Refused at the render where the GPU cannot take it (`Renderer::shadow_choice`).
+    settings.shading.visibility_rule = rule;
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     // The reference mirroring the device, for the bound of f32 interpolation.
     let reference = device_reference_options(r.device_info(), a);
@@ -204,6 +207,26 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let prediction = done.prediction;
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
+}
+
+/// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
+/// (`--tolerance-in-penumbrae`) and the GPU can take them for every light that casts shadows (the disk sun, no disk
+/// light or sky, no alpha-masked occluders, a device whose fragment shader walks the BVH), as the reference
+/// defaults to them there; the grid otherwise.
+fn default_visibility(
+    a: &SceneArgs,
+    settings: &RenderSettings,
+    scene: &crate::scene::Scene,
+    device: &crate::gpu::DeviceInfo,
+) -> crate::shading::VisibilityRule {
+    let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae);
+    let sun_alone = settings.lights.sun.is_some() && settings.lights.disks.is_empty() && settings.lights.sky.is_none();
+    let sliceable = settings.shading.sun == crate::shading::SunModel::Disk && !scene.has_alpha_masks();
+    if in_penumbrae && sun_alone && sliceable && !device.ray_query && a.shadows != Shadows::Map {
+        crate::shading::VisibilityRule::Slices
+    } else {
+        crate::shading::VisibilityRule::Grid
+    }
 }
 
 /// Why `--tolerance` stopped at a render the device's loop limiter refused (`why`): `settings` holds that render's
