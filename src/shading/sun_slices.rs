@@ -1,5 +1,6 @@
 //! The sun's visible fraction by slices: the sky's rule (`sky_slices`) on the sun's disk, for the reference's
-//! truth in the sun's penumbrae, where a grid of rays converges slowly. No GPU mirror.
+//! truth in the sun's penumbrae, where a grid of rays converges slowly; the GPU's too, where its fragment shader
+//! walks the occluders' BVH (below).
 //!
 //! The sun is the cap of half-angle `σ = δ/2` about `l`. The slices are half great circles through an axis
 //! `c ⊥ l` ([`sun_slice_axis`]): `ω(β, ψ) = cos β c + sin β p(ψ)`, `p(ψ) = cos ψ l + sin ψ q`, `q = c × l`, so that
