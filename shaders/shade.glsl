@@ -67,7 +67,7 @@ vec3 irradiance_visible(Frame p) {
             if (VARIANT_SUN == SUN_DELTA) {
                 v = visible_along(p.shadow_origin, l) ? 1.0 : 0.0;
             } else {
-                // By slices where asked and the shader walks the BVH itself (sun_slices.glsl; `4 k^2` rows, as
+                // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
                 // sky_slices::slice_rows), the grid where they cannot be taken.
                 v = -1.0;
 #ifdef SUNSHADE_RAY_BVH
@@ -95,9 +95,22 @@ vec3 irradiance_visible(Frame p) {
             : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
         float v = 1.0;
         if (SHADOWS_ON && omega > 0.0) {
-            v = VARIANT_DISKS == DISKS_SMALL_SOURCE
-                ? (visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0)
-                : disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+            if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
+                v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
+            } else {
+                // By slices where asked and the shader walks the BVH itself, as the sun's.
+                v = -1.0;
+#ifdef SUNSHADE_RAY_BVH
+                if (lights.sampling.w == VISIBILITY_SLICES) {
+                    v = disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
+                                                     d.center_radius.w, 4u * k * k);
+                }
+#endif
+                if (v < 0.0) {
+                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
+                                              d.direction.xyz, d.center_radius.w);
+                }
+            }
         }
         if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
             bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;

@@ -94,7 +94,7 @@ float fraction(float visible, float total) {
 }
 
 #ifdef SUNSHADE_RAY_BVH
-#include "sun_slices.glsl"
+#include "slices.glsl"
 #endif
 
 // The sun's sample through the point xy of the unit disk, in the frame (t, b) about l: its direction (omega) and

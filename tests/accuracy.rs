@@ -933,7 +933,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
         };
         assert!(e.contains("penumbrae included"), "{e}");
         assert!(!e.contains("not bounded"), "{e}");
-        assert_eq!(e.contains("by slices of its disk"), walks, "{e}");
+        assert_eq!(e.contains("visible fractions by slices"), walks, "{e}");
         let (measured, line) = common::error_against_fine(&out, &scene, &s, &e);
         eprintln!("sunset.glb, T = {t:e} in penumbrae: measured {measured:.2e} against the fine render; {line}");
         assert!(measured <= t, "{measured:.3e} over {t:e}\n{e}");

@@ -161,8 +161,8 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         // The occluders: the BVH walk and the watertight test (src/visibility), and which hits block a ray
         // (src/cpu/occluders.rs, the reference's occluders).
         ("occluders.glsl", &["src/visibility", "src/cpu"]),
-        // The sun's slices: the rule (src/shading) and the walk's reach (src/visibility/bvh.rs).
-        ("sun_slices.glsl", &["src/shading", "src/visibility"]),
+        // The sun's and disk lights' slices: the rule (src/shading) and the walk's reach (src/visibility/bvh.rs).
+        ("slices.glsl", &["src/shading", "src/visibility"]),
     ];
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
     // replacements for lavapipe's inaccurate built-ins (Rust uses f64's); the shadow map (the reference casts rays,

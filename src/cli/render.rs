@@ -33,12 +33,13 @@ pub struct RenderArgs {
     /// ~/.cache/sunshade).
     #[arg(help_heading = "Device", long)]
     pub no_cache: bool,
-    /// How the sun's visible fraction through occluders is taken with shadow rays: `grid` (the located grid of
-    /// --shadow-samples rays, the default) or `slices` (exact across the sun's disk along one angle, a midpoint
-    /// rule of 4k² rows along the other, for k² = --shadow-samples: second order in the rows where every occluder
-    /// is opaque, as `sunshade reference --visibility slices` takes it). On devices without ray queries, whose
-    /// fragment shader walks the occluders' BVH, and for the sun's disk only: refused where a disk light or the sky
-    /// casts shadows (the reference slices those).
+    /// How the sun's and disk lights' visible fractions through occluders are taken with shadow rays: `grid` (the
+    /// located grids of --shadow-samples rays) or `slices` (exact across the light along one angle, a midpoint rule
+    /// of 4k² rows along the other, for k² = --shadow-samples: second order in the rows where every occluder is
+    /// opaque, as `sunshade reference --visibility slices` takes them; a pixel whose light's cone holds more than
+    /// 256 triangles casts the grid's rays). On devices without ray queries, whose fragment shader walks the
+    /// occluders' BVH; refused where the sky casts shadows (the reference slices it). Default: slices with
+    /// --tolerance-in-penumbrae where those hold, else the grid.
     #[arg(long = "visibility", value_name = "grid|slices", help_heading = "Shadows")]
     pub visibility_rule: Option<crate::shading::VisibilityRule>,
     /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
@@ -149,14 +150,14 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         // Slices take the place of shadow rays: `auto` casts them on any device.
         choice = crate::visibility::ShadowChoice {
             technique: Shadows::Ray,
-            reason: "auto with --visibility slices: the sun's visible fraction by slices of its disk (the device has \
+            reason: "auto with --visibility slices: the lights' visible fractions by slices (the device has \
                      no ray queries: the fragment shader walks the occluders' BVH)"
                 .into(),
             warning: false,
         };
     }
     if slices {
-        choice.reason += "; the sun's visible fraction by slices of its disk (--visibility slices)";
+        choice.reason += "; the sun's and disk lights' visible fractions by slices (--visibility slices)";
     }
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
@@ -210,8 +211,8 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
-/// (`--tolerance-in-penumbrae`) and the GPU can take them for every light that casts shadows (the disk sun, no disk
-/// light or sky, no alpha-masked occluders, a device whose fragment shader walks the BVH), as the reference
+/// (`--tolerance-in-penumbrae`) and the GPU can take them for every light that casts shadows (the sun and disk
+/// lights, no sky, no alpha-masked occluders, a device whose fragment shader walks the BVH), as the reference
 /// defaults to them there; the grid otherwise.
 fn default_visibility(
     a: &SceneArgs,
@@ -220,9 +221,8 @@ fn default_visibility(
     device: &crate::gpu::DeviceInfo,
 ) -> crate::shading::VisibilityRule {
     let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae);
-    let sun_alone = settings.lights.sun.is_some() && settings.lights.disks.is_empty() && settings.lights.sky.is_none();
-    let sliceable = settings.shading.sun == crate::shading::SunModel::Disk && !scene.has_alpha_masks();
-    if in_penumbrae && sun_alone && sliceable && !device.ray_query && a.shadows != Shadows::Map {
+    let lights = (settings.lights.sun.is_some() || !settings.lights.disks.is_empty()) && settings.lights.sky.is_none();
+    if in_penumbrae && lights && !scene.has_alpha_masks() && !device.ray_query && a.shadows != Shadows::Map {
         crate::shading::VisibilityRule::Slices
     } else {
         crate::shading::VisibilityRule::Grid

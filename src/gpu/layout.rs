@@ -22,8 +22,8 @@ pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
-/// The sun's visibility rule with shadow rays (`lights.sampling.w`): the located grid, or slices
-/// (shaders/sun_slices.glsl, where the fragment shader walks the occluders' BVH; elsewhere the grid).
+/// The sun's and disk lights' visibility rule with shadow rays (`lights.sampling.w`): the located grid, or slices
+/// (shaders/slices.glsl, where the fragment shader walks the occluders' BVH; elsewhere the grid).
 pub const VISIBILITY_GRID: u32 = 0;
 pub const VISIBILITY_SLICES: u32 = 1;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.

@@ -429,17 +429,17 @@ impl Renderer {
     }
 
     /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: without shadow
-    /// rays, on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where a
-    /// disk light or the sky casts shadows (the GPU slices the sun's disk only, shaders/sun_slices.glsl; a
-    /// comparison with the reference would set unlike rules side by side).
+    /// rays, on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where the
+    /// sky casts shadows (the GPU slices the sun's disk and disk lights, shaders/slices.glsl; a comparison with the
+    /// reference would set unlike rules side by side).
     fn check_slices(&self, technique: Shadows, settings: &RenderSettings) -> Result<(), GpuError> {
         let why = if technique != Shadows::Ray {
             "slices take the place of shadow rays (--shadows ray)"
         } else if !self.pipeline.rays_walk_bvh() {
             "the GPU takes slices where its fragment shader walks the occluders' BVH (devices without ray queries), \
              and this one has ray queries"
-        } else if !settings.lights.disks.is_empty() || settings.lights.sky.is_some() {
-            "the GPU slices the sun's disk only, and a disk light or the sky casts shadows here"
+        } else if settings.lights.sky.is_some() {
+            "the GPU slices the sun's disk and disk lights, not the sky, which casts shadows here"
         } else {
             return Ok(());
         };

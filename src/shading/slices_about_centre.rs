@@ -1,5 +1,5 @@
 //! A light's slices measured from the chords' middle: the angle `γ = β − π/2` in place of `β` (`sky_slices`), the
-//! formulation the GPU's sun slices use in f32 (shaders/sun_slices.glsl, which mirrors these names).
+//! formulation the GPU's sun slices use in f32 (shaders/slices.glsl, which mirrors these names).
 //!
 //! **Why.** The sun's chords lie within its half-angle σ (0.0046 rad) of `β = π/2`. In f32, `β` there carries an
 //! absolute error of an ulp of π/2, 1.2e-7 rad, which is 1.3e-5 of a chord, and a short interval's `b1 − b0` loses

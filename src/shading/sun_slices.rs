@@ -19,7 +19,7 @@
 //! The weight is the grid's (`visibility::sun_sample`: `(n·ω)⁺` per solid angle), so both rules estimate the same
 //! fraction.
 //!
-//! **On the GPU** (shaders/sun_slices.glsl, where the fragment shader walks the occluders' BVH): the same rows,
+//! **On the GPU** (shaders/slices.glsl, where the fragment shader walks the occluders' BVH): the same rows,
 //! chords and intervals in f32, the chords measured from their middle (`slices_about_centre`), and each gathered
 //! triangle cut only in the rows of its azimuth range ([`slice_row_range`], where this file files triangles under
 //! rows by `slice_buckets`' diamond-angle arcs).
@@ -61,26 +61,33 @@ pub fn row_of_psi(psi: f64, sigma: f64, rows: u32) -> f64 {
     x.acos() * rows as f64 / std::f64::consts::PI - 0.5
 }
 
-/// The rows (of `rows` across the sun of half-angle `sigma`, frame `(l, q)` across the slicing axis) whose
-/// half-plane may cut the triangle `tri` (corners relative to the rays' origin \[m\]), as `(first, last)`, or `None`
-/// where none can: its azimuth range about the axis, `ψ = atan((x·q)/(x·l))` over its corners, where every corner
-/// lies in front (`x·l > 0`: the projection along the axis then lies in the half-plane `x·l > 0`, where the
-/// azimuths seen from the origin form an interval), every row otherwise; widened by a row each side (floor and
-/// ceiling) for rounding. The GPU's filing of triangles under rows (shaders/sun_slices.glsl).
-pub fn slice_row_range(tri: &[DVec3; 3], l: DVec3, q: DVec3, sigma: f64, rows: u32) -> Option<(u32, u32)> {
+/// The rows (of `rows` along `ψ = ψ_mid − ψ_half cos u` in the frame `(h, q)` across the slicing axis: the sun's
+/// with `(0, σ)`, a disk light's with its `psi_range`) whose half-plane may cut the triangle `tri` (corners
+/// relative to the rays' origin \[m\]), as `(first, last)`, or `None` where none can: its azimuth range about the
+/// axis, `ψ = atan((x·q)/(x·h))` over its corners, where every corner lies in front (`x·h > 0`: the projection
+/// along the axis then lies in the half-plane `x·h > 0`, where the azimuths seen from the origin form an
+/// interval), every row otherwise; widened by a row each side (floor and ceiling) for rounding. The GPU's filing of
+/// triangles under rows (shaders/slices.glsl).
+pub fn slice_row_range(
+    tri: &[DVec3; 3],
+    h: DVec3,
+    q: DVec3,
+    (psi_mid, psi_half): (f64, f64),
+    rows: u32,
+) -> Option<(u32, u32)> {
     let last = rows.max(1) - 1;
-    let along = tri.map(|x| x.dot(l));
+    let along = tri.map(|x| x.dot(h));
     if along.iter().any(|&a| a <= 0.0) {
         return Some((0, last));
     }
     let tau = [0, 1, 2].map(|j| tri[j].dot(q) / along[j]);
-    let psi_lo = tau.iter().copied().fold(f64::INFINITY, f64::min).atan();
-    let psi_hi = tau.iter().copied().fold(f64::NEG_INFINITY, f64::max).atan();
-    if psi_lo > sigma || psi_hi < -sigma {
+    let psi_lo = tau.iter().copied().fold(f64::INFINITY, f64::min).atan() - psi_mid;
+    let psi_hi = tau.iter().copied().fold(f64::NEG_INFINITY, f64::max).atan() - psi_mid;
+    if psi_lo > psi_half || psi_hi < -psi_half {
         return None;
     }
     let index = |r: f64| r.clamp(0.0, last as f64) as u32;
-    Some((index(row_of_psi(psi_lo, sigma, rows).floor()), index(row_of_psi(psi_hi, sigma, rows).ceil())))
+    Some((index(row_of_psi(psi_lo, psi_half, rows).floor()), index(row_of_psi(psi_hi, psi_half, rows).ceil())))
 }
 
 /// The sun's cosine-weighted visible fraction from `s.origin` on a surface of unit normal `n`, the sun in unit
@@ -146,8 +153,9 @@ mod tests {
 
     #[test]
     fn a_triangle_is_cut_only_by_the_rows_of_its_range() {
-        // Random small and large triangles about the sun's cone: every row whose half-plane cuts one (the exact
-        // test, `slice_segment` with t ≥ 0) lies in its range, and the ranges leave rows out.
+        // Random small and large triangles about the rows' middle (the sun's rows and a disk light's): every row
+        // whose half-plane cuts one (the exact test, `slice_segment` with t ≥ 0) lies in its range, and the ranges
+        // leave rows out.
         use crate::shading::sky_slices::{cosine_rows, slice_segment};
         let mut next = crate::test_rng::uniform(17);
         let l = DVec3::new(0.3, 0.4, -0.2).normalize();
@@ -155,24 +163,28 @@ mod tests {
         let q = c.cross(l);
         let sigma = 0.5 * 0.53f64.to_radians();
         let rows = 64;
-        let made = cosine_rows(l, q, (0.0, sigma), rows);
-        let (mut cut, mut left_out) = (0, 0);
-        for _ in 0..3000 {
-            let dist = 1.0 + 20.0 * next().abs();
-            let size = if next() > 0.0 { 0.002 * dist * next().abs() } else { 2.0 * next().abs() };
-            let centre = dist * l + 0.01 * dist * (next() * q + next() * c);
-            let tri = [0; 3].map(|_| centre + size * DVec3::new(next(), next(), next()));
-            let range = slice_row_range(&tri, l, q, sigma, rows);
-            for (i, r) in made.iter().enumerate() {
-                let m = c.cross(r.p);
-                let hit = slice_segment(tri, c, r.p, m).is_some_and(|[a, b]| a.1 > 0.0 || b.1 > 0.0);
-                let inside = range.is_some_and(|(lo, hi)| (lo as usize..=hi as usize).contains(&i));
-                assert!(!hit || inside, "row {i} cuts {tri:?} outside its range {range:?}");
-                cut += usize::from(hit);
-                left_out += usize::from(!inside);
+        // The sun's rows, and a disk light's off-centre ones.
+        for (mid, half) in [(0.0, sigma), (0.3, 0.1)] {
+            let made = cosine_rows(l, q, (mid, half), rows);
+            let (mut cut, mut left_out) = (0, 0);
+            for _ in 0..3000 {
+                let dist = 1.0 + 20.0 * next().abs();
+                let size = if next() > 0.0 { 0.002 * dist * next().abs() } else { 2.0 * next().abs() };
+                let p_mid = mid.cos() * l + mid.sin() * q;
+                let centre = dist * p_mid + 2.0 * half * dist * (next() * q + next() * c);
+                let tri = [0; 3].map(|_| centre + size * DVec3::new(next(), next(), next()));
+                let range = slice_row_range(&tri, l, q, (mid, half), rows);
+                for (i, r) in made.iter().enumerate() {
+                    let m = c.cross(r.p);
+                    let hit = slice_segment(tri, c, r.p, m).is_some_and(|[a, b]| a.1 > 0.0 || b.1 > 0.0);
+                    let inside = range.is_some_and(|(lo, hi)| (lo as usize..=hi as usize).contains(&i));
+                    assert!(!hit || inside, "row {i} cuts {tri:?} outside its range {range:?}");
+                    cut += usize::from(hit);
+                    left_out += usize::from(!inside);
+                }
             }
+            assert!(cut > 10_000 && left_out > 10_000, "({mid}, {half}): {cut} cuts, {left_out} rows left out");
         }
-        assert!(cut > 10_000 && left_out > 10_000, "{cut} cuts, {left_out} rows left out");
     }
 
     #[test]

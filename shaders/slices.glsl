@@ -19,8 +19,8 @@
 // (no loop), sorting only the intervals that would have made more pieces, with the pieces. Then 4 k^2 rows fit the
 // budget up to k = 13 there (676 rows; 1444 cut 4 pixels short, which the renderer refuses), where sorting every
 // row's intervals stopped at 64 rows.
-#ifndef SUNSHADE_SUN_SLICES_GLSL
-#define SUNSHADE_SUN_SLICES_GLSL
+#ifndef SUNSHADE_SLICES_GLSL
+#define SUNSHADE_SLICES_GLSL
 
 #include "math.glsl"
 #include "occluders.glsl"
@@ -215,28 +215,47 @@ bool sphere_meets_cone(vec3 centre, float r, vec3 axis, float cos_a, float sin_a
     return cos_t > 0.0 ? (along > -slack && across <= sin_t * dist + slack) : along >= cos_t * dist - slack;
 }
 
-// Whether a node's box reaches above the surface (n) and in front of the sun (l) from `origin` and may meet the
-// sun's cone: the box's centre's signed distance plus its half-extent projected on the normal, positive within a
-// slack of 1e-5 of the box's size and distance (f32's rounding; the boxes are padded too).
-bool within_reach(BvhNode node, vec3 origin, vec3 n, vec3 l, float cos_s, float sin_s) {
-    vec3 centre = 0.5 * (node.lo + node.hi) - origin;
+// What a point's slices can reach (the Rust's SliceReach): above the surface (n) and in front towards the light
+// (h), within the cone about h of cosine cos_a and sine sin_a (none where cos_a <= -1), and beyond the plane
+// beyond_k.x = beyond_b (none where beyond_k = 0, beyond_b < 0): a disk light's near side, where its rays end.
+struct SliceReach {
+    vec3 origin;
+    vec3 n;
+    vec3 h;
+    float cos_a;
+    float sin_a;
+    vec3 beyond_k;
+    float beyond_b;
+};
+
+// Whether a node's box may reach what the slices reach: the box's centre's signed distance plus its half-extent
+// projected on each normal above the plane, within a slack of 1e-5 of the box's size and distance (f32's rounding;
+// the boxes are padded too), and its bounding sphere meeting the cone.
+bool within_reach(BvhNode node, SliceReach r) {
+    vec3 centre = 0.5 * (node.lo + node.hi) - r.origin;
     vec3 half_extent = 0.5 * (node.hi - node.lo);
     float slack = 1e-5 * (length(centre) + length(half_extent));
-    return dot(centre, n) + dot(half_extent, abs(n)) > -slack && dot(centre, l) + dot(half_extent, abs(l)) > -slack
-        && sphere_meets_cone(centre, length(half_extent), l, cos_s, sin_s);
+    return dot(centre, r.n) + dot(half_extent, abs(r.n)) > -slack
+        && dot(centre, r.h) + dot(half_extent, abs(r.h)) > -slack
+        && dot(centre, r.beyond_k) + dot(half_extent, abs(r.beyond_k)) > r.beyond_b - slack
+        && (r.cos_a <= -1.0 || sphere_meets_cone(centre, length(half_extent), r.h, r.cos_a, r.sin_a));
 }
 
-// A leaf's triangle into the gathered ones: count -1 where it is alpha-masked or the array is full.
+// A leaf's triangle into the gathered ones where a corner lies above the surface, one in front and one beyond (the
+// same tests, exact, on its corners; a disk light's `before`); count -1 where it is alpha-masked or the array is
+// full.
 #define GATHER_LEAF(leaf) \
     { \
         uvec4 tri = occluder_triangles[(leaf).first]; \
         if (materials[tri.w & 0x7fffffffu].kind.z != 0u || count >= MAX_SLICE_TRIANGLES) { \
             return -1; \
         } \
-        vec3 a = OCCLUDER_CORNER(tri.x) - origin; \
-        vec3 b = OCCLUDER_CORNER(tri.y) - origin; \
-        vec3 d = OCCLUDER_CORNER(tri.z) - origin; \
-        if (max(max(dot(a, n), dot(b, n)), dot(d, n)) > 0.0 && max(max(dot(a, l), dot(b, l)), dot(d, l)) > 0.0) { \
+        vec3 a = OCCLUDER_CORNER(tri.x) - r.origin; \
+        vec3 b = OCCLUDER_CORNER(tri.y) - r.origin; \
+        vec3 d = OCCLUDER_CORNER(tri.z) - r.origin; \
+        if (max(max(dot(a, r.n), dot(b, r.n)), dot(d, r.n)) > 0.0 \
+            && max(max(dot(a, r.h), dot(b, r.h)), dot(d, r.h)) > 0.0 \
+            && max(max(dot(a, r.beyond_k), dot(b, r.beyond_k)), dot(d, r.beyond_k)) > r.beyond_b) { \
             slice_corners[3 * count] = a; \
             slice_corners[3 * count + 1] = b; \
             slice_corners[3 * count + 2] = d; \
@@ -246,7 +265,7 @@ bool within_reach(BvhNode node, vec3 origin, vec3 n, vec3 l, float cos_s, float 
 #define GATHER_CHILD(ch) \
     { \
         BvhNode child = bvh_nodes[ch]; \
-        if (within_reach(child, origin, n, l, cos_s, sin_s)) { \
+        if (within_reach(child, r)) { \
             if (child.count == 0u) { \
                 stack[top] = (ch); \
                 top += 1u; \
@@ -254,12 +273,12 @@ bool within_reach(BvhNode node, vec3 origin, vec3 n, vec3 l, float cos_s, float 
         } \
     }
 
-// The triangles of one walk within reach (within_reach) into slice_corners: their count, or -1 (module text).
-// A node taken from the stack is one iteration of the budget, as in any_hit.
-int gather(vec3 origin, vec3 n, vec3 l, float cos_s, float sin_s) {
+// The triangles of one walk within reach into slice_corners: their count, or -1 (module text). A node taken from
+// the stack is one iteration of the budget, as in any_hit.
+int gather(SliceReach r) {
     int count = 0;
     BvhNode root = bvh_nodes[0];
-    if (!within_reach(root, origin, n, l, cos_s, sin_s)) {
+    if (!within_reach(root, r)) {
         return 0;
     }
     if (root.count > 0u) {
@@ -285,25 +304,26 @@ float row_of_psi(float psi, float sigma, uint rows) {
     return atan2_accurate(sqrt(max(1.0 - x * x, 0.0)), x) * float(rows) / PI - 0.5;
 }
 
-// The rows whose half-plane may cut the triangle (a, b, d) (corners relative to the origin [m]), as
-// (first, last): the triangle's azimuth range about the axis c, psi = atan(x.q / x.l) over its corners, where every
-// corner lies in front (x.l > 0: its projection along c then lies in the half-plane x.l > 0, whose azimuths from
-// the origin form an interval); every row otherwise. Widened by a row on each side (floor, ceil) for rounding; an
-// empty range (first > last) where the triangle lies wholly to one side of the rows. (The reference files the
-// triangles under rows by their diamond-angle arcs, slice_buckets; the rows found are the same but at the ends.)
-uvec2 slice_row_range(vec3 a, vec3 b, vec3 d, vec3 l, vec3 q, float sigma, uint rows) {
-    vec3 along = vec3(dot(a, l), dot(b, l), dot(d, l));
+// The rows (psi = mid - half cos u in the frame (h, q) across the axis c) whose half-plane may cut the triangle
+// (a, b, d) (corners relative to the origin [m]), as (first, last): the triangle's azimuth range about the axis,
+// psi = atan(x.q / x.h) over its corners, where every corner lies in front (x.h > 0: its projection along c then
+// lies in the half-plane x.h > 0, whose azimuths from the origin form an interval); every row otherwise. Widened by
+// a row on each side (floor, ceil) for rounding; an empty range (first > last) where the triangle lies wholly to
+// one side of the rows. (The reference files the triangles under rows by their diamond-angle arcs, slice_buckets;
+// the rows found are the same but at the ends.)
+uvec2 slice_row_range(vec3 a, vec3 b, vec3 d, vec3 h, vec3 q, vec2 mid_half, uint rows) {
+    vec3 along = vec3(dot(a, h), dot(b, h), dot(d, h));
     if (min(min(along.x, along.y), along.z) <= 0.0) {
         return uvec2(0u, rows - 1u);
     }
     vec3 tau = vec3(dot(a, q), dot(b, q), dot(d, q)) / along;
-    float psi_lo = atan2_accurate(min(min(tau.x, tau.y), tau.z), 1.0);
-    float psi_hi = atan2_accurate(max(max(tau.x, tau.y), tau.z), 1.0);
-    if (psi_lo > sigma || psi_hi < -sigma) {
+    float psi_lo = atan2_accurate(min(min(tau.x, tau.y), tau.z), 1.0) - mid_half.x;
+    float psi_hi = atan2_accurate(max(max(tau.x, tau.y), tau.z), 1.0) - mid_half.x;
+    if (psi_lo > mid_half.y || psi_hi < -mid_half.y) {
         return uvec2(1u, 0u);
     }
-    float lo = floor(row_of_psi(psi_lo, sigma, rows));
-    float hi = ceil(row_of_psi(psi_hi, sigma, rows));
+    float lo = floor(row_of_psi(psi_lo, mid_half.y, rows));
+    float hi = ceil(row_of_psi(psi_hi, mid_half.y, rows));
     return uvec2(uint(clamp(lo, 0.0, float(rows - 1u))), uint(clamp(hi, 0.0, float(rows - 1u))));
 }
 
@@ -371,46 +391,114 @@ uint slice_order[MAX_SLICE_TRIANGLES];
         } \
     }
 
-// The triangle at `w` of the order, cut by row i's plane where its row range holds the row: its interval kept
-// where it meets the span, into the union; `hidden` once the union covers the span (an umbra's rows, mostly).
+
+// The interval [psi0, psi1] of slices that meet the disk (disk_slices::psi_range): the roots in t = tan psi of
+// A + 2 B t + C t^2, A = R^2 ((q.d)^2 - 1), B = -R^2 (q.d)(D.d), C = |D|^2 - R^2 (1 - (D.d)^2), the second from
+// the product A/C; false where C <= 0 (the origin within the disk's own reach).
+bool psi_range(float dist, float radius, float q_d, float dhat_d, out vec2 range) {
+    float r2 = radius * radius;
+    float a = r2 * (q_d * q_d - 1.0);
+    float b = -r2 * q_d * dhat_d;
+    float c = dist * dist - r2 * (1.0 - dhat_d * dhat_d);
+    range = vec2(0.0);
+    if (c <= 0.0) {
+        return false;
+    }
+    float disc = max(b * b - a * c, 0.0);
+    float t1 = (-b - (b < 0.0 ? -1.0 : 1.0) * sqrt(disc)) / c;
+    float t2 = t1 != 0.0 ? a / (c * t1) : -2.0 * b / c;
+    range = vec2(atan2_accurate(min(t1, t2), 1.0), atan2_accurate(max(t1, t2), 1.0));
+    return true;
+}
+
+// The chord in which the plane through the origin of unit normal m cuts the disk (centre D relative to the origin
+// [m], unit direction d, radius [m]): its ends relative to the origin; false where it misses it or the disk lies
+// in the plane (disk_slices::chord).
+bool chord(vec3 d_vec, vec3 d, float radius, vec3 m, out vec3 y0, out vec3 y1) {
+    y0 = vec3(0.0);
+    y1 = vec3(0.0);
+    float d_m = dot(d, m);
+    float across = 1.0 - d_m * d_m;
+    if (across <= 0.0) {
+        return false;
+    }
+    float dm = dot(d_vec, m);
+    vec3 foot = d_vec + (-dm / across) * (m - d_m * d);
+    float half2 = radius * radius - dm * dm / across;
+    if (half2 <= 0.0) {
+        return false;
+    }
+    vec3 along = normalize(cross(m, d));
+    float half_chord = sqrt(half2);
+    y0 = foot - half_chord * along;
+    y1 = foot + half_chord * along;
+    return true;
+}
+
+// The triangle at `w` of the order, cut by row i's plane where its row range holds the row (for a disk light,
+// the segment first clipped to the chord line's near side, `line`): its interval kept where it meets the span,
+// into the union; `hidden` once the union covers the span (an umbra's rows, mostly).
 #define SLICE_TRIANGLE(w) \
     if (!hidden && (w) < count) { \
         uint j = slice_order[w]; \
+        vec2 e0; \
+        vec2 e1; \
         vec2 interval; \
         if (slice_ranges[j].x <= i && slice_ranges[j].y >= i \
-            && blocked_interval(slice_corners[3u * j], slice_corners[3u * j + 1u], slice_corners[3u * j + 2u], c, p, \
-                                m, interval) \
+            && slice_segment(slice_corners[3u * j], slice_corners[3u * j + 1u], slice_corners[3u * j + 2u], c, p, m, \
+                             e0, e1) \
+            && (!disk || clip_segment(e0, e1, line.xy, line.z)) && segment_interval(e0, e1, interval) \
             && interval.y > key_lo && interval.x < key_hi) { \
             UNION_INSERT(interval) \
             hidden = pieces == 1u && union_piece[0].x <= key_lo && union_piece[0].y >= key_hi; \
         } \
     }
 
-// The sun's cosine-weighted visible fraction from `origin` on a surface of unit normal n, the sun in unit
-// direction l with angular diameter [rad], by `rows` slices; SLICES_UNSLICEABLE where they cannot be taken
-// (module text). 1 where the walk gathers nothing. The same rows, chords, intervals and gaps as the Rust's, so the
-// same sums but for f32's rounding.
-float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows) {
-    float sigma = 0.5 * angular_diameter;
-    vec3 c = sun_slice_axis(l);
-    vec3 q = cross(c, l);
-    int gathered = gather(origin, n, l, cos(sigma), sin(sigma));
+// The part of the segment (e0, e1) where a.(s, t) < b, if any (a and b of a line of the slice's plane).
+bool clip_segment(inout vec2 e0, inout vec2 e1, vec2 a, float b) {
+    float f0 = dot(a, e0) - b;
+    float f1 = dot(a, e1) - b;
+    if (f0 >= 0.0 && f1 >= 0.0) {
+        return false;
+    }
+    if (f0 < 0.0 && f1 < 0.0) {
+        return true;
+    }
+    vec2 cut = e0 + (f0 / (f0 - f1)) * (e1 - e0);
+    if (f0 < 0.0) {
+        e1 = cut;
+    } else {
+        e0 = cut;
+    }
+    return true;
+}
+
+// A light's visible fraction by its rows, the part the sun's and disk lights' slices share (sky_slices'
+// sliced_fraction): one walk within reach gathers the triangles (1 at once where it gathers none); they are
+// filed under their rows' ranges and ordered along the chords; the rows psi = mid - half cos u about the axis c,
+// in the frame (h, q), each give their chord's span (the sun's: +-chi about its middle, `sigma` its half-angle;
+// a disk light's, `disk`: its chord (D, d, radius) seen from the origin, with the chord line that clips the
+// segments to where the rays end), cut by the surface's horizon, and its visible weight; sum(visible) /
+// sum(whole) over the rows. SLICES_UNSLICEABLE where the walk cannot gather.
+float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bool disk, vec3 d_vec, vec3 d,
+                      float radius, float sigma) {
+    vec3 n = r.n;
+    vec3 h = r.h;
+    int gathered = gather(r);
     if (gathered < 0) {
         return SLICES_UNSLICEABLE;
     }
-    // The triangles that some row may cut, sorted by where they lie along the chords (the pseudo-angle of their
-    // centroid about the axis, seen along l): a row then meets its intervals nearly in order, so that the union
-    // grows at its ends rather than in pieces (Shell's sort, Ciura's gaps: about count^1.25 of the budget where
-    // insertion would take count^2 / 4).
+    // The triangles that some row may cut, first ordered by where their centroids lie along the chords (the
+    // pseudo-angle about the axis, seen along h; Shell's sort, Ciura's gaps: about count^1.25 of the budget).
     uint count = 0u;
     for (uint j = 0u; j < uint(gathered); ++j) {
         vec3 a = slice_corners[3u * j];
         vec3 b = slice_corners[3u * j + 1u];
-        vec3 d = slice_corners[3u * j + 2u];
-        uvec2 range = slice_row_range(a, b, d, l, q, sigma, rows);
+        vec3 e = slice_corners[3u * j + 2u];
+        uvec2 range = slice_row_range(a, b, e, h, q, mid_half, rows);
         slice_ranges[j] = range;
-        vec3 g = a + b + d;
-        slice_keys[j] = pseudo_angle(dot(g, c), max(dot(g, l), 0.0));
+        vec3 g = a + b + e;
+        slice_keys[j] = pseudo_angle(dot(g, c), max(dot(g, h), 0.0));
         if (range.x <= range.y) {
             slice_order[count] = j;
             count += 1u;
@@ -437,18 +525,40 @@ float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_dia
     float total = 0.0;
     for (uint i = 0u; i < rows; ++i) {
         vec2 su = cosine_row(i, rows);
-        float psi = -sigma * su.y;
-        vec3 p = cos(psi) * l + sin(psi) * q;
-        float jacobian = sigma * su.x;
-        float chi = chord_half_width(sigma, psi);
+        float psi = mid_half.x - mid_half.y * su.y;
+        vec3 p = cos(psi) * h + sin(psi) * q;
+        float jacobian = mid_half.y * su.x;
+        vec3 m = cos(psi) * q - sin(psi) * h;
+        vec2 chord_span;
+        vec3 line = vec3(0.0);
+        if (disk) {
+            // The chord's ends seen from the origin, as gamma = atan2(-s, t); the chord line a.(s, t) = b, a
+            // towards its far side, pulled in to where the rays end.
+            vec3 y0;
+            vec3 y1;
+            if (!chord(d_vec, d, radius, m, y0, y1)) {
+                continue;
+            }
+            vec2 e0 = vec2(dot(y0, c), dot(y0, p));
+            vec2 e1 = vec2(dot(y1, c), dot(y1, p));
+            float g0 = atan2_accurate(-e0.x, max(e0.y, 0.0));
+            float g1 = atan2_accurate(-e1.x, max(e1.y, 0.0));
+            chord_span = vec2(min(g0, g1), max(g0, g1));
+            vec2 a = vec2(e1.y - e0.y, e0.x - e1.x);
+            float b = dot(a, e0);
+            line = b < 0.0 ? vec3(-a, -SEGMENT_T_MAX * b) : vec3(a, SEGMENT_T_MAX * b);
+        } else {
+            float chi = chord_half_width(sigma, psi);
+            chord_span = vec2(-chi, chi);
+        }
         float n_p = dot(n, p);
         vec2 surface = above_about_centre(n_c, n_p);
-        vec2 span = vec2(max(-chi, surface.x), min(chi, surface.y));
+        vec2 span = vec2(max(chord_span.x, surface.x), min(chord_span.y, surface.y));
         float whole = jacobian * weight_integral_about_centre(n_c, n_p, span.x, span.y);
         if (whole <= 0.0) {
             continue;
         }
-        vec3 m = cross(c, p);
+        total += whole;
         float key_lo = pseudo_angle_of_gamma(span.x);
         float key_hi = pseudo_angle_of_gamma(span.y);
         uint pieces = 0u;
@@ -463,7 +573,6 @@ float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_dia
             SLICE_TRIANGLE(w + 3u)
         }
         if (hidden) {
-            total += whole;
             continue;
         }
         // The pieces after the intervals set aside (sorted below with them; alone, the sort moves nothing).
@@ -474,9 +583,42 @@ float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_dia
             }
         }
         visible += blocked == 0u ? whole : jacobian * visible_weight_about_centre(n_c, n_p, span, blocked);
-        total += whole;
     }
     return fraction(visible, total);
+}
+
+// The sun's cosine-weighted visible fraction from `origin` on a surface of unit normal n, the sun in unit
+// direction l with angular diameter [rad], by `rows` slices (sun_slices.rs): the rows psi = -sigma cos u across
+// an axis perpendicular to l; SLICES_UNSLICEABLE where they cannot be taken (module text).
+float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows) {
+    float sigma = 0.5 * angular_diameter;
+    vec3 c = sun_slice_axis(l);
+    SliceReach r = SliceReach(origin, n, l, cos(sigma), sin(sigma), vec3(0.0), -1.0);
+    return sliced_fraction(r, c, cross(c, l), vec2(0.0, sigma), rows, false, vec3(0.0), vec3(0.0), 0.0, sigma);
+}
+
+// The visible fraction of the disk light (centre [m], unit emission direction d, radius [m]) from `origin` on a
+// surface of unit normal n, weighted by projected solid angle, by `rows` slices (disk_slices.rs): 1 where the disk
+// gives nothing (seen from behind); SLICES_UNSLICEABLE where the origin is too near the disk for the slices' range
+// or the walk cannot gather.
+float disk_visible_fraction_sliced(vec3 origin, vec3 n, vec3 center, vec3 d, float radius, uint rows) {
+    vec3 d_vec = center - origin;
+    float dist = length(d_vec);
+    if (!(dot(d, d_vec) < 0.0 && dist > 0.0)) {
+        return 1.0;
+    }
+    vec3 dhat = d_vec / dist;
+    vec3 c = sun_slice_axis(dhat);
+    vec3 q = cross(c, dhat);
+    vec2 range;
+    if (!psi_range(dist, radius, dot(q, d), dot(dhat, d), range)) {
+        return SLICES_UNSLICEABLE;
+    }
+    vec2 mid_half = vec2(0.5 * (range.x + range.y), 0.5 * (range.y - range.x));
+    float sin_a = radius / dist;
+    vec2 cone = dist > radius ? vec2(sqrt(1.0 - sin_a * sin_a), sin_a) : vec2(-2.0, 0.0);
+    SliceReach r = SliceReach(origin, n, dhat, cone.x, cone.y, d, SEGMENT_T_MAX * dot(d, d_vec));
+    return sliced_fraction(r, c, q, mid_half, rows, true, d_vec, d, radius, 0.0);
 }
 
 #endif
