@@ -143,8 +143,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
             warning: false,
         };
     }
-    let rule =
-        a.visibility_rule.unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, r.device_info()));
+    let rule = a
+        .visibility_rule
+        .unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, r.device_info(), choice.technique));
     let slices = rule == crate::shading::VisibilityRule::Slices;
     if slices && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
         // Slices take the place of shadow rays: `auto` casts them on any device.
@@ -212,17 +213,19 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
 /// (`--tolerance-in-penumbrae`) and the GPU can take them for every light that casts shadows (the sun and disk
-/// lights, no sky, no alpha-masked occluders, a device whose fragment shader walks the BVH), as the reference
-/// defaults to them there; the grid otherwise.
+/// lights, no sky, no alpha-masked occluders, a device whose fragment shader walks the BVH, and shadow rays: `auto`
+/// or `ray`, not where `auto` found nothing to shadow), as the reference defaults to them there; the grid otherwise.
 fn default_visibility(
     a: &SceneArgs,
     settings: &RenderSettings,
     scene: &crate::scene::Scene,
     device: &crate::gpu::DeviceInfo,
+    technique: Shadows,
 ) -> crate::shading::VisibilityRule {
     let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae);
     let lights = (settings.lights.sun.is_some() || !settings.lights.disks.is_empty()) && settings.lights.sky.is_none();
-    if in_penumbrae && lights && !scene.has_alpha_masks() && !device.ray_query && a.shadows != Shadows::Map {
+    let rays = matches!(a.shadows, Shadows::Auto | Shadows::Ray) && technique != Shadows::None;
+    if in_penumbrae && lights && rays && !scene.has_alpha_masks() && !device.ray_query {
         crate::shading::VisibilityRule::Slices
     } else {
         crate::shading::VisibilityRule::Grid

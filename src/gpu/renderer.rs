@@ -428,12 +428,14 @@ impl Renderer {
         })
     }
 
-    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: without shadow
-    /// rays, on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where the
+    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: with shadow maps,
+    /// on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where the
     /// sky casts shadows (the GPU slices the sun's disk and disk lights, shaders/slices.glsl; a comparison with the
     /// reference would set unlike rules side by side).
     fn check_slices(&self, technique: Shadows, settings: &RenderSettings) -> Result<(), GpuError> {
-        let why = if technique != Shadows::Ray {
+        let why = if technique == Shadows::None {
+            return Ok(()); // nothing to slice
+        } else if technique != Shadows::Ray {
             "slices take the place of shadow rays (--shadows ray)"
         } else if !self.pipeline.rays_walk_bvh() {
             "the GPU takes slices where its fragment shader walks the occluders' BVH (devices without ray queries), \
