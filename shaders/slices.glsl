@@ -1,14 +1,15 @@
-// The sun's visible fraction by slices, on devices whose fragment shader walks the occluders' BVH itself
-// (SUNSHADE_RAY_BVH). Mirrors src/shading/sun_slices.rs (the rule: half great circles through an axis across
-// the sun, rows along psi = -sigma cos u, each chord cut by the surface's horizon and by the intervals that the
-// triangles in its plane block, its visible weight closed-form), sky_slices.rs (segments, pseudo-angles),
-// slices_about_centre.rs (the chords measured by gamma = beta - pi/2, which keeps f32's digits on a chord
+// The sun's and disk lights' visible fractions by slices, on devices whose fragment shader walks the occluders'
+// BVH itself (SUNSHADE_RAY_BVH). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
+// through an axis across the light, rows along psi = mid - half cos u, each row's chord of the light cut by the
+// surface's horizon and by the intervals that the triangles in its plane block, a disk light's segments first
+// clipped to where its rays end; the visible weight closed-form), sky_slices.rs (segments, pseudo-angles),
+// slices_about_centre.rs (the chords measured by gamma = beta - pi/2, which keeps f32's digits on the sun's chord
 // within 0.0046 rad of beta = pi/2; see its text) and visibility/bvh.rs (within_reach, sphere_meets_cone).
 //
-// One walk a pixel gathers the triangles within the sun's cone above the surface's horizon into a local array of
-// MAX_SLICE_TRIANGLES; every row then cuts those whose row range holds it. Where the walk finds more, or an
-// alpha-masked triangle (which slices cannot cut), the fraction is SLICES_UNSLICEABLE and the caller casts the
-// grid's rays instead.
+// One walk a pixel and light gathers the triangles within its reach (above the surface's horizon, in front, in
+// the light's cone, before a disk light's near side) into a local array of MAX_SLICE_TRIANGLES; every row then
+// cuts those whose row range holds it. Where the walk finds more, or an alpha-masked triangle (which slices cannot
+// cut), the fraction is SLICES_UNSLICEABLE and the caller casts the grid's rays instead.
 //
 // llvmpipe's loop budget (gpu::loop_budget: 65535 iterations a fragment, every loop together) shapes the rows'
 // work. A penumbra's pixel behind a tessellated sphere's limb gathers 100 to 200 triangles, and a row cuts some
@@ -18,7 +19,7 @@
 // times) and merges its intervals as they come into at most UNION_PIECES sorted disjoint pieces, steps written out
 // (no loop), sorting only the intervals that would have made more pieces, with the pieces. Then 4 k^2 rows fit the
 // budget up to k = 13 there (676 rows; 1444 cut 4 pixels short, which the renderer refuses), where sorting every
-// row's intervals stopped at 64 rows.
+// row's intervals stopped at 64 rows. docs/platform.md has the measurements.
 #ifndef SUNSHADE_SLICES_GLSL
 #define SUNSHADE_SLICES_GLSL
 
@@ -27,7 +28,7 @@
 
 // sky_slices::SLICE_AXIS.
 #define SLICE_AXIS vec3(0.33232518133916444, 0.8023039599071088, 0.4958511165312262)
-// The most triangles one pixel's slices gather (a pixel whose sun cone holds more casts rays).
+// The most triangles one pixel's slices of a light gather (a pixel whose cone holds more casts the grid's rays).
 #define MAX_SLICE_TRIANGLES 256
 // What a fraction the slices cannot give reads.
 #define SLICES_UNSLICEABLE -1.0
