@@ -97,6 +97,8 @@ pub(super) fn tolerance_rows(
     let mut rows = Vec::new();
     for tolerance in TOLERANCES {
         let mut s = settings.clone();
+        // The GPU's grids, whatever rule the truth took (`render`'s slices are not in this table yet).
+        s.shading.visibility_rule = crate::shading::VisibilityRule::Grid;
         let (mut spent, mut renders) = (Duration::ZERO, 0u32);
         let request =
             Request { scene, renderer: predicted, asked: settings.shading.shadows, scene_can_occlude: can_occlude };
