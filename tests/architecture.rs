@@ -78,6 +78,11 @@ fn glsl_functions(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// Whether the Rust sources define a function of this name (generic or not).
+fn has_twin(rust: &str, name: &str) -> bool {
+    rust.contains(&format!("fn {name}(")) || rust.contains(&format!("fn {name}<"))
+}
+
 #[test]
 fn every_glsl_shading_function_has_a_rust_twin() {
     let rust: String = sources("src/shading").into_iter().map(|(_, t)| t).collect();
@@ -94,7 +99,7 @@ fn every_glsl_shading_function_has_a_rust_twin() {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders").join(file)).unwrap();
         for name in glsl_functions(&text) {
             assert!(
-                rust.contains(&format!("fn {name}(")),
+                has_twin(&rust, &name),
                 "shaders/{file}: `{name}` has no Rust function in src/shading"
             );
             checked += 1;
@@ -191,7 +196,7 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         let rust: String = rust_dirs.iter().flat_map(|d| sources(d)).map(|(_, t)| t).collect();
         let text = std::fs::read_to_string(dir.join(&name)).unwrap();
         for f in glsl_functions(&text) {
-            assert!(rust.contains(&format!("fn {f}(")), "shaders/{name}: `{f}` has no Rust function in {rust_dirs:?}");
+            assert!(has_twin(&rust, &f), "shaders/{name}: `{f}` has no Rust function in {rust_dirs:?}");
         }
     }
 }
