@@ -98,10 +98,7 @@ fn every_glsl_shading_function_has_a_rust_twin() {
     ] {
         let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders").join(file)).unwrap();
         for name in glsl_functions(&text) {
-            assert!(
-                has_twin(&rust, &name),
-                "shaders/{file}: `{name}` has no Rust function in src/shading"
-            );
+            assert!(has_twin(&rust, &name), "shaders/{file}: `{name}` has no Rust function in src/shading");
             checked += 1;
         }
     }
