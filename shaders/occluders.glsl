@@ -156,6 +156,22 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
             return true; \
         } \
     }
+// The walk below an inner root: nodes taken from an explicit stack (at most one pending sibling a level of a tree
+// fewer than 78 levels deep), each visiting its two children with VISIT(child), which stacks an inner child it
+// enters (`stack`, `top`) and may return from the caller. One iteration of llvmpipe's budget a node taken
+// (gpu::loop_budget). Shared by any_hit and the slices' gather (slices.glsl).
+#define BVH_WALK(VISIT) \
+    { \
+        uint stack[BVH_STACK_SIZE]; \
+        uint top = 1u; \
+        stack[0] = 0u; \
+        while (top > 0u) { \
+            top -= 1u; \
+            BvhNode node = bvh_nodes[stack[top]]; \
+            VISIT(node.first) \
+            VISIT(node.first + 1u) \
+        } \
+    }
 // Child `c` of an inner node, if the ray meets its box: a leaf tested at once, an inner node stacked.
 #define VISIT_CHILD(c) \
     { \
@@ -186,15 +202,7 @@ bool any_hit(WatertightRay r, float t_max) {
         LEAF_TEST(root)
         return false;
     }
-    uint stack[BVH_STACK_SIZE];
-    uint top = 1u;
-    stack[0] = 0u;
-    while (top > 0u) {
-        top -= 1u;
-        BvhNode node = bvh_nodes[stack[top]];
-        VISIT_CHILD(node.first)
-        VISIT_CHILD(node.first + 1u)
-    }
+    BVH_WALK(VISIT_CHILD)
     return false;
 }
 

@@ -286,15 +286,7 @@ int gather(SliceReach r) {
         GATHER_LEAF(root)
         return count;
     }
-    uint stack[BVH_STACK_SIZE];
-    uint top = 1u;
-    stack[0] = 0u;
-    while (top > 0u) {
-        top -= 1u;
-        BvhNode node = bvh_nodes[stack[top]];
-        GATHER_CHILD(node.first)
-        GATHER_CHILD(node.first + 1u)
-    }
+    BVH_WALK(GATHER_CHILD)
     return count;
 }
 

@@ -172,9 +172,24 @@ pub fn weight_integral(n_c: f64, n_p: f64, b0: f64, b1: f64) -> f64 {
 
 /// The weight over `[lo, hi]` (β) less the union of `blocked` (pseudo-angles, sorted here), by the gaps between
 /// them; a gap's end at the span's own end keeps its exact β.
-pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
-    blocked.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+pub fn visible_weight(n_c: f64, n_p: f64, span: (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
     let key = |b: f64| pseudo_angle(b.cos(), b.sin());
+    gaps_weight(blocked, span, key, angle_of, |b0, b1| weight_integral(n_c, n_p, b0, b1))
+}
+
+/// The sum of `weight` over the gaps that the union of `blocked` (pseudo-angles, sorted here by their starts)
+/// leaves in `[lo, hi]` (angles whose pseudo-angles `key` gives; `angle` turns a pseudo-angle back): one walk in
+/// order of the starts, a gap wherever the next start lies beyond the furthest end reached; a gap's end at the
+/// span's own end keeps its exact angle. The union's walk of [`visible_weight`] (β) and of
+/// `slices_about_centre::visible_weight_about_centre` (γ).
+pub fn gaps_weight(
+    blocked: &mut [(f64, f64)],
+    (lo, hi): (f64, f64),
+    key: impl Fn(f64) -> f64,
+    angle: impl Fn(f64) -> f64,
+    weight: impl Fn(f64, f64) -> f64,
+) -> f64 {
+    blocked.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
     let (key_lo, key_hi) = (key(lo), key(hi));
     let mut visible = 0.0;
     let mut reached = key_lo;
@@ -184,7 +199,7 @@ pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(
         } else if k == key_hi {
             hi
         } else {
-            angle_of(k)
+            angle(k)
         }
     };
     for &(k0, k1) in blocked.iter() {
@@ -192,12 +207,12 @@ pub fn visible_weight(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(
             break;
         }
         if k0 > reached {
-            visible += weight_integral(n_c, n_p, at(reached), at(k0));
+            visible += weight(at(reached), at(k0));
         }
         reached = reached.max(k1);
     }
     if reached < key_hi {
-        visible += weight_integral(n_c, n_p, at(reached), hi);
+        visible += weight(at(reached), hi);
     }
     visible
 }

@@ -17,7 +17,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use super::sky_slices::pseudo_angle;
+use super::sky_slices::{gaps_weight, pseudo_angle};
 
 /// γ of a pseudo-angle `k` (`sky_slices::pseudo_angle`; the direction `(s, t) ∝ (−k, 1 − |k|)`):
 /// `atan2(k, 1 − |k|)`, so that γ near 0 keeps the relative precision of `k` (`sky_slices::angle_of` gives
@@ -61,33 +61,8 @@ pub fn pseudo_angle_of_gamma(g: f64) -> f64 {
 
 /// The weight over `[lo, hi]` (γ) less the union of `blocked` (pseudo-angles, sorted here by their starts), by
 /// the gaps between them; a gap's end at the span's own end keeps its exact γ (`sky_slices::visible_weight` in γ).
-pub fn visible_weight_about_centre(n_c: f64, n_p: f64, (lo, hi): (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
-    blocked.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    let (key_lo, key_hi) = (pseudo_angle_of_gamma(lo), pseudo_angle_of_gamma(hi));
-    let at = |k: f64| {
-        if k == key_lo {
-            lo
-        } else if k == key_hi {
-            hi
-        } else {
-            gamma_of(k)
-        }
-    };
-    let mut visible = 0.0;
-    let mut reached = key_lo;
-    for &(k0, k1) in blocked.iter() {
-        if k0 >= key_hi {
-            break;
-        }
-        if k0 > reached {
-            visible += weight_integral_about_centre(n_c, n_p, at(reached), at(k0));
-        }
-        reached = reached.max(k1);
-    }
-    if reached < key_hi {
-        visible += weight_integral_about_centre(n_c, n_p, at(reached), hi);
-    }
-    visible
+pub fn visible_weight_about_centre(n_c: f64, n_p: f64, span: (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
+    gaps_weight(blocked, span, pseudo_angle_of_gamma, gamma_of, |g0, g1| weight_integral_about_centre(n_c, n_p, g0, g1))
 }
 
 #[cfg(test)]
