@@ -28,6 +28,10 @@
 // The coverage alpha of a fragment whose loops llvmpipe's limiter cut short (fragment.glsl's coverage_alpha), and
 // the probe loop's iterations; values match gpu::loop_budget.
 #define LOOP_BUDGET_SPENT -1.0
+// The coverage alpha of a fragment whose slices gathered more triangles than they keep (slices.glsl), set in
+// `slices_overflowed`; the value matches gpu::slice_gather.
+#define SLICES_OVERFLOWED -2.0
+bool slices_overflowed = false;
 #define LOOP_PROBE_ITERATIONS 2u
 // What the fragment shader writes (VARIANT_QUANTITY); values match gpu::layout.
 #define QUANTITY_RADIANCE 0u

@@ -13,13 +13,14 @@
 // every loop exits after its current iteration, silently: a lobe grid or a shadow ray's walk left unfinished
 // (docs/platform.md). This probe loop runs
 // lights.counts.z (2) iterations, not known to the compiler, so it is not unrolled; it stops after one exactly when
-// the budget is spent, and the renderer refuses an image with such pixels (gpu::loop_budget).
+// the budget is spent, and the renderer refuses an image with such pixels (gpu::loop_budget). SLICES_OVERFLOWED
+// where the slices of a light gathered more triangles than they keep (gpu::slice_gather), refused too.
 float coverage_alpha() {
     uint probe = 0u;
     for (uint i = 0u; i < lights.counts.z; ++i) {
         probe += 1u;
     }
-    return probe == lights.counts.z ? 1.0 : LOOP_BUDGET_SPENT;
+    return probe != lights.counts.z ? LOOP_BUDGET_SPENT : (slices_overflowed ? SLICES_OVERFLOWED : 1.0);
 }
 
 vec3 fragment_vertex_position(uint index) {

@@ -8,8 +8,9 @@
 //
 // One walk a pixel and light gathers the triangles within its reach (above the surface's horizon, in front, in
 // the light's cone, before a disk light's near side) into a local array of MAX_SLICE_TRIANGLES; every row then
-// cuts those whose row range holds it. Where the walk finds more, or an alpha-masked triangle (which slices cannot
-// cut), the fraction is SLICES_UNSLICEABLE and the caller casts the grid's rays instead.
+// cuts those whose row range holds it. Where the walk finds an alpha-masked triangle (which slices cannot cut),
+// the fraction is SLICES_UNSLICEABLE and the caller casts the grid's rays instead, as the reference does; where
+// it finds more triangles than the array keeps, the same, and the image is refused (gpu::slice_gather).
 //
 // llvmpipe's loop budget (gpu::loop_budget: 65535 iterations a fragment, every loop together) shapes the rows'
 // work. A penumbra's pixel behind a tessellated sphere's limb gathers 100 to 200 triangles, and a row cuts some
@@ -28,8 +29,9 @@
 
 // sky_slices::SLICE_AXIS.
 #define SLICE_AXIS vec3(0.33232518133916444, 0.8023039599071088, 0.4958511165312262)
-// The most triangles one pixel's slices of a light gather (a pixel whose cone holds more casts the grid's rays).
-#define MAX_SLICE_TRIANGLES 256
+// The most triangles one pixel's slices of a light gather (gpu::slice_gather: a pixel whose cone holds more sets
+// slices_overflowed, and the renderer refuses the image).
+#define MAX_SLICE_TRIANGLES 1024
 // What a fraction the slices cannot give reads.
 #define SLICES_UNSLICEABLE -1.0
 
@@ -243,12 +245,16 @@ bool within_reach(BvhNode node, SliceReach r) {
 }
 
 // A leaf's triangle into the gathered ones where a corner lies above the surface, one in front and one beyond (the
-// same tests, exact, on its corners; a disk light's `before`); count -1 where it is alpha-masked or the array is
-// full.
+// same tests, exact, on its corners; a disk light's `before`); count -1 where it is alpha-masked (the reference's
+// slices too take the grid there), or the array is full (slices_overflowed set: the image is refused).
 #define GATHER_LEAF(leaf) \
     { \
         uvec4 tri = occluder_triangles[(leaf).first]; \
-        if (materials[tri.w & 0x7fffffffu].kind.z != 0u || count >= MAX_SLICE_TRIANGLES) { \
+        if (materials[tri.w & 0x7fffffffu].kind.z != 0u) { \
+            return -1; \
+        } \
+        if (count >= MAX_SLICE_TRIANGLES) { \
+            slices_overflowed = true; \
             return -1; \
         } \
         vec3 a = OCCLUDER_CORNER(tri.x) - r.origin; \

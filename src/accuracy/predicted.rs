@@ -80,6 +80,12 @@ impl Prediction {
         self.max_relative = (self.max_relative + bound).min(1.0);
     }
 
+    /// Adds a term measured rather than bounded (`what` says so), to the bound and its terms.
+    pub fn add_measured(&mut self, what: &str, value: f64) {
+        self.terms.push((what.into(), value));
+        self.max_relative = (self.max_relative + value).min(1.0);
+    }
+
     /// The `-v` line: `predicted max relative error: 1.6e-4 (...)`.
     pub fn line(&self) -> String {
         let terms: Vec<String> = self.terms.iter().map(|(what, b)| format!("{what} {b:.1e}")).collect();

@@ -447,6 +447,11 @@ mod tests {
         use super::super::loop_budget::{LOOP_BUDGET_SPENT, LOOP_PROBE_ITERATIONS};
         assert!(glsl.contains(&format!("#define LOOP_PROBE_ITERATIONS {LOOP_PROBE_ITERATIONS}u\n")));
         assert!(glsl.contains(&format!("#define LOOP_BUDGET_SPENT {LOOP_BUDGET_SPENT:.1}\n")));
+        let overflowed = super::super::slice_gather::SLICES_OVERFLOWED;
+        assert!(glsl.contains(&format!("#define SLICES_OVERFLOWED {overflowed:.1}\n")));
+        let slices = include_str!("../../shaders/slices.glsl");
+        let most = super::super::slice_gather::MAX_SLICE_TRIANGLES;
+        assert!(slices.contains(&format!("#define MAX_SLICE_TRIANGLES {most}\n")));
         assert!(glsl.contains("#define NO_TEXTURE 0xffffffffu\n"));
         // The vertex layout: FLOATS_PER_VERTEX and each attribute's offset in floats.
         assert!(glsl.contains(&format!("#define FLOATS_PER_VERTEX {}u\n", std::mem::size_of::<Vertex>() / 4)));

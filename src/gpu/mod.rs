@@ -26,6 +26,7 @@ mod renderer;
 pub mod shaders;
 pub mod shadow_bvh;
 mod shadow_map;
+pub mod slice_gather;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;

@@ -617,6 +617,7 @@ impl Renderer {
         let t_readback = Instant::now();
         let image = self.read_back(width, height)?;
         super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
+        super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.check_validation()?;
