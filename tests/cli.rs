@@ -1001,3 +1001,23 @@ fn lavapipe_loop_budget_is_detected_not_trusted() {
         assert!(o.status.success(), "{}", stderr(&o));
     }
 }
+
+/// `render --visibility slices` where a pixel's light cone holds more triangles than the GPU's slices gather (the
+/// teapot under a disk light 3 m wide just above it): refused by name, exit non-zero, no image. On a device with
+/// ray queries the slices are refused before that, by their own name.
+#[test]
+fn gpu_slices_refuse_a_light_cone_holding_too_many_triangles() {
+    let dir = TempDir::new("cli-slices-overflow");
+    let out = dir.path("teapot.exr");
+    let flags = "render models/teapot.glb --width 32 --height 24 --shadows ray --visibility slices --sun-irradiance 0 \
+                 --disk-light 0,3,0:0,-1,0:3:100 -o";
+    let mut args: Vec<&str> = flags.split_whitespace().collect();
+    args.push(out.to_str().unwrap());
+    let o = sunshade(&args);
+    let e = stderr(&o);
+    assert!(!o.status.success() && !out.exists(), "{e}");
+    assert!(
+        e.contains("--visibility slices") && (e.contains("more than 1024 triangles") || e.contains("ray queries")),
+        "{e}"
+    );
+}

@@ -43,6 +43,15 @@ impl Image {
         &self.pixels
     }
 
+    /// How many pixels carry exactly this alpha (a renderer's sentinel: `gpu::loop_budget`, `gpu::slice_gather`),
+    /// and where the first one is, `(x, y)`; `None` where none does.
+    pub fn alpha_count_and_first(&self, alpha: f32) -> Option<(usize, (u32, u32))> {
+        let mut marked = self.pixels.iter().enumerate().filter(|(_, p)| p[3] == alpha).map(|(i, _)| i);
+        let first = marked.next()?;
+        let w = self.width as usize;
+        Some((1 + marked.count(), ((first % w) as u32, (first / w) as u32)))
+    }
+
     pub fn pixels_mut(&mut self) -> &mut [[f32; 4]] {
         &mut self.pixels
     }

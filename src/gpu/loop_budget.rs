@@ -32,18 +32,12 @@ pub const LLVMPIPE_LOOP_ITERATIONS: u32 = 65535;
 
 /// `Err` naming how many pixels the limiter cut short (and where the first one is), if any did.
 pub fn check(image: &Image, device: &str) -> Result<(), String> {
-    let w = image.width() as usize;
-    let spent: Vec<usize> =
-        image.pixels().iter().enumerate().filter(|(_, p)| p[3] == LOOP_BUDGET_SPENT).map(|(i, _)| i).collect();
-    let Some(&first) = spent.first() else { return Ok(()) };
+    let Some((count, (x, y))) = image.alpha_count_and_first(LOOP_BUDGET_SPENT) else { return Ok(()) };
     Err(format!(
-        "{device} cut the loops of {} pixel(s) short (the first at ({}, {})): llvmpipe runs at most \
+        "{device} cut the loops of {count} pixel(s) short (the first at ({x}, {y})): llvmpipe runs at most \
          {LLVMPIPE_LOOP_ITERATIONS} loop iterations a fragment, all loops together, and then stops them silently \
          (docs/platform.md); render with fewer samples (--samples, --sun-samples, --shadow-samples) or on a device \
-         without that limit",
-        spent.len(),
-        first % w,
-        first / w
+         without that limit"
     ))
 }
 

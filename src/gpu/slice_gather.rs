@@ -13,17 +13,11 @@ pub const MAX_SLICE_TRIANGLES: u32 = 1024;
 
 /// `Err` naming how many pixels gathered too many triangles (and where the first one is), if any did.
 pub fn check(image: &Image) -> Result<(), String> {
-    let w = image.width() as usize;
-    let over: Vec<usize> =
-        image.pixels().iter().enumerate().filter(|(_, p)| p[3] == SLICES_OVERFLOWED).map(|(i, _)| i).collect();
-    let Some(&first) = over.first() else { return Ok(()) };
+    let Some((count, (x, y))) = image.alpha_count_and_first(SLICES_OVERFLOWED) else { return Ok(()) };
     Err(format!(
-        "--visibility slices: {} pixel(s) (the first at ({}, {})) see more than {MAX_SLICE_TRIANGLES} triangles in a \
-         light's cone, more than the GPU's slices gather a pixel; --visibility grid casts rays there, and \
-         `sunshade reference --visibility slices` has no such limit",
-        over.len(),
-        first % w,
-        first / w
+        "--visibility slices: {count} pixel(s) (the first at ({x}, {y})) see more than {MAX_SLICE_TRIANGLES} \
+         triangles in a light's cone, more than the GPU's slices gather a pixel; --visibility grid casts rays there, \
+         and `sunshade reference --visibility slices` has no such limit"
     ))
 }
 
@@ -32,14 +26,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn an_image_with_an_overflowed_pixel_is_refused_and_others_pass() {
+    fn overflowed_pixels_are_counted_and_named_and_the_loop_budgets_are_not() {
         let mut image = Image::new(5, 2);
-        for p in image.pixels_mut() {
-            *p = [1.0, 2.0, 3.0, 1.0];
-        }
+        image.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
         assert!(check(&image).is_ok());
+        image.pixels_mut()[9][3] = SLICES_OVERFLOWED;
         image.pixels_mut()[7][3] = SLICES_OVERFLOWED;
+        image.pixels_mut()[1][3] = crate::gpu::loop_budget::LOOP_BUDGET_SPENT;
         let e = check(&image).unwrap_err();
-        assert!(e.contains("1 pixel(s)") && e.contains("(2, 1)") && e.contains("1024"), "{e}");
+        assert!(e.contains("2 pixel(s)") && e.contains("(2, 1)") && e.contains("1024"), "{e}");
     }
 }
