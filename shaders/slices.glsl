@@ -156,14 +156,6 @@ bool segment_interval(vec2 e0, vec2 e1, out vec2 interval) {
     return true;
 }
 
-// The interval of pseudo-angles that the triangle (a, b, d) blocks for rays to a light at infinity.
-bool blocked_interval(vec3 a, vec3 b, vec3 d, vec3 c, vec3 p, vec3 m, out vec2 interval) {
-    vec2 e0;
-    vec2 e1;
-    interval = vec2(0.0);
-    return slice_segment(a, b, d, c, p, m, e0, e1) && segment_interval(e0, e1, interval);
-}
-
 // The weight over span (gamma) less the union of the row's `count` blocked intervals (slice_blocked, sorted here
 // by their starts: an insertion sort, a row holding a few), by the gaps between them.
 float visible_weight_about_centre(float n_c, float n_p, vec2 span, uint count) {

@@ -281,7 +281,8 @@ pub fn reference_within_tolerance(
 }
 
 /// Whether every visible fraction the study refines is the reference's slices and no lobe sample casts a ray
-/// (`refinement`'s "Penumbrae by slices"): the reference by `--visibility slices` (the GPU casts its grid), no
+/// (`refinement`'s "Penumbrae by slices"): the reference by `--visibility slices` (the GPU's slices keep the cap of
+/// 1: nothing bounds their f32 geometry per pixel, which `render` measures instead), no
 /// alpha-masked material (whose occluders send the slices back to the grid), and every material the meshes use
 /// Lambertian at every pixel ([`only_lambertian`]: a lobe's samples under the lights cast rays).
 fn penumbrae_by_slices_alone(request: Request, settings: &RenderSettings) -> bool {

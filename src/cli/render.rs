@@ -133,28 +133,21 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let upload = session.upload(scene, renderer)?;
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let mut choice = r.shadow_choice(gpu_scene, &settings)?;
-    if a.scene.tolerance.is_some() && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
-        // Shadow maps have no error bound; `--tolerance` casts rays on any device (without ray queries, by the
-        // fragment shader's walk of the occluders' BVH).
-        choice = crate::visibility::ShadowChoice {
-            technique: Shadows::Ray,
-            reason: "auto with --tolerance: shadow rays, whose error outside penumbrae is known (the device has no \
-                     ray queries: the fragment shader walks the occluders' BVH)"
-                .into(),
-            warning: false,
-        };
-    }
     let rule = a
         .visibility_rule
         .unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, r.device_info(), choice.technique));
     let slices = rule == crate::shading::VisibilityRule::Slices;
-    if slices && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
-        // Slices take the place of shadow rays: `auto` casts them on any device.
+    if (a.scene.tolerance.is_some() || slices) && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
+        // Shadow maps have no error bound, and slices take the place of shadow rays: `auto` casts rays on any
+        // device (without ray queries, by the fragment shader's walk of the occluders' BVH).
+        let why = if a.scene.tolerance.is_some() {
+            "auto with --tolerance: shadow rays, whose error outside penumbrae is known"
+        } else {
+            "auto with --visibility slices: the lights' visible fractions by slices"
+        };
         choice = crate::visibility::ShadowChoice {
             technique: Shadows::Ray,
-            reason: "auto with --visibility slices: the lights' visible fractions by slices (the device has \
-                     no ray queries: the fragment shader walks the occluders' BVH)"
-                .into(),
+            reason: format!("{why} (the device has no ray queries: the fragment shader walks the occluders' BVH)"),
             warning: false,
         };
     }
