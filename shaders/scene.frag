@@ -115,6 +115,18 @@ void main() {
             emission = emitted_radiance(material, s);
         }
     }
+#ifdef SUNSHADE_RAY_BVH
+    if (VARIANT_QUANTITY == QUANTITY_SKY_ROWS) {
+        // One pass of the sky's slices: its rows' visible and unoccluded weights (gpu::sky_passes sums them).
+        vec2 weights = vec2(0.0);
+        if (frame.normal.y > -1.0) {
+            weights = sky_rows_weights(frame.shadow_origin, frame.normal, 4u * lights.sampling.y * lights.sampling.y,
+                                       lights.sky_rows.x, lights.sky_rows.y);
+        }
+        out_radiance = vec4(weights, 0.0, coverage_alpha());
+        return;
+    }
+#endif
     if (VARIANT_QUANTITY == QUANTITY_IRRADIANCE) {
         // The irradiance at the surface [W/m^2] (shading::quantity): the lights' visible parts, no material.
         out_radiance = vec4(irradiance_visible(frame), coverage_alpha());

@@ -124,7 +124,17 @@ vec3 irradiance_visible(Frame p) {
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
         float v = 1.0;
         if (SHADOWS_ON && normal.y > -1.0) {
-            v = sky_visible_fraction(p.shadow_origin, k, normal);
+            // By the slices the sky's passes took before this one, where they did (gpu::sky_passes).
+            v = -1.0;
+#ifdef SUNSHADE_RAY_BVH
+            if (lights.sky_rows.z == SKY_ROWS_READ) {
+                uvec2 pixel = uvec2(gl_FragCoord.xy);
+                v = sky_fractions[pixel.y * uint(pc.framebuffer_size.x) + pixel.x];
+            }
+#endif
+            if (v < 0.0) {
+                v = sky_visible_fraction(p.shadow_origin, k, normal);
+            }
         }
         e += sky_irradiance(lights.sky.rgb, normal.y) * v;
     }

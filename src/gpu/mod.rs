@@ -10,6 +10,7 @@
 //! - `commands`: record, submit, wait;
 //! - `accel`: acceleration structures for the shadow rays (ray queries);
 //! - `shadow_map`: the sun's shadow-map pass;
+//! - `sky_passes`: the sky's slices, taken in passes before the frame;
 //! - `renderer`: upload, draw, readback.
 
 mod accel;
@@ -26,6 +27,7 @@ mod renderer;
 pub mod shaders;
 pub mod shadow_bvh;
 mod shadow_map;
+pub mod sky_passes;
 pub mod slice_gather;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};

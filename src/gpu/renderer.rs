@@ -12,14 +12,16 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, MaterialGpu,
-    PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
+    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_sky_rows,
+    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, QUANTITY_SKY_ROWS, SHADOWS_MAP,
+    SHADOWS_NONE, SHADOWS_RAY, SKY_ROWS_NONE, SKY_ROWS_READ,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
+use super::sky_passes;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -111,6 +113,8 @@ pub struct Renderer {
     // Field order is drop order: everything that uses the device goes before `dev`.
     target: Option<Target>,
     lights: Option<Buffer>,
+    /// The sky's fractions from its passes of slices (`sky_passes`), or one unused value: binding 13.
+    sky_fractions: Option<Buffer>,
     sun_map: DepthMap,
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
@@ -200,6 +204,7 @@ impl Renderer {
         let renderer = Self {
             target: None,
             lights: None,
+            sky_fractions: None,
             sun_map,
             disk_maps,
             pipeline,
@@ -429,10 +434,8 @@ impl Renderer {
     }
 
     /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: with shadow maps,
-    /// on a device with ray queries (whose shader does not walk the BVH the slices gather from), or where the
-    /// sky casts shadows (the GPU slices the sun's disk and disk lights, shaders/slices.glsl; a comparison with the
-    /// reference would set unlike rules side by side).
-    fn check_slices(&self, technique: Shadows, settings: &RenderSettings) -> Result<(), GpuError> {
+    /// or on a device with ray queries (whose shader does not walk the BVH the slices gather from).
+    fn check_slices(&self, technique: Shadows) -> Result<(), GpuError> {
         let why = if technique == Shadows::None {
             return Ok(()); // nothing to slice
         } else if technique != Shadows::Ray {
@@ -440,8 +443,6 @@ impl Renderer {
         } else if !self.pipeline.rays_walk_bvh() {
             "the GPU takes slices where its fragment shader walks the occluders' BVH (devices without ray queries), \
              and this one has ray queries"
-        } else if settings.lights.sky.is_some() {
-            "the GPU slices the sun's disk and disk lights, not the sky, which casts shadows here"
         } else {
             return Ok(());
         };
@@ -477,7 +478,7 @@ impl Renderer {
             choice.reason += " (the device has no ray queries: the fragment shader walks the occluders' BVH)";
         }
         if settings.shading.visibility_rule == VisibilityRule::Slices {
-            self.check_slices(choice.technique, settings)?;
+            self.check_slices(choice.technique)?;
         }
         if choice.technique == Shadows::Map {
             if settings.lights.disks.len() > MAX_DISK_MAPS {
@@ -578,7 +579,7 @@ impl Renderer {
             .collect();
         self.pipeline.prepare_variants(&variants)?;
         let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
-        for variant in variants {
+        for &variant in &variants {
             draw_pipelines.push(self.pipeline.variant(variant)?.0);
         }
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
@@ -595,10 +596,28 @@ impl Renderer {
         }
         let pipelines = t_pipelines.elapsed();
         let t_render = Instant::now();
+        // The sky's visible fractions by its passes of slices, where the frame takes them (`sky_passes`).
+        let sky_sliced = shadows == SHADOWS_RAY
+            && self.pipeline.rays_walk_bvh()
+            && settings.shading.visibility_rule == VisibilityRule::Slices
+            && settings.lights.sky.is_some();
+        let mut passes_pipelines = Duration::ZERO;
+        let sky_fractions = if sky_sliced {
+            let (fractions, made) = self.sky_fractions(scene, settings, lights.mapped(), &variants)?;
+            passes_pipelines = made;
+            fractions
+        } else {
+            Buffer::storage(&self.dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?
+        };
+        let lights = if sky_sliced {
+            Buffer::storage(&self.dev, &with_sky_rows(lights.mapped(), [0, 0, SKY_ROWS_READ, 0]), "lights")?
+        } else {
+            lights
+        };
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
         unsafe {
-            self.write_descriptors(scene, &lights);
+            self.write_descriptors(scene, &lights, &sky_fractions);
             let cb = self.commands.begin(&self.dev)?;
             if shadow_pipeline.is_some() {
                 if let Some(frame) = &sun_map {
@@ -613,15 +632,70 @@ impl Renderer {
             self.record_scene_pass(cb, scene, settings, &draw_pipelines);
             self.commands.submit_and_wait(&self.dev, cb)?;
         }
-        let render = t_render.elapsed();
+        let render = t_render.elapsed() - passes_pipelines;
+        let pipelines = pipelines + passes_pipelines;
         let t_readback = Instant::now();
         let image = self.read_back(width, height)?;
         super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
         super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
+        self.sky_fractions = Some(sky_fractions);
         self.check_validation()?;
         Ok((image, FrameTimings { pipelines, render, readback }))
+    }
+
+    /// The sky's visible fraction at every pixel by its slices, taken in passes before the frame (`sky_passes`):
+    /// each pass draws the scene with `variants` turned to `QUANTITY_SKY_ROWS` and the light buffer `lights` (its
+    /// bytes) naming the pass's rows; a pass refused (a gather overflowed, the loop budget spent) is split in two and
+    /// drawn again, a refused single row refuses the image. The fractions' buffer, and the time spent making the
+    /// passes' pipelines.
+    fn sky_fractions(
+        &mut self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        lights: &[u8],
+        variants: &[ShaderVariant],
+    ) -> Result<(Buffer, Duration), GpuError> {
+        let t = Instant::now();
+        let pass_variants: Vec<_> =
+            variants.iter().map(|&v| ShaderVariant { quantity: QUANTITY_SKY_ROWS, ..v }).collect();
+        self.pipeline.prepare_variants(&pass_variants)?;
+        let mut pass_pipelines = Vec::with_capacity(pass_variants.len());
+        for &variant in &pass_variants {
+            pass_pipelines.push(self.pipeline.variant(variant)?.0);
+        }
+        let made = t.elapsed();
+        let unused = Buffer::storage(&self.dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?;
+        let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
+        let mut passes: std::collections::VecDeque<_> = sky_passes::first_passes(rows).into();
+        let mut sums = sky_passes::SkySums::new((settings.width * settings.height) as usize);
+        while let Some((first, count)) = passes.pop_front() {
+            let pass_lights =
+                Buffer::storage(&self.dev, &with_sky_rows(lights, [first, count, SKY_ROWS_NONE, 0]), "lights")?;
+            // SAFETY: as in `render`: the GPU is idle between submissions.
+            unsafe {
+                self.write_descriptors(scene, &pass_lights, &unused);
+                let cb = self.commands.begin(&self.dev)?;
+                self.record_scene_pass(cb, scene, settings, &pass_pipelines);
+                self.commands.submit_and_wait(&self.dev, cb)?;
+            }
+            let image = self.read_back(settings.width, settings.height)?;
+            match sky_passes::refusal(&image) {
+                None => sums.add(&image),
+                Some(_) if count > 1 => {
+                    let half = count / 2;
+                    passes.push_front((first + half, count - half));
+                    passes.push_front((first, half));
+                }
+                Some(_) => {
+                    super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
+                    super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
+                }
+            }
+        }
+        let fractions = Buffer::storage(&self.dev, bytemuck::cast_slice(&sums.fractions()), "sky fractions")?;
+        Ok((fractions, made))
     }
 
     /// The colour and depth targets and the readback buffer, (re)made for this size.
@@ -660,14 +734,14 @@ impl Renderer {
     }
 
     /// Bindings 0 materials, 1 lights, 2 indices, 3 vertices, 4 the acceleration structure, 5 the sun's map.
-    unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer) {
+    unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer, sky_fractions: &Buffer) {
         let d = &self.dev.device;
         // SAFETY: the caller guarantees the GPU is idle; every handle belongs to this renderer.
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
-                // 12 the occluders' BVH for the pipelines whose shadow rays walk it.
+                // 12 the occluders' BVH and 13 the sky's fractions for the pipelines whose shadow rays walk it.
                 let mut buffers = vec![
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
@@ -680,6 +754,7 @@ impl Renderer {
                 ];
                 if self.pipeline.rays_walk_bvh() {
                     buffers.push((12, scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer)));
+                    buffers.push((13, sky_fractions.buffer));
                 }
                 let infos: Vec<_> = buffers
                     .into_iter()

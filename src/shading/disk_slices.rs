@@ -110,7 +110,7 @@ pub fn disk_visible_fraction_sliced(
     // One walk over the cone, each triangle filed under the rows its arc about the axis holds (`slice_buckets`);
     // only triangles with a corner before the rays' ends kept; the rows, ψ = mid − half cos u ascending, made only
     // where the walk keeps one.
-    let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond };
+    let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond, row: None };
     let rows = || cosine_rows(dhat, q, (mid, half), rows.max(1));
     sliced_fraction(s, &reach, before, (frame_about(dhat, q), rows, |r: &CosineRow| r.p), |i, row, buckets, blocked| {
         let &CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. } = row;

@@ -1,6 +1,7 @@
 //! The sky's visible fraction by slices: exact along one angle, a midpoint rule along the other. The reference's
-//! alternative to the located grid (`visibility::grid_fraction`) where its occluders are opaque triangles; no GPU
-//! mirror (the shader has no room for a list of intervals a row).
+//! alternative to the located grid (`visibility::grid_fraction`) where its occluders are opaque triangles. The GPU
+//! takes the same rows in passes, each row walking the occluders for its own triangles ([`sky_rows_weights`],
+//! shaders/slices.glsl, `gpu::sky_passes`).
 //!
 //! The sphere of directions is cut into half great circles through a fixed axis `c` ([`SLICE_AXIS`]):
 //! `ω(β, ψ) = cos β c + sin β p(ψ)`, `p(ψ) = cos ψ p₁ + sin ψ p₂`, `β ∈ [0, π]`, `ψ ∈ [0, 2π)`, the area element
@@ -334,9 +335,7 @@ fn sky_row(n: DVec3, c: DVec3, p: DVec3) -> Option<SkyRow> {
 /// then the caller casts rays. Exactly 1 where no row meets an occluder (the same sums), and 1 where the sky
 /// gives nothing (a surface facing straight down).
 pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option<f64> {
-    let c = DVec3::from_array(SLICE_AXIS);
-    let p1 = c.cross(DVec3::Z).normalize();
-    let p2 = c.cross(p1);
+    let (c, p1, p2) = sky_frame();
     let rows = || {
         midpoint_rows(rows.max(1))
             .map(|psi| {
@@ -347,7 +346,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
     };
     // One walk for all rows: the triangles above both horizons, each filed under the rows its arc about the axis
     // holds (`slice_buckets`); a row then tests only its own.
-    let reach = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None };
+    let reach = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None, row: None };
     sliced_fraction(
         s,
         &reach,
@@ -360,6 +359,44 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
             Some((row_visible_weight(row, (n_c, n_p), (span, whole), blocked), whole))
         },
     )
+}
+
+/// The slices' axis `c` and the frame `(p₁, p₂)` across it whose azimuths the rows' midpoints ψ run in:
+/// `p₁ = c × z` normalised, `p₂ = c × p₁`.
+fn sky_frame() -> (DVec3, DVec3, DVec3) {
+    let c = DVec3::from_array(SLICE_AXIS);
+    let p1 = c.cross(DVec3::Z).normalize();
+    (c, p1, c.cross(p1))
+}
+
+/// One pass of the sky's slices, the GPU's unit of work (`gpu::sky_passes`, shaders/slices.glsl): the rows
+/// `first .. first + count` of [`sky_visible_fraction_sliced`]'s `rows`, each walking the occluders for the
+/// triangles its own half-plane may cut (`SliceReach::row`; a pixel's sky reaches more triangles than a fragment
+/// gathers, a row's plane some hundred); `(visible, whole)` summed over them, or `None` where the occluders cannot
+/// be sliced. Over passes covering every row, `rows_fraction` of the sums is the fraction by slices (the same rows,
+/// the same triangles a row: tested).
+pub fn sky_rows_weights(s: &Shadowing, n: DVec3, rows: u32, first: u32, count: u32) -> Option<(f64, f64)> {
+    let (c, p1, p2) = sky_frame();
+    let rows = rows.max(1);
+    let (mut visible, mut total) = (0.0, 0.0);
+    let mut triangles = Vec::new();
+    let mut blocked = Vec::new();
+    for i in first..first + count {
+        let psi = std::f64::consts::TAU * (i as f64 + 0.5) / rows as f64;
+        let (sin_p, cos_p) = psi.sin_cos();
+        let p = cos_p * p1 + sin_p * p2;
+        let Some(SkyRow { n_cp, span, whole }) = sky_row(n, c, p) else { continue };
+        let m = c.cross(p);
+        let reach = SliceReach { origin: s.origin, above: [DVec3::Y, n], cone: None, beyond: None, row: Some((p, m)) };
+        triangles.clear();
+        if !s.occluders.slice_triangles(&reach, &mut |tri| triangles.push(tri.map(|x| x - s.origin))) {
+            return None;
+        }
+        let row = triangles.iter().filter_map(|&tri| blocked_interval(tri, c, p, m));
+        visible += row_visible_weight(row, n_cp, (span, whole), &mut blocked);
+        total += whole;
+    }
+    Some((visible, total))
 }
 
 #[cfg(test)]
@@ -462,6 +499,37 @@ mod tests {
             let got = sky_visible_fraction_sliced(&shadowing(&occ, 6), n, rows).unwrap();
             assert!(every > 0.05 && every < 0.95, "{n}: {every}");
             assert_eq!(got, every, "{n}");
+        }
+    }
+
+    /// The GPU's passes (a walk a row, [`sky_rows_weights`]) sum to the reference's fraction by slices (one walk
+    /// for all rows, buckets), however the rows are cut into passes.
+    #[test]
+    fn passes_of_rows_walking_for_their_own_give_the_fraction_by_slices() {
+        let mut r = crate::test_rng::uniform(0x2545f4914f6cdd1d);
+        let tris: Vec<[DVec3; 3]> = (0..400)
+            .map(|_| {
+                let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
+                [0, 1, 2].map(|_| centre + 0.5 * DVec3::new(r(), r(), r()))
+            })
+            .collect();
+        let occ = Bvh::new(tris);
+        for n in [DVec3::Y, DVec3::new(0.3, 1.0, 0.2).normalize(), DVec3::new(-0.8, 0.3, 0.2).normalize()] {
+            let s = shadowing(&occ, 6);
+            let rows = slice_rows(6);
+            let whole = sky_visible_fraction_sliced(&s, n, rows).unwrap();
+            assert!(whole > 0.05 && whole < 0.95, "{n}: {whole}");
+            for cuts in [vec![0, rows], vec![0, 1, 50, 51, 143, rows], vec![0, 7, 100, rows - 1, rows]] {
+                let (mut visible, mut total) = (0.0, 0.0);
+                for pass in cuts.windows(2) {
+                    let (v, t) = sky_rows_weights(&s, n, rows, pass[0], pass[1] - pass[0]).unwrap();
+                    visible += v;
+                    total += t;
+                }
+                let passes = rows_fraction(visible, total);
+                assert!((passes - whole).abs() < 1e-13, "{n} {cuts:?}: {passes} against {whole}");
+            }
+            assert_eq!(sky_rows_weights(&shadowing(&Unoccluded, 6), n, rows, 3, 40).map(|(v, t)| v == t), Some(true));
         }
     }
 

@@ -101,7 +101,7 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
     // (`slice_buckets`); the rows, ψ = −σ cos u ascending, made only where the walk keeps a triangle.
     let cone = Some((l, sigma.cos(), sigma.sin()));
-    let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None };
+    let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None, row: None };
     let rows = || cosine_rows(l, q, (0.0, sigma), rows.max(1));
     sliced_fraction(
         s,

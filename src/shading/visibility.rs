@@ -187,6 +187,9 @@ pub struct SliceReach {
     /// A half-space `k·(x − origin) > b` (`(k, b)`) that a triangle must reach into to count (the near side of
     /// a disk light, where its rays end), if any.
     pub beyond: Option<(DVec3, f64)>,
+    /// One row's half-plane `{s c + t p : t ≥ 0}` through `origin` (`(p, m)`, `m` the plane's unit normal), if the
+    /// walk is for one row only (the GPU's sky, a walk a row: `sky_slices::sky_rows_weights`).
+    pub row: Option<(DVec3, DVec3)>,
 }
 
 /// Nothing occludes anything.
@@ -562,7 +565,7 @@ pub fn disk_sample(
 /// with unit normal `n`.
 ///
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
-/// (`sun_slices`), which the GPU does not mirror.
+/// (`sun_slices`; the GPU too, shaders/slices.glsl, where its shader walks the BVH).
 pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
     if let Some(v) = s.by_slices(|rows| super::sun_slices::sun_visible_fraction_sliced(s, n, l, angular_diameter, rows))
     {
@@ -578,7 +581,7 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
 /// projected solid angle, from the point `x` with unit normal `n`.
 ///
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
-/// (`disk_slices`), which the GPU does not mirror.
+/// (`disk_slices`; the GPU too, as the sun's).
 pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
     if let Some(v) = s.by_slices(|rows| super::disk_slices::disk_visible_fraction_sliced(s, n, center, d, radius, rows))
     {
@@ -657,7 +660,7 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
 /// reach what stands at the point's own height, the limit of the sky's rays just above it.
 ///
 /// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
-/// slices instead (`sky_slices`: exact along one angle, second order in its rows), which the GPU does not mirror.
+/// slices instead (`sky_slices`: exact along one angle, second order in its rows; the GPU in passes of them).
 pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
     if let Some(v) = s.by_slices(|rows| super::sky_slices::sky_visible_fraction_sliced(s, n, rows)) {
         return v;

@@ -329,8 +329,9 @@ impl crate::shading::Occlusion for Bvh {
 
 impl Bvh {
     /// Visits (the index as given to [`Bvh::new`] of) every triangle in a leaf whose box reaches into the
-    /// half-spaces `above` and `beyond` of a point's slices and whose bounding sphere may meet their cone (the
-    /// lights' slices: `shading::sky_slices`, `sun_slices`, `disk_slices`). A box reaches into a half-space where
+    /// half-spaces `above` and `beyond` of a point's slices, whose bounding sphere may meet their cone, and which
+    /// may hold a part of their one `row` ([`within_row`]) (the lights' slices: `shading::sky_slices`,
+    /// `sun_slices`, `disk_slices`). A box reaches into a half-space where
     /// its centre's signed distance plus its half-extent projected on the normal is positive; the boxes' padding
     /// (a relative 1e-9) covers the rounding of those tests.
     pub fn within_reach(&self, reach: &SliceReach, mut visit: impl FnMut(usize)) {
@@ -342,7 +343,8 @@ impl Bvh {
             // The culls as written (a NaN distance keeps the box: no comparison culls it).
             let culled = !reach.above.iter().all(|&k| reaches(centre, half, k))
                 || reach.cone.is_some_and(|(axis, cos, sin)| !sphere_meets_cone(centre, half.length(), axis, cos, sin))
-                || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b);
+                || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b)
+                || reach.row.is_some_and(|(p, m)| !within_row(centre, half, p, m));
             !culled
         };
         self.descend(enter, |i| {
@@ -350,6 +352,13 @@ impl Bvh {
             false
         });
     }
+}
+
+/// Whether a box (centre relative to a point's rays' origin, half-extent) may hold a part of a row's half-plane
+/// `{s c + t p : t ≥ 0}` of unit normal `m` through that origin: it straddles the plane and reaches `t > 0` (the
+/// GPU's sky rows' walk, shaders/slices.glsl; there with f32's slack, here the boxes' padding).
+pub fn within_row(centre: DVec3, half: DVec3, p: DVec3, m: DVec3) -> bool {
+    centre.dot(m).abs() <= half.dot(m.abs()) && centre.dot(p) + half.dot(p.abs()) > 0.0
 }
 
 impl Bvh {
@@ -445,8 +454,8 @@ mod tests {
 
     #[test]
     fn the_walk_within_reach_visits_every_triangle_the_slices_can_meet() {
-        // Every triangle with a corner in each half-space `above` and in `beyond`, and a corner inside the cone,
-        // must be visited (the walk may visit more); and the walk must leave some out.
+        // Every triangle with a corner in each half-space `above` and in `beyond`, a corner inside the cone, and a
+        // part of the row's half-plane, must be visited (the walk may visit more); and the walk must leave some out.
         let mut rng = Rng(11);
         let mut left_out = 0;
         for (count, size) in [(1usize, 0.5), (200, 0.2), (3000, 0.05)] {
@@ -459,7 +468,11 @@ mod tests {
                 let cone = (rng.f() < 0.5).then_some((axis, angle.cos(), angle.sin()));
                 let k = rng.v(1.0).normalize();
                 let beyond = (rng.f() < 0.5).then_some((k, rng.f() - 0.5));
-                let reach = SliceReach { origin, above, cone, beyond };
+                // A row's half-plane {s c + t p : t ≥ 0}, m = c × p, for some walks (the GPU's sky rows).
+                let m = rng.v(1.0).normalize();
+                let p = m.cross(rng.v(1.0)).normalize();
+                let row = (rng.f() < 0.5).then_some((p, m));
+                let reach = SliceReach { origin, above, cone, beyond, row };
                 let mut visited = vec![false; count];
                 bvh.within_reach(&reach, |i| visited[i] = true);
                 left_out += visited.iter().filter(|&&v| !v).count();
@@ -470,7 +483,12 @@ mod tests {
                     let in_cone =
                         cone.is_none_or(|(a, cos, _)| t.iter().any(|&p| (p - origin).normalize().dot(a) > cos));
                     let is_beyond = beyond.is_none_or(|(k, b)| side(k).iter().any(|&x| x > b));
-                    if in_cone && is_beyond && above.iter().all(|&k| reaches(k)) {
+                    // The segment in which the row's plane cuts it, reaching t > 0.
+                    let in_row = row.is_none_or(|(p, m)| {
+                        crate::shading::sky_slices::slice_segment(t.map(|x| x - origin), m.cross(p), p, m)
+                            .is_some_and(|[a, b]| a.1 > 0.0 || b.1 > 0.0)
+                    });
+                    if in_cone && is_beyond && in_row && above.iter().all(|&k| reaches(k)) {
                         assert!(visited[i], "{count} triangles: triangle {i} missed");
                     }
                 }

@@ -1,0 +1,126 @@
+//! The sky's visible fraction by slices on the GPU, in passes. The reference slices the sky through occluders
+//! (`shading::sky_slices`: half great circles through a fixed axis, each row's blocked intervals exact, midpoints
+//! in the rows' angle). The sun's and disk lights' slices on the GPU gather the occluders in the light's cone once
+//! a pixel (`MAX_SLICE_TRIANGLES`, 1024); a pixel's sky reaches every occluder above its horizons, on overcast.glb
+//! the whole teapot (2256 triangles), and a wedge of rows about the axis does not narrow that where the axis line
+//! from the point passes through the teapot (measured at 64 × 48: wedges of 45° gathered up to all 2256). A row's
+//! plane cuts far fewer, so each row walks the BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on
+//! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and the rows are taken
+//! in passes before the frame, as many a pass as the loop budget (65 535 iterations, `loop_budget`) holds: each
+//! pass draws the scene with the variant `QUANTITY_SKY_ROWS`, whose fragment writes its rows' visible and
+//! unoccluded weights; the host sums the passes per pixel in f64 ([`SkySums`]) and the frame reads each pixel's
+//! fraction from a buffer (`SKY_ROWS_READ`).
+//!
+//! The passes start as [`first_passes`] cuts the rows, at most [`ROWS_A_PASS`] each. A pass that the limiter cuts
+//! short, or where a row's intervals overflow what a fragment keeps, is split in two and drawn again
+//! ([`refusal`]); a single row that still is refuses the image, with the reason of its refusal. The sums are
+//! those of the reference's rows in another order (f32 within a pass), so a clear sky still reads exactly 1
+//! ([`SkySums::fractions`]: `rows_fraction`'s rule).
+
+use crate::film::Image;
+use crate::shading::sky_slices::rows_fraction;
+
+use super::loop_budget::LOOP_BUDGET_SPENT;
+use super::slice_gather::SLICES_OVERFLOWED;
+
+/// The most rows a pass takes at first: at some 100 iterations a row (overcast.glb: 80 for the walk, 20 for the
+/// triangles it meets), 128 rows spend a fifth of the loop budget, leaving room for pixels whose rows cut more
+/// (at 256 rows a pass, k = 8 at 64 × 48, some pixels were cut short and the pass was split).
+pub const ROWS_A_PASS: u32 = 128;
+
+/// The passes `(first row, rows)` that cover `rows` rows in order, at most [`ROWS_A_PASS`] rows each, their sizes
+/// differing by at most one.
+pub fn first_passes(rows: u32) -> Vec<(u32, u32)> {
+    let passes = rows.div_ceil(ROWS_A_PASS).max(1);
+    (0..passes)
+        .map(|j| {
+            let first = (j as u64 * rows as u64 / passes as u64) as u32;
+            let next = ((j as u64 + 1) * rows as u64 / passes as u64) as u32;
+            (first, next - first)
+        })
+        .filter(|&(_, count)| count > 0)
+        .collect()
+}
+
+/// Why a pass's image cannot be summed, if it cannot: a pixel with a row whose intervals overflowed, or whose loops
+/// the limiter cut short (the coverage alphas `SLICES_OVERFLOWED`, `LOOP_BUDGET_SPENT`). Either is split and drawn
+/// again.
+pub fn refusal(image: &Image) -> Option<f32> {
+    [SLICES_OVERFLOWED, LOOP_BUDGET_SPENT].into_iter().find(|&a| image.alpha_count_and_first(a).is_some())
+}
+
+/// The passes' weights summed per pixel: visible and unoccluded, f64, and the pixels a pass could not slice.
+pub struct SkySums {
+    visible: Vec<f64>,
+    total: Vec<f64>,
+    unsliceable: Vec<bool>,
+}
+
+impl SkySums {
+    pub fn new(pixels: usize) -> Self {
+        Self { visible: vec![0.0; pixels], total: vec![0.0; pixels], unsliceable: vec![false; pixels] }
+    }
+
+    /// Adds one pass's image: (visible, whole) in red and green; a negative visible weight where the pixel's
+    /// slices could not be taken (an alpha-masked occluder, `SLICES_UNSLICEABLE`).
+    pub fn add(&mut self, pass: &Image) {
+        for (i, p) in pass.pixels().iter().enumerate() {
+            if p[0] < 0.0 {
+                self.unsliceable[i] = true;
+            } else {
+                self.visible[i] += p[0] as f64;
+                self.total[i] += p[1] as f64;
+            }
+        }
+    }
+
+    /// Each pixel's visible fraction, `rows_fraction` of its sums (exactly 1 where every row was clear, and where
+    /// the sky gives nothing), or −1 where some pass could not slice it: the frame then casts the grid's rays there,
+    /// as the reference does.
+    pub fn fractions(&self) -> Vec<f32> {
+        (0..self.visible.len())
+            .map(|i| if self.unsliceable[i] { -1.0 } else { rows_fraction(self.visible[i], self.total[i]) as f32 })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_passes_cover_every_row_once_in_order() {
+        for rows in [1u32, 3, 8, 9, 64, 100, 324, 676, 2916, 6084] {
+            let passes = first_passes(rows);
+            let mut next = 0;
+            for &(first, count) in &passes {
+                assert_eq!(first, next, "{rows}: {passes:?}");
+                assert!(count >= 1 && count <= ROWS_A_PASS, "{rows}: {passes:?}");
+                next = first + count;
+            }
+            assert_eq!(next, rows);
+            assert_eq!(passes.len() as u32, rows.div_ceil(ROWS_A_PASS));
+            let sizes = passes.iter().map(|p| p.1);
+            assert!(sizes.clone().max().unwrap() - sizes.min().unwrap() <= 1);
+        }
+    }
+
+    #[test]
+    fn sums_keep_a_clear_sky_exactly_one_and_name_what_could_not_be_sliced() {
+        let mut a = Image::new(3, 1);
+        let mut b = Image::new(3, 1);
+        // Pixel 0 clear in both passes, pixel 1 half hidden in the second, pixel 2 unsliceable in the first.
+        a.pixels_mut().copy_from_slice(&[[0.3, 0.3, 0.0, 1.0], [0.2, 0.2, 0.0, 1.0], [-1.0, 0.0, 0.0, 1.0]]);
+        b.pixels_mut().copy_from_slice(&[[0.7, 0.7, 0.0, 1.0], [0.1, 0.2, 0.0, 1.0], [0.5, 0.5, 0.0, 1.0]]);
+        let mut sums = SkySums::new(3);
+        sums.add(&a);
+        sums.add(&b);
+        let f = sums.fractions();
+        assert_eq!(f[0], 1.0);
+        assert!((f[1] - 0.75).abs() < 1e-7, "{f:?}");
+        assert_eq!(f[2], -1.0);
+        assert_eq!(refusal(&a), None);
+        a.pixels_mut()[1][3] = SLICES_OVERFLOWED;
+        assert_eq!(refusal(&a), Some(SLICES_OVERFLOWED));
+    }
+}
