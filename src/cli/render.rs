@@ -9,7 +9,7 @@ use super::diff::{compare_and_report, ReportFormat, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
 use crate::accuracy::predicted::{self, Prediction};
-use crate::accuracy::trial::{render_within_tolerance, TrialError};
+use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
 use crate::gpu::{pipeline_cache, FrameTimings, Interpolation};
@@ -152,7 +152,11 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         };
     }
     if slices {
-        choice.reason += "; the sun's and disk lights' visible fractions by slices (--visibility slices)";
+        choice.reason += if settings.lights.sky.is_some() {
+            "; the lights' visible fractions by slices (--visibility slices; the sky's in passes before the frame)"
+        } else {
+            "; the lights' visible fractions by slices (--visibility slices)"
+        };
     }
     if choice.warning {
         super::warn_once(&format!("shadows: {}", choice.reason));
@@ -170,49 +174,101 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         asked: a.scene.shadows,
         scene_can_occlude: gpu_scene.can_occlude(),
     };
-    let tolerance = a.scene.tolerance();
+    // Where the GPU slices the sky through occluders the promise holds in penumbrae too, asked or not, as the
+    // reference's does (`accuracy::trial::reference_within_tolerance`): the sky's penumbra is nearly the whole image.
+    let sky_sliced = crate::accuracy::trial::sky_by_slices(scene_data, &settings, gpu_scene.can_occlude());
+    let tolerance = a.scene.tolerance().map(|t| Tolerance { in_penumbrae: t.in_penumbrae || sky_sliced, ..t });
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
-    let done = render_within_tolerance(
-        request,
-        &mut settings,
-        tolerance,
-        &reference,
-        |s| {
-            let (image, t) = r.render(gpu_scene, s)?;
-            spent.pipelines += t.pipelines;
-            spent.render += t.render;
-            spent.readback += t.readback;
-            Ok::<_, crate::gpu::GpuError>((image, t))
-        },
-        |(image, _)| image,
-    )
-    .map_err(|e| match (e, tolerance) {
-        (TrialError::Tolerance(why), _) => CliError::Usage(why),
+    let mut gpu_render = |s: &RenderSettings| {
+        let (image, t) = r.render(gpu_scene, s)?;
+        spent.pipelines += t.pipelines;
+        spent.render += t.render;
+        spent.readback += t.readback;
+        Ok::<_, crate::gpu::GpuError>((image, t))
+    };
+    let beyond = |e: crate::gpu::GpuError, settings: &RenderSettings| match (e, tolerance) {
         // A render the device cannot run (`settings` holds its grids, the finest of any material's): the models
         // chosen, or a grid the study went on to; no setting it can render meets the tolerance.
-        (TrialError::Render(crate::gpu::GpuError::LoopBudget(why)), Some(t)) => CliError::Usage(format!(
+        (crate::gpu::GpuError::LoopBudget(why), Some(t)) => CliError::Usage(format!(
             "--tolerance {:e}: {}; `sunshade reference` with the same scene flags has no such limit",
             t.max_relative,
-            beyond_this_device(&settings, &why)
+            beyond_this_device(settings, &why)
         )),
-        (TrialError::Render(e), _) => CliError::from(e),
-    })?;
-    let (image, _) = done.kept;
+        (e, _) => CliError::from(e),
+    };
+    let (image, prediction) = match tolerance {
+        Some(t) if sky_sliced => {
+            let scene_flags = (a.scene.shadows, gpu_scene.can_occlude());
+            sky_studied_on_the_reference(scene_data, &mut settings, &reference, scene_flags, t, |s| {
+                gpu_render(s).map(|(image, _)| image).map_err(|e| beyond(e, s))
+            })?
+        }
+        _ => {
+            let done = render_within_tolerance(request, &mut settings, tolerance, &reference, gpu_render, |(i, _)| i)
+                .map_err(|e| match e {
+                TrialError::Tolerance(why) => CliError::Usage(why),
+                TrialError::Render(e) => beyond(e, &settings),
+            })?;
+            let ((image, _), mut prediction) = (done.kept, done.prediction);
+            if let Some(t) = tolerance.filter(|t| t.in_penumbrae) {
+                slices_measured_against_the_reference(
+                    &image,
+                    scene_data,
+                    &settings,
+                    &reference,
+                    t.max_relative,
+                    &mut prediction,
+                )?;
+            }
+            (image, prediction)
+        }
+    };
     let frame = spent;
-    let mut prediction = done.prediction;
-    if let Some(t) = tolerance.filter(|t| t.in_penumbrae) {
-        slices_measured_against_the_reference(
-            &image,
-            scene_data,
-            &settings,
-            &reference,
-            t.max_relative,
-            &mut prediction,
-        )?;
-    }
     warn_if_nothing_covered(&image, &a.scene.scene);
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
+}
+
+/// `--tolerance` where the GPU slices the sky through occluders: the grids are studied on the reference, the same
+/// rule in f64 (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps), then the
+/// GPU renders once with them (`render`), and the distance of its image from the reference's at those settings
+/// (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to the prediction, T
+/// refused by name where the sum exceeds it. The GPU's sky passes cost some 40 ms a row at 64 × 48 on lavapipe
+/// (`gpu::sky_passes`) and a study's rungs thousands of rows: on overcast.glb at 64 × 48 and 1e-3 a study on the
+/// GPU took 6 min and kept 27² (its order capped at 1), the reference's takes 4 s and keeps 19².
+/// `(asked, can_occlude)`: the shadows asked for, and whether the scene can shadow itself.
+fn sky_studied_on_the_reference(
+    scene: &crate::scene::Scene,
+    settings: &mut RenderSettings,
+    reference: &ReferenceOptions,
+    (asked, can_occlude): (Shadows, bool),
+    tolerance: Tolerance,
+    render: impl FnOnce(&RenderSettings) -> Result<Image, CliError>,
+) -> Result<(Image, Prediction), CliError> {
+    let (studied, mut prediction) = crate::accuracy::trial::reference_within_tolerance(
+        scene,
+        settings,
+        reference,
+        asked,
+        can_occlude,
+        Some(tolerance),
+    )
+    .map_err(CliError::Usage)?;
+    let image = render(settings)?;
+    let apart = crate::accuracy::refinement::max_difference(&image, &studied);
+    prediction.add_measured(
+        "the GPU against the reference at the kept settings (measured; studied on the reference):",
+        apart,
+    );
+    if prediction.max_relative > tolerance.max_relative {
+        return Err(CliError::Usage(format!(
+            "--tolerance {:e}: the GPU's image is {apart:.1e} from the reference's at the settings kept (its f32 \
+             shading, interpolation and slices), which with the rest ({:.1e}) exceeds it; `sunshade reference` with \
+             the same scene flags has no f32",
+            tolerance.max_relative, prediction.max_relative
+        )));
+    }
+    Ok((image, prediction))
 }
 
 /// What f32 geometry costs the GPU's slices where `--tolerance` holds in penumbrae: a point millimetres to
@@ -249,9 +305,9 @@ fn slices_measured_against_the_reference(
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
-/// (`--tolerance-in-penumbrae`) and the GPU can take them for every light that casts shadows (the sun and disk
-/// lights, no sky, no alpha-masked occluders, a device whose fragment shader walks the BVH, and shadow rays: `auto`
-/// or `ray`, not where `auto` found nothing to shadow), as the reference defaults to them there; the grid otherwise.
+/// (`--tolerance-in-penumbrae`, or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
+/// alpha-masked occluders, a device whose fragment shader walks the BVH, and shadow rays: `auto` or `ray`, not
+/// where `auto` found nothing to shadow), as the reference defaults to them there; the grid otherwise.
 fn default_visibility(
     a: &SceneArgs,
     settings: &RenderSettings,
@@ -259,10 +315,11 @@ fn default_visibility(
     device: &crate::gpu::DeviceInfo,
     technique: Shadows,
 ) -> crate::shading::VisibilityRule {
-    let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae);
-    let lights = (settings.lights.sun.is_some() || !settings.lights.disks.is_empty()) && settings.lights.sky.is_none();
+    let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae || settings.lights.sky.is_some());
+    let lights = &settings.lights;
+    let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
     let rays = matches!(a.shadows, Shadows::Auto | Shadows::Ray) && technique != Shadows::None;
-    if in_penumbrae && lights && rays && !scene.has_alpha_masks() && !device.ray_query {
+    if in_penumbrae && lit && rays && !scene.has_alpha_masks() && !device.ray_query {
         crate::shading::VisibilityRule::Slices
     } else {
         crate::shading::VisibilityRule::Grid
