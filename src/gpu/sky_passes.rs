@@ -95,7 +95,7 @@ mod tests {
             let mut next = 0;
             for &(first, count) in &passes {
                 assert_eq!(first, next, "{rows}: {passes:?}");
-                assert!(count >= 1 && count <= ROWS_A_PASS, "{rows}: {passes:?}");
+                assert!((1..=ROWS_A_PASS).contains(&count), "{rows}: {passes:?}");
                 next = first + count;
             }
             assert_eq!(next, rows);
