@@ -621,7 +621,7 @@ float disk_visible_fraction_sliced(vec3 origin, vec3 n, vec3 center, vec3 d, flo
 
 // Whether a node's box may hold a part of the sky row's half-plane {s c + t p : t >= 0} (unit normal m) that lies
 // above the surface (n) and the ground: the box straddles the plane, reaches t >= 0 and the two half-spaces, each
-// within within_reach's slack (visibility/bvh.rs, within_row).
+// within within_reach's slack (visibility/bvh.rs: within_row, and within_reach's half-spaces `above`).
 bool within_row(BvhNode node, vec3 origin, vec3 n, vec3 p, vec3 m) {
     vec3 centre = 0.5 * (node.lo + node.hi) - origin;
     vec3 half_extent = 0.5 * (node.hi - node.lo);
@@ -634,7 +634,8 @@ bool within_row(BvhNode node, vec3 origin, vec3 n, vec3 p, vec3 m) {
 
 // The leaves one sky row's walk meets (their triangles' indices), cut after the walk: the walk's iterations then
 // hold only the boxes' tests, which llvmpipe runs for all of a SIMD group's lanes whenever one of them needs them
-// (measured on overcast.glb at 64 x 48, k = 4: 8.1 s with the triangles cut inside the walk, 2.0 s after it).
+// (measured on overcast.glb at 64 x 48, k = 4: a frame of 8.1 s with the triangles cut inside the walk, 4.6 s
+// after it).
 uint row_leaves[MAX_SLICE_TRIANGLES];
 // Child `ch` of an inner node on a sky row's walk: a leaf noted, an inner node within the row stacked; a row
 // meeting more leaves than row_leaves holds sets slices_overflowed (the renderer refuses the image).
@@ -679,8 +680,8 @@ uint row_leaves[MAX_SLICE_TRIANGLES];
 // unoccluded weights summed over the pass; (SLICES_UNSLICEABLE, 0) where an alpha-masked occluder is cut. The
 // renderer sums the passes and divides (gpu::sky_passes). A pixel's sky reaches every occluder above its
 // horizons, thousands of triangles, more than one gather keeps (the sun's and disk lights' slices gather once);
-// but a plane cuts some hundred of them, so each row walks the BVH for its own (within_row): a few hundred of the
-// budget's iterations a row, and the renderer gives each pass as many rows as the budget holds.
+// but a plane cuts some hundred of them, so each row walks the BVH for its own (within_row): some hundred of the
+// budget's iterations a row on overcast.glb, and the renderer gives each pass as many rows as the budget holds.
 vec2 sky_rows_weights(vec3 origin, vec3 n, uint rows, uint first, uint count) {
     vec3 c = SLICE_AXIS;
     vec3 p1 = normalize(cross(c, vec3(0.0, 0.0, 1.0)));

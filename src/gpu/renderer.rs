@@ -512,7 +512,8 @@ impl Renderer {
     }
 
     /// Draws an uploaded scene and reads the radiance back: the sun's shadow-map pass where the technique is
-    /// `map`, the scene pass, the readback.
+    /// `map`, the sky's passes of slices where its visible fraction is taken by them (`sky_passes`, with rays
+    /// walking the BVH and `--visibility slices`), the scene pass, the readback.
     pub fn render(&mut self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Image, FrameTimings), GpuError> {
         let (width, height) = (settings.width, settings.height);
         self.check_size(width, height)?;
@@ -647,8 +648,8 @@ impl Renderer {
 
     /// The sky's visible fraction at every pixel by its slices, taken in passes before the frame (`sky_passes`):
     /// each pass draws the scene with `variants` turned to `QUANTITY_SKY_ROWS` and the light buffer `lights` (its
-    /// bytes) naming the pass's rows; a pass refused (a gather overflowed, the loop budget spent) is split in two and
-    /// drawn again, a refused single row refuses the image. The fractions' buffer, and the time spent making the
+    /// bytes) naming the pass's rows; a pass the loop budget cuts short is split in two and drawn again (a single
+    /// row cut short refuses the image), one with a row meeting more triangles than a fragment keeps refuses it. The fractions' buffer, and the time spent making the
     /// passes' pipelines.
     fn sky_fractions(
         &mut self,
@@ -683,14 +684,16 @@ impl Renderer {
             let image = self.read_back(settings.width, settings.height)?;
             match sky_passes::refusal(&image) {
                 None => sums.add(&image),
-                Some(_) if count > 1 => {
+                Some(sky_passes::Refusal::Overflowed) => {
+                    return Err(GpuError::Unsupported(sky_passes::overflowed(&image, (first, count))));
+                }
+                Some(sky_passes::Refusal::LoopBudget) if count > 1 => {
                     let half = count / 2;
                     passes.push_front((first + half, count - half));
                     passes.push_front((first, half));
                 }
-                Some(_) => {
+                Some(sky_passes::Refusal::LoopBudget) => {
                     super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
-                    super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
                 }
             }
         }

@@ -5,23 +5,23 @@
 //! the whole teapot (2256 triangles), and a wedge of rows about the axis does not narrow that where the axis line
 //! from the point passes through the teapot (measured at 64 × 48: wedges of 45° gathered up to all 2256). A row's
 //! plane cuts far fewer, so each row walks the BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on
-//! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and the rows are taken
-//! in passes before the frame, as many a pass as the loop budget (65 535 iterations, `loop_budget`) holds: each
+//! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and
+//! the rows are taken in passes before the frame, as many a pass as the loop budget (65 535 iterations, `loop_budget`) holds: each
 //! pass draws the scene with the variant `QUANTITY_SKY_ROWS`, whose fragment writes its rows' visible and
 //! unoccluded weights; the host sums the passes per pixel in f64 ([`SkySums`]) and the frame reads each pixel's
 //! fraction from a buffer (`SKY_ROWS_READ`).
 //!
 //! The passes start as [`first_passes`] cuts the rows, at most [`ROWS_A_PASS`] each. A pass that the limiter cuts
-//! short, or where a row's intervals overflow what a fragment keeps, is split in two and drawn again
-//! ([`refusal`]); a single row that still is refuses the image, with the reason of its refusal. The sums are
-//! those of the reference's rows in another order (f32 within a pass), so a clear sky still reads exactly 1
-//! ([`SkySums::fractions`]: `rows_fraction`'s rule).
+//! short is split in two and drawn again ([`refusal`]; a single row still cut short refuses the image); a row whose
+//! walk meets more triangles than a fragment keeps (`MAX_SLICE_TRIANGLES`) refuses it at once ([`overflowed`]).
+//! The sums are those of the reference's rows in another order (f32 within a pass), so a clear sky still reads
+//! exactly 1 ([`SkySums::fractions`]: `rows_fraction`'s rule).
 
 use crate::film::Image;
 use crate::shading::sky_slices::rows_fraction;
 
 use super::loop_budget::LOOP_BUDGET_SPENT;
-use super::slice_gather::SLICES_OVERFLOWED;
+use super::slice_gather::{MAX_SLICE_TRIANGLES, SLICES_OVERFLOWED};
 
 /// The most rows a pass takes at first: at some 100 iterations a row (overcast.glb: 80 for the walk, 20 for the
 /// triangles it meets), 128 rows spend a fifth of the loop budget, leaving room for pixels whose rows cut more
@@ -42,11 +42,38 @@ pub fn first_passes(rows: u32) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// Why a pass's image cannot be summed, if it cannot: a pixel with a row whose intervals overflowed, or whose loops
-/// the limiter cut short (the coverage alphas `SLICES_OVERFLOWED`, `LOOP_BUDGET_SPENT`). Either is split and drawn
-/// again.
-pub fn refusal(image: &Image) -> Option<f32> {
-    [SLICES_OVERFLOWED, LOOP_BUDGET_SPENT].into_iter().find(|&a| image.alpha_count_and_first(a).is_some())
+/// Why a pass's image cannot be summed ([`refusal`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refusal {
+    /// A pixel with a row whose walk met more triangles than a fragment keeps: a row's own limit, which no split
+    /// of the passes lifts; the image is refused ([`overflowed`]).
+    Overflowed,
+    /// A pixel whose loops the limiter cut short: the pass is split in two and drawn again.
+    LoopBudget,
+}
+
+/// Why a pass's image cannot be summed, if it cannot: the coverage alphas `SLICES_OVERFLOWED` and
+/// `LOOP_BUDGET_SPENT`.
+pub fn refusal(image: &Image) -> Option<Refusal> {
+    if image.alpha_count_and_first(SLICES_OVERFLOWED).is_some() {
+        Some(Refusal::Overflowed)
+    } else if image.alpha_count_and_first(LOOP_BUDGET_SPENT).is_some() {
+        Some(Refusal::LoopBudget)
+    } else {
+        None
+    }
+}
+
+/// Why a pass (its first row and rows) with a row whose walk met more triangles than a fragment keeps refuses the
+/// image.
+pub fn overflowed(image: &Image, (first, count): (u32, u32)) -> String {
+    let (pixels, (x, y)) = image.alpha_count_and_first(SLICES_OVERFLOWED).unwrap_or((0, (0, 0)));
+    format!(
+        "--visibility slices: a row of the sky's slices (of rows {first} to {}) meets more than {MAX_SLICE_TRIANGLES} \
+         triangles at {pixels} pixel(s) (the first at ({x}, {y})), more than the GPU's slices keep a row; \
+         --visibility grid casts rays there, and `sunshade reference --visibility slices` has no such limit",
+        first + count - 1
+    )
 }
 
 /// The passes' weights summed per pixel: visible and unoccluded, f64, and the pixels a pass could not slice.
@@ -120,7 +147,11 @@ mod tests {
         assert!((f[1] - 0.75).abs() < 1e-7, "{f:?}");
         assert_eq!(f[2], -1.0);
         assert_eq!(refusal(&a), None);
+        a.pixels_mut()[0][3] = LOOP_BUDGET_SPENT;
+        assert_eq!(refusal(&a), Some(Refusal::LoopBudget));
         a.pixels_mut()[1][3] = SLICES_OVERFLOWED;
-        assert_eq!(refusal(&a), Some(SLICES_OVERFLOWED));
+        assert_eq!(refusal(&a), Some(Refusal::Overflowed));
+        let e = overflowed(&a, (17, 4));
+        assert!(e.contains("rows 17 to 20") && e.contains("1 pixel(s)") && e.contains("(1, 0)"), "{e}");
     }
 }
