@@ -185,10 +185,16 @@ layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
 
-#ifdef SUNSHADE_RAY_BVH
-// The occluders' tree for shadow rays on devices without ray queries (gpu::shadow_bvh::BvhNodeGpu, 32 bytes): a
-// box [m] (padded for the f32 slab test), and a leaf's first record of OccluderTriangles and their count, or an
-// inner node's (count 0) first child (the second follows it).
+// Every module with shadow rays walks the occluders' tree: for the rays themselves without ray queries
+// (SUNSHADE_RAY_BVH), and for the lights' slices (slices.glsl) with or without them.
+#if defined(SUNSHADE_RAY_BVH) || defined(SUNSHADE_RAY_QUERY)
+#define SUNSHADE_WALK
+#endif
+
+#ifdef SUNSHADE_WALK
+// The occluders' tree (gpu::shadow_bvh::BvhNodeGpu, 32 bytes): a box [m] (padded for the f32 slab test), and a
+// leaf's first record (WALK_RECORD) and their count, or an inner node's (count 0) first child (the second follows
+// it). One dummy node until a render walks it.
 struct BvhNode {
     vec3 lo;
     uint first;
@@ -204,6 +210,16 @@ layout(std430, set = 0, binding = 12) readonly buffer BvhNodes {
 layout(std430, set = 0, binding = 13) readonly buffer SkyFractions {
     float sky_fractions[];
 };
+#ifdef SUNSHADE_RAY_QUERY
+// With ray queries OccluderTriangles is in the acceleration structure's order (its masked hits read it by
+// primitive index), so the walk's records, in the tree's leaf order, are a buffer of their own.
+layout(std430, set = 0, binding = 14) readonly buffer WalkTriangles {
+    uvec4 walk_triangles[];
+};
+#define WALK_RECORD(i) walk_triangles[i]
+#else
+#define WALK_RECORD(i) occluder_triangles[i]
+#endif
 #endif
 
 // Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rho

@@ -43,13 +43,38 @@ bool blocks(uvec4 tri, vec2 b) {
     return masked_hit_blocks(material, s);
 }
 
-#ifdef SUNSHADE_RAY_BVH
-
+#ifdef SUNSHADE_WALK
+// What the shadow rays' walk (devices without ray queries) and the slices' walks (shaders/slices.glsl, on every
+// device with shadow rays) share: the tree, its leaves' corners, the walk.
 // A corner of an occluder triangle: the world position [m] of global vertex i (the vertex buffer's f32, which the
 // reference's rays meet as f64).
 #define OCCLUDER_CORNER(i) vec3(vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION], \
     vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 1u], \
     vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 2u])
+
+// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
+#define BVH_LEAF_SIZE 1u
+// The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
+#define BVH_STACK_SIZE 96
+// The walk below an inner root: nodes taken from an explicit stack (at most one pending sibling a level of a tree
+// fewer than 78 levels deep), each visiting its two children with VISIT(child), which stacks an inner child it
+// enters (`stack`, `top`) and may return from the caller. One iteration of llvmpipe's budget a node taken
+// (gpu::loop_budget). Shared by any_hit and the slices' gather (slices.glsl).
+#define BVH_WALK(VISIT) \
+    { \
+        uint stack[BVH_STACK_SIZE]; \
+        uint top = 1u; \
+        stack[0] = 0u; \
+        while (top > 0u) { \
+            top -= 1u; \
+            BvhNode node = bvh_nodes[stack[top]]; \
+            VISIT(node.first) \
+            VISIT(node.first + 1u) \
+        } \
+    }
+#endif
+
+#ifdef SUNSHADE_RAY_BVH
 
 // A ray prepared for the watertight test (WatertightRay in the Rust): the direction's dominant axis kz, the other
 // two kx, ky (swapped where the direction along kz is negative, keeping the winding), and the shear
@@ -142,10 +167,6 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     return !outside && !(lo > hi);
 }
 
-// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
-#define BVH_LEAF_SIZE 1u
-// The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
-#define BVH_STACK_SIZE 96
 // The triangle of the leaf node `leaf`: where the ray meets it and it blocks the ray, any_hit returns true.
 #define LEAF_TEST(leaf) \
     { \
@@ -154,22 +175,6 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
         if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary) \
             && blocks(tri, bary)) { \
             return true; \
-        } \
-    }
-// The walk below an inner root: nodes taken from an explicit stack (at most one pending sibling a level of a tree
-// fewer than 78 levels deep), each visiting its two children with VISIT(child), which stacks an inner child it
-// enters (`stack`, `top`) and may return from the caller. One iteration of llvmpipe's budget a node taken
-// (gpu::loop_budget). Shared by any_hit and the slices' gather (slices.glsl).
-#define BVH_WALK(VISIT) \
-    { \
-        uint stack[BVH_STACK_SIZE]; \
-        uint top = 1u; \
-        stack[0] = 0u; \
-        while (top > 0u) { \
-            top -= 1u; \
-            BvhNode node = bvh_nodes[stack[top]]; \
-            VISIT(node.first) \
-            VISIT(node.first + 1u) \
         } \
     }
 // Child `c` of an inner node, if the ray meets its box: a leaf tested at once, an inner node stacked.

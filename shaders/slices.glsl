@@ -1,5 +1,5 @@
-// The sun's and disk lights' visible fractions by slices, on devices whose fragment shader walks the occluders'
-// BVH itself (SUNSHADE_RAY_BVH). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
+// The lights' visible fractions by slices, in every module with shadow rays (SUNSHADE_WALK: the shader walks the
+// occluders' BVH for them, with ray queries or without). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
 // through an axis across the light, rows along psi = mid - half cos u, each row's chord of the light cut by the
 // surface's horizon and by the intervals that the triangles in its plane block, a disk light's segments first
 // clipped to where its rays end; the visible weight closed-form), sky_slices.rs (segments, pseudo-angles),
@@ -241,7 +241,7 @@ bool within_reach(BvhNode node, SliceReach r) {
 // slices too take the grid there), or the array is full (slices_overflowed set: the image is refused).
 #define GATHER_LEAF(leaf) \
     { \
-        uvec4 tri = occluder_triangles[(leaf).first]; \
+        uvec4 tri = WALK_RECORD((leaf).first); \
         if (materials[tri.w & 0x7fffffffu].kind.z != 0u) { \
             return -1; \
         } \
@@ -659,7 +659,7 @@ uint row_leaves[MAX_SLICE_TRIANGLES];
 // grid's rays there).
 #define SKY_ROW_LEAF(w) \
     if (!hidden && (w) < leaves) { \
-        uvec4 tri = occluder_triangles[row_leaves[w]]; \
+        uvec4 tri = WALK_RECORD(row_leaves[w]); \
         if (materials[tri.w & 0x7fffffffu].kind.z != 0u) { \
             return vec2(SLICES_UNSLICEABLE, 0.0); \
         } \

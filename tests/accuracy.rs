@@ -900,25 +900,16 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
 }
 
 /// `render --tolerance` on the sky through occluders (overcast.glb, the sky through the teapot onto its floor):
-/// where the GPU's shader walks the BVH, the sky is taken by slices in passes (`gpu::sky_passes`), the grids are
+/// the sky is taken by slices in passes (`gpu::sky_passes`), the grids are
 /// studied on the reference (the same rows in f64), and the GPU's image, measured against the reference's at the
 /// kept settings, meets T = 1e-2 and 1e-3 over every pixel against a truth whose every pixel's last doubling moved
 /// it by less than a tenth of 1e-4. Measured 2026-12-05 at 32 × 24 on Mesa 22.3.6: 9², 19², measured 1.3e-3,
 /// 6.9e-5, the GPU 8.1e-7 and 1.3e-6 from the reference at the kept settings (at 64 × 48 against `reference
-/// --converged --accuracy 1e-5`: 9.3e-4, 1.9e-4). With ray queries (no slices on the GPU) it is refused by name,
-/// pointing to the reference.
+/// --converged --accuracy 1e-5`: 9.3e-4, 1.9e-4). With `--visibility grid` it is refused by name, pointing to the
+/// slices.
 #[test]
 fn render_tolerance_meets_it_on_the_sky_through_occluders() {
     let dir = common::TempDir::new("tolerance-sky");
-    let walks = !common::CheckedRenderer::new().renderer().device_info().ray_query;
-    if !walks {
-        let o = render_to("models/overcast.glb --width 32 --height 24 --tolerance 1e-2", &dir.path("overcast.exr"));
-        let e = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.code() == Some(2) && e.contains("the sky's penumbra"), "{e}");
-        assert!(e.contains("`sunshade reference` with the same scene flags studies it on the CPU instead"), "{e}");
-        assert!(!dir.path("overcast.exr").exists(), "no image where it refused");
-        return;
-    }
     let scene = common::load(std::path::Path::new("models/overcast.glb"));
     let mut s = settings::resolve(&scene, 32, 24, &CameraOptions::default(), &SunOptions::default()).unwrap();
     s.shading.shadows = Shadows::Ray;
@@ -951,15 +942,21 @@ fn render_tolerance_meets_it_on_the_sky_through_occluders() {
         grids.push(k.parse::<u32>().unwrap());
     }
     assert!(grids[0] <= grids[1], "looser T must cost no more: {grids:?}");
+    let flags = "models/overcast.glb --width 32 --height 24 --tolerance 1e-2 --visibility grid";
+    let o = render_to(flags, &dir.path("overcast.exr"));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.code() == Some(2) && e.contains("the sky's penumbra"), "{e}");
+    assert!(e.contains("as `render` does with `--visibility slices`"), "{e}");
+    assert!(!dir.path("overcast.exr").exists(), "no image where it refused");
 }
 
 /// `render --tolerance T --tolerance-in-penumbrae` on sunset.glb (the sun's penumbrae) on any device: the shadow
 /// rays' grids join the study, `-v` says so, and the image meets T everywhere, penumbrae included, against the
 /// reference with the sun's and lobes' grids at 181² and the sun's visible fraction by 4 × 64² slices (an
 /// independent render, not the converged reference, whose per-pixel test two grids of a penumbra can pass by
-/// chance). T = 1e-2 on any device; where the fragment shader walks the BVH, the study takes the sun's penumbrae
-/// by slices (second order), and T = 1e-3 and 1e-4 too (a grid of rays stopped at llvmpipe's loop budget short of
-/// 1e-3 before).
+/// chance). The study takes the sun's penumbrae by slices (second order; on every device since 2026-12-05, with
+/// ray queries too), and T = 1e-2, 1e-3 and 1e-4 are met (a grid of rays stopped at llvmpipe's loop budget short
+/// of 1e-3 before).
 #[test]
 fn render_tolerance_in_penumbrae_meets_it_there() {
     let dir = common::TempDir::new("tolerance-penumbrae");
@@ -971,9 +968,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     s.shading.sun_samples_per_axis = 181;
     s.shading.shadow_samples_per_axis = 64;
     s.shading.visibility_rule = VisibilityRule::Slices;
-    let walks = !common::CheckedRenderer::new().renderer().device_info().ray_query;
-    let tolerances: &[f64] = if walks { &[1e-2, 1e-3, 1e-4] } else { &[1e-2] };
-    for &t in tolerances {
+    for t in [1e-2, 1e-3, 1e-4] {
         let out = dir.path(&format!("sunset-{t:e}.exr"));
         let flags = format!("models/sunset.glb --width 48 --height 36 --tolerance {t:e} --tolerance-in-penumbrae -v");
         let Some(e) = render_with_tolerance(&flags, &out) else {
@@ -981,17 +976,12 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
         };
         assert!(e.contains("penumbrae included"), "{e}");
         assert!(!e.contains("not bounded"), "{e}");
-        assert_eq!(e.contains("visible fractions by slices"), walks, "{e}");
+        assert!(e.contains("visible fractions by slices"), "{e}");
         let (measured, line) = common::error_against_fine(&out, &scene, &s, &e);
         eprintln!("sunset.glb, T = {t:e} in penumbrae: measured {measured:.2e} against the fine render; {line}");
         assert!(measured <= t, "{measured:.3e} over {t:e}\n{e}");
-        if walks {
-            // The f32 slices' own difference from the reference's is measured and part of the prediction.
-            assert!(line.contains("GPU f32 slices (measured against the reference's)"), "{line}");
-        }
-    }
-    if !walks {
-        return;
+        // The f32 slices' own difference from the reference's is measured and part of the prediction.
+        assert!(line.contains("GPU f32 slices (measured against the reference's)"), "{line}");
     }
     // cube.glb at 64²: its contact shadows put pixels a centimetre from the cube, where f32 corners leave the GPU's
     // slices 1.5e-4 from the reference's: T = 1e-4 is refused for it, by name, or met.

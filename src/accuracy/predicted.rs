@@ -522,8 +522,7 @@ pub(crate) fn techniques_within(
             match renderer {
                 Renderer::Gpu { .. } => {
                     "; `sunshade reference` with the same scene flags studies it on the CPU instead, by slices (second \
-                     order), as `render` does with `--visibility slices` (its default there) on devices whose \
-                     shader walks the BVH (no ray queries)"
+                     order), as `render` does with `--visibility slices` (its default there)"
                 }
                 Renderer::Reference => "",
             }

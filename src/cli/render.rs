@@ -133,9 +133,8 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let upload = session.upload(scene, renderer)?;
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let mut choice = r.shadow_choice(gpu_scene, &settings)?;
-    let rule = a
-        .visibility_rule
-        .unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, r.device_info(), choice.technique));
+    let rule =
+        a.visibility_rule.unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, choice.technique));
     let slices = rule == crate::shading::VisibilityRule::Slices;
     if (a.scene.tolerance.is_some() || slices) && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
         // Shadow maps have no error bound, and slices take the place of shadow rays: `auto` casts rays on any
@@ -306,20 +305,19 @@ fn slices_measured_against_the_reference(
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
 /// (`--tolerance-in-penumbrae`, or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
-/// alpha-masked occluders, a device whose fragment shader walks the BVH, and shadow rays: `auto` or `ray`, not
-/// where `auto` found nothing to shadow), as the reference defaults to them there; the grid otherwise.
+/// alpha-masked occluders, and shadow rays: `auto` or `ray`, not where `auto` found nothing to shadow), as the
+/// reference defaults to them there; the grid otherwise.
 fn default_visibility(
     a: &SceneArgs,
     settings: &RenderSettings,
     scene: &crate::scene::Scene,
-    device: &crate::gpu::DeviceInfo,
     technique: Shadows,
 ) -> crate::shading::VisibilityRule {
     let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae || settings.lights.sky.is_some());
     let lights = &settings.lights;
     let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
     let rays = matches!(a.shadows, Shadows::Auto | Shadows::Ray) && technique != Shadows::None;
-    if in_penumbrae && lit && rays && !scene.has_alpha_masks() && !device.ray_query {
+    if in_penumbrae && lit && rays && !scene.has_alpha_masks() {
         crate::shading::VisibilityRule::Slices
     } else {
         crate::shading::VisibilityRule::Grid

@@ -411,7 +411,8 @@ impl Renderer {
         let records = occluder_records(scene, &vertex_offsets, rq && masked);
         let occluder_triangles = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder triangles")?;
         let bvh_nodes = Buffer::storage(&self.dev, bytemuck::bytes_of(&BvhNodeGpu::zeroed()), "occluder BVH nodes")?;
-        let walk_source = bvh.then(|| WalkSource::new(scene, &vertex_offsets));
+        // The walk's source where the pipelines have shadow rays: their walk without ray queries, the slices' with.
+        let walk_source = (bvh || rq).then(|| WalkSource::new(scene, &vertex_offsets));
         Ok(GpuScene {
             accel,
             vertices,
@@ -433,18 +434,12 @@ impl Renderer {
         })
     }
 
-    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: with shadow maps,
-    /// or on a device with ray queries (whose shader does not walk the BVH the slices gather from).
+    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: with shadow maps.
     fn check_slices(&self, technique: Shadows) -> Result<(), GpuError> {
-        let why = if technique == Shadows::None {
-            return Ok(()); // nothing to slice
-        } else if technique != Shadows::Ray {
-            "slices take the place of shadow rays (--shadows ray)"
-        } else if !self.pipeline.rays_walk_bvh() {
-            "the GPU takes slices where its fragment shader walks the occluders' BVH (devices without ray queries), \
-             and this one has ray queries"
+        let why = if technique == Shadows::None || technique == Shadows::Ray {
+            return Ok(()); // nothing to slice, or the rays' place taken
         } else {
-            return Ok(());
+            "slices take the place of shadow rays (--shadows ray)"
         };
         Err(GpuError::Unsupported(format!(
             "--visibility slices: {why}; `sunshade reference --visibility slices` takes them for every light"
@@ -520,7 +515,9 @@ impl Renderer {
         self.ensure_target(width, height)?;
         self.lights = None;
         let technique = self.shadow_choice(scene, settings)?.technique;
-        if let (Shadows::Ray, Some(source), None) = (technique, &scene.walk_source, scene.walk.get()) {
+        // The walk's buffers, laid out when a render first walks: its rays without ray queries, its slices.
+        let walks = self.pipeline.rays_walk_bvh() || settings.shading.visibility_rule == VisibilityRule::Slices;
+        if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();
             let nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
             let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
@@ -599,7 +596,6 @@ impl Renderer {
         let t_render = Instant::now();
         // The sky's visible fractions by its passes of slices, where the frame takes them (`sky_passes`).
         let sky_sliced = shadows == SHADOWS_RAY
-            && self.pipeline.rays_walk_bvh()
             && settings.shading.visibility_rule == VisibilityRule::Slices
             && settings.lights.sky.is_some();
         let mut passes_pipelines = Duration::ZERO;
@@ -744,7 +740,7 @@ impl Renderer {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
-                // 12 the occluders' BVH and 13 the sky's fractions for the pipelines whose shadow rays walk it.
+                // 12 the occluders' BVH and 13 the sky's fractions for the pipelines with shadow rays.
                 let mut buffers = vec![
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
@@ -752,12 +748,19 @@ impl Renderer {
                     (3, vb.buffer),
                     (8, scene.texture_table.buffer),
                     (9, scene.surface_vertices.buffer),
-                    (10, scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, records)| records.buffer)),
                     (11, scene.measured.buffer),
                 ];
+                // The walk's records: binding 10 without ray queries; with them, 14, beside the acceleration
+                // structure's own order at 10.
+                let walk_records = scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, r)| r.buffer);
+                let nodes = scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer);
                 if self.pipeline.rays_walk_bvh() {
-                    buffers.push((12, scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer)));
-                    buffers.push((13, sky_fractions.buffer));
+                    buffers.extend([(10, walk_records), (12, nodes), (13, sky_fractions.buffer)]);
+                } else if self.pipeline.has_ray_queries() {
+                    buffers.extend([(10, scene.occluder_triangles.buffer), (12, nodes), (13, sky_fractions.buffer)]);
+                    buffers.push((14, walk_records));
+                } else {
+                    buffers.push((10, scene.occluder_triangles.buffer));
                 }
                 let infos: Vec<_> = buffers
                     .into_iter()
