@@ -459,6 +459,16 @@ float row_visible_weight(float n_c, float n_p, vec2 span, vec2 union_piece[UNION
     return blocked == 0u ? whole : jacobian * visible_weight_about_centre(n_c, n_p, span, blocked);
 }
 
+// A row's union, empty, for UNION_INSERT and the row's triangles to fill: its span's ends as pseudo-angles (key_lo,
+// key_hi), its pieces, the intervals set aside (spilled), and whether it hides the span (hidden).
+#define ROW_UNION_BEGIN(span) \
+    float key_lo = pseudo_angle_of_gamma((span).x); \
+    float key_hi = pseudo_angle_of_gamma((span).y); \
+    uint pieces = 0u; \
+    vec2 union_piece[UNION_PIECES]; \
+    uint spilled = 0u; \
+    bool hidden = false;
+
 // The part of the segment (e0, e1) where a.(s, t) < b, if any (a and b of a line of the slice's plane).
 bool clip_segment(inout vec2 e0, inout vec2 e1, vec2 a, float b) {
     float f0 = dot(a, e0) - b;
@@ -564,12 +574,7 @@ float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bo
             continue;
         }
         total += whole;
-        float key_lo = pseudo_angle_of_gamma(span.x);
-        float key_hi = pseudo_angle_of_gamma(span.y);
-        uint pieces = 0u;
-        vec2 union_piece[UNION_PIECES];
-        uint spilled = 0u;
-        bool hidden = false;
+        ROW_UNION_BEGIN(span)
         // Four triangles an iteration (SLICE_TRIANGLE written out four times): the budget counts iterations.
         for (uint w = 0u; w < count && !hidden; w += 4u) {
             SLICE_TRIANGLE(w)
@@ -704,12 +709,7 @@ vec2 sky_rows_weights(vec3 origin, vec3 n, uint rows, uint first, uint count) {
             continue;
         }
         total += whole;
-        float key_lo = pseudo_angle_of_gamma(span.x);
-        float key_hi = pseudo_angle_of_gamma(span.y);
-        uint pieces = 0u;
-        vec2 union_piece[UNION_PIECES];
-        uint spilled = 0u;
-        bool hidden = false;
+        ROW_UNION_BEGIN(span)
         uint leaves = 0u;
         if (within_row(root, origin, n, p, m)) {
             if (root.count > 0u) {

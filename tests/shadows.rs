@@ -1016,6 +1016,26 @@ fn specular_lobes_in_the_suns_penumbra_meet_their_quadrature() {
     assert!(report.pass, "{}", report.text("gpu", "reference"));
 }
 
+/// The GPU's slices at `s` (k² shadow rays, slices) against the reference's at the same settings, and the GPU's
+/// slices and grid against the reference's slices at k = 16 (the shadows' truth: everything else is the same):
+/// `(apart, slices' error, grid's error)`, max relative.
+fn slices_against_the_reference_and_the_grid(
+    gpu: &mut CheckedRenderer,
+    scene: &Scene,
+    s: &RenderSettings,
+) -> (f64, f64, f64) {
+    let sliced = gpu.render(scene, s);
+    let reference = cpu::render(scene, s, &gpu.reference_options());
+    let mut grid = s.clone();
+    grid.shading.visibility_rule = VisibilityRule::Grid;
+    let gridded = gpu.render(scene, &grid);
+    let mut fine = s.clone();
+    fine.shading.shadow_samples_per_axis = 16;
+    let truth = cpu::render(scene, &fine, &ReferenceOptions::default());
+    let max_rel = |a: &Image, b: &Image| compare::diff(a, b, &DiffOptions::default()).unwrap().0.max_rel;
+    (max_rel(&sliced, &reference), max_rel(&sliced, &truth), max_rel(&gridded, &truth))
+}
+
 #[test]
 fn gpu_sun_slices_agree_with_the_reference_and_beat_the_grid() {
     // sunset.glb's low sun behind the spheres' limbs (a penumbra's pixel gathers 100 to 200 triangles): the GPU's
@@ -1032,17 +1052,7 @@ fn gpu_sun_slices_agree_with_the_reference_and_beat_the_grid() {
     s.shading.shadows = Shadows::Ray;
     s.shading.shadow_samples_per_axis = 4;
     s.shading.visibility_rule = VisibilityRule::Slices;
-    let sliced = gpu.render(&scene, &s);
-    let reference = cpu::render(&scene, &s, &gpu.reference_options());
-    let mut grid = s.clone();
-    grid.shading.visibility_rule = VisibilityRule::Grid;
-    let gridded = gpu.render(&scene, &grid);
-    let mut fine = s.clone();
-    fine.shading.shadow_samples_per_axis = 16;
-    let truth = cpu::render(&scene, &fine, &ReferenceOptions::default());
-    let max_rel = |a: &Image, b: &Image| compare::diff(a, b, &DiffOptions::default()).unwrap().0.max_rel;
-    let (apart, sliced_error, grid_error) =
-        (max_rel(&sliced, &reference), max_rel(&sliced, &truth), max_rel(&gridded, &truth));
+    let (apart, sliced_error, grid_error) = slices_against_the_reference_and_the_grid(&mut gpu, &scene, &s);
     eprintln!("GPU slices vs reference {apart:.1e}; against k = 16: slices {sliced_error:.1e}, grid {grid_error:.1e}");
     assert!(apart <= 1e-5, "the GPU's slices {apart:e} from the reference's");
     assert!(
@@ -1068,17 +1078,7 @@ fn gpu_sky_slices_in_passes_agree_with_the_reference_and_beat_the_grid() {
     s.shading.shadows = Shadows::Ray;
     s.shading.shadow_samples_per_axis = 4;
     s.shading.visibility_rule = VisibilityRule::Slices;
-    let max_rel = |a: &Image, b: &Image| compare::diff(a, b, &DiffOptions::default()).unwrap().0.max_rel;
-    let sliced = gpu.render(&scene, &s);
-    let reference = cpu::render(&scene, &s, &gpu.reference_options());
-    let mut grid = s.clone();
-    grid.shading.visibility_rule = VisibilityRule::Grid;
-    let gridded = gpu.render(&scene, &grid);
-    let mut fine = s.clone();
-    fine.shading.shadow_samples_per_axis = 16;
-    let truth = cpu::render(&scene, &fine, &ReferenceOptions::default());
-    let (apart, sliced_error, grid_error) =
-        (max_rel(&sliced, &reference), max_rel(&sliced, &truth), max_rel(&gridded, &truth));
+    let (apart, sliced_error, grid_error) = slices_against_the_reference_and_the_grid(&mut gpu, &scene, &s);
     eprintln!(
         "sky: GPU slices vs reference {apart:.1e}; against k = 16: slices {sliced_error:.1e}, grid {grid_error:.1e}"
     );
@@ -1095,7 +1095,8 @@ fn gpu_sky_slices_in_passes_agree_with_the_reference_and_beat_the_grid() {
         angular_diameter: 0.53f32.to_radians(),
     });
     let both = gpu.render(&scene, &s);
-    let apart = max_rel(&both, &cpu::render(&scene, &s, &gpu.reference_options()));
+    let reference = cpu::render(&scene, &s, &gpu.reference_options());
+    let apart = compare::diff(&both, &reference, &DiffOptions::default()).unwrap().0.max_rel;
     eprintln!("sun and sky: GPU slices vs reference {apart:.1e}");
     assert!(apart <= 1e-5, "the GPU's sun and sky slices {apart:e} from the reference's");
 }

@@ -468,17 +468,23 @@ mod tests {
         }
     }
 
+    /// `count` random triangles of corners within `size` \[m\] of centres scattered over a few metres above the
+    /// origin's floor (seeded by `seed`).
+    fn scattered_above(seed: u64, count: usize, size: f64) -> Vec<[DVec3; 3]> {
+        let mut r = crate::test_rng::uniform(seed);
+        (0..count)
+            .map(|_| {
+                let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
+                [0, 1, 2].map(|_| centre + size * DVec3::new(r(), r(), r()))
+            })
+            .collect()
+    }
+
     /// The rows' buckets (`slice_buckets`) leave out no triangle a row's half-plane cuts: the fraction equals,
     /// to the bit, every row testing every triangle.
     #[test]
     fn buckets_give_what_every_row_testing_every_triangle_gives() {
-        let mut r = crate::test_rng::uniform(0x9e3779b97f4a7c15);
-        let tris: Vec<[DVec3; 3]> = (0..300)
-            .map(|_| {
-                let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
-                [0, 1, 2].map(|_| centre + 0.6 * DVec3::new(r(), r(), r()))
-            })
-            .collect();
+        let tris = scattered_above(0x9e3779b97f4a7c15, 300, 0.6);
         let occ = Bvh::new(tris.clone());
         let c = DVec3::from_array(SLICE_AXIS);
         let p1 = c.cross(DVec3::Z).normalize();
@@ -506,14 +512,7 @@ mod tests {
     /// for all rows, buckets), however the rows are cut into passes.
     #[test]
     fn passes_of_rows_walking_for_their_own_give_the_fraction_by_slices() {
-        let mut r = crate::test_rng::uniform(0x2545f4914f6cdd1d);
-        let tris: Vec<[DVec3; 3]> = (0..400)
-            .map(|_| {
-                let centre = DVec3::new(3.0 * r(), 0.2 + 2.0 * r().abs(), 3.0 * r());
-                [0, 1, 2].map(|_| centre + 0.5 * DVec3::new(r(), r(), r()))
-            })
-            .collect();
-        let occ = Bvh::new(tris);
+        let occ = Bvh::new(scattered_above(0x2545f4914f6cdd1d, 400, 0.5));
         for n in [DVec3::Y, DVec3::new(0.3, 1.0, 0.2).normalize(), DVec3::new(-0.8, 0.3, 0.2).normalize()] {
             let s = shadowing(&occ, 6);
             let rows = slice_rows(6);
