@@ -21,8 +21,8 @@
 #define SHADOWS_NONE 0u
 #define SHADOWS_RAY 1u
 #define SHADOWS_MAP 2u
-// The rule for the sun's and disk lights' visible fractions with shadow rays (lights.sampling.w); values match
-// gpu::layout.
+// The rule for the lights' visible fractions with shadow rays (VARIANT_VISIBILITY, and lights.sampling.w); values
+// match gpu::layout.
 #define VISIBILITY_GRID 0u
 #define VISIBILITY_SLICES 1u
 // The coverage alpha of a fragment whose loops llvmpipe's limiter cut short (fragment.glsl's coverage_alpha), and
@@ -55,6 +55,7 @@ layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PR
 layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 layout(constant_id = 5) const uint VARIANT_SURFACE = 0u; // SURFACE_* bits: what the material needs per pixel
 layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE, QUANTITY_IRRADIANCE or QUANTITY_SKY_ROWS
+layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID or VISIBILITY_SLICES, with shadow rays
 
 // What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
 #define SURFACE_EVAL 1u
@@ -142,7 +143,8 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     uvec4 sampling; // x: samples per axis over the sun's disk (the render's; each draw reads its material's from
                     // pc.sun_samples); y: shadow samples per axis (visible fractions);
                     // z: shadow-map filter, 1 PCSS, 2 nearest; w: the sun's and disk lights' visibility rule
-                    // with rays, VISIBILITY_GRID or VISIBILITY_SLICES (slices.glsl, on devices that walk the BVH)
+                    // with rays, VISIBILITY_GRID or VISIBILITY_SLICES (slices.glsl; the code is the variant's,
+                    // VARIANT_VISIBILITY)
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
     vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 0 none, 1 PCSS, 2 nearest
     // The first MAX_DISK_MAPS disk lights' perspective maps (visibility/shadow_map.rs, fit_disk_map): world -> map
@@ -185,9 +187,9 @@ layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
 
-// Every module with shadow rays walks the occluders' tree: for the rays themselves without ray queries
-// (SUNSHADE_RAY_BVH), and for the lights' slices (slices.glsl) with or without them.
-#if defined(SUNSHADE_RAY_BVH) || defined(SUNSHADE_RAY_QUERY)
+// The modules that walk the occluders' tree: for the shadow rays themselves without ray queries
+// (SUNSHADE_RAY_BVH), and for the lights' slices (SUNSHADE_SLICES, slices.glsl) with ray queries or without.
+#if defined(SUNSHADE_RAY_BVH) || defined(SUNSHADE_SLICES)
 #define SUNSHADE_WALK
 #endif
 

@@ -115,7 +115,7 @@ void main() {
             emission = emitted_radiance(material, s);
         }
     }
-#ifdef SUNSHADE_WALK
+#ifdef SUNSHADE_SLICES
     if (VARIANT_QUANTITY == QUANTITY_SKY_ROWS) {
         // One pass of the sky's slices: its rows' visible and unoccluded weights (gpu::sky_passes sums them).
         vec2 weights = vec2(0.0);

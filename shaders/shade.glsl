@@ -70,8 +70,8 @@ vec3 irradiance_visible(Frame p) {
                 // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
                 // sky_slices::slice_rows), the grid where they cannot be taken.
                 v = -1.0;
-#ifdef SUNSHADE_WALK
-                if (lights.sampling.w == VISIBILITY_SLICES) {
+#ifdef SUNSHADE_SLICES
+                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
                     v = sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
                 }
 #endif
@@ -100,8 +100,8 @@ vec3 irradiance_visible(Frame p) {
             } else {
                 // By slices where asked and the shader walks the BVH itself, as the sun's.
                 v = -1.0;
-#ifdef SUNSHADE_WALK
-                if (lights.sampling.w == VISIBILITY_SLICES) {
+#ifdef SUNSHADE_SLICES
+                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
                     v = disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
                                                      d.center_radius.w, 4u * k * k);
                 }
@@ -126,7 +126,7 @@ vec3 irradiance_visible(Frame p) {
         if (SHADOWS_ON && normal.y > -1.0) {
             // By the slices the sky's passes took before this one, where they did (gpu::sky_passes).
             v = -1.0;
-#ifdef SUNSHADE_WALK
+#ifdef SUNSHADE_SLICES
             if (lights.sky_rows.z == SKY_ROWS_READ) {
                 uvec2 pixel = uvec2(gl_FragCoord.xy);
                 v = sky_fractions[pixel.y * uint(pc.framebuffer_size.x) + pixel.x];

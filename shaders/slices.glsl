@@ -1,5 +1,5 @@
-// The lights' visible fractions by slices, in every module with shadow rays (SUNSHADE_WALK: the shader walks the
-// occluders' BVH for them, with ray queries or without). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
+// The lights' visible fractions by slices, in the modules with shadow rays built for them (SUNSHADE_SLICES: the
+// shader walks the occluders' BVH for them, with ray queries or without). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
 // through an axis across the light, rows along psi = mid - half cos u, each row's chord of the light cut by the
 // surface's horizon and by the intervals that the triangles in its plane block, a disk light's segments first
 // clipped to where its rays end; the visible weight closed-form), sky_slices.rs (segments, pseudo-angles),

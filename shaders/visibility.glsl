@@ -93,7 +93,7 @@ float fraction(float visible, float total) {
     return (visible == total || total <= 0.0) ? 1.0 : visible / total;
 }
 
-#ifdef SUNSHADE_WALK
+#ifdef SUNSHADE_SLICES
 #include "slices.glsl"
 #endif
 

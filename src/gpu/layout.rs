@@ -48,7 +48,7 @@ pub const MIP_LINEAR: u32 = 2;
 pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 4). The shader keeps only the code these select; `shadows` also
+/// `shaders/bindings.glsl`, constant ids 0 to 7). The shader keeps only the code these select; `shadows` also
 /// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
@@ -66,6 +66,9 @@ pub struct ShaderVariant {
     pub surface: u32,
     /// `QUANTITY_RADIANCE`, `QUANTITY_IRRADIANCE`, or `QUANTITY_SKY_ROWS` (`gpu::sky_passes`).
     pub quantity: u32,
+    /// `VISIBILITY_GRID` or `VISIBILITY_SLICES` with shadow rays (`VISIBILITY_GRID` without: nothing to take), so
+    /// that the grid's pipelines leave the slices' code out (on Mesa 25 with ray queries it cost their creation 0.4 s).
+    pub visibility: u32,
 }
 
 impl ShaderVariant {
@@ -86,12 +89,16 @@ impl ShaderVariant {
             Quantity::Radiance => QUANTITY_RADIANCE,
             Quantity::Irradiance => QUANTITY_IRRADIANCE,
         };
-        Self { brdf, sun, disks, sky, shadows, surface, quantity }
+        let visibility = match shading.visibility_rule {
+            crate::shading::VisibilityRule::Slices if shadows == SHADOWS_RAY => VISIBILITY_SLICES,
+            _ => VISIBILITY_GRID,
+        };
+        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility }
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 7] {
-        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface, self.quantity]
+    pub fn constants(&self) -> [u32; 8] {
+        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface, self.quantity, self.visibility]
     }
 }
 
@@ -487,11 +494,21 @@ mod tests {
         ] {
             assert!(glsl.contains(&format!("#define {name} {}u\n", offset / 4)), "bindings.glsl: {name}");
         }
-        for (id, name) in
-            ["VARIANT_BRDF", "VARIANT_SUN", "VARIANT_DISKS", "VARIANT_SKY", "VARIANT_SHADOWS", "VARIANT_SURFACE"]
-                .iter()
-                .enumerate()
-        {
+        let variant_constants = [
+            "VARIANT_BRDF",
+            "VARIANT_SUN",
+            "VARIANT_DISKS",
+            "VARIANT_SKY",
+            "VARIANT_SHADOWS",
+            "VARIANT_SURFACE",
+            "VARIANT_QUANTITY",
+            "VARIANT_VISIBILITY",
+        ];
+        assert_eq!(
+            variant_constants.len(),
+            ShaderVariant::new(0, 0, &Default::default(), &Default::default(), 0).constants().len()
+        );
+        for (id, name) in variant_constants.iter().enumerate() {
             assert!(
                 glsl.contains(&format!("layout(constant_id = {id}) const uint {name} ")),
                 "{name} is not constant {id}"

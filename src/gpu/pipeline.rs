@@ -15,7 +15,7 @@ use ash::vk;
 
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::layout::{PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY};
+use super::layout::{PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY, VISIBILITY_SLICES};
 use super::pipeline_cache::{self, DiskPipelineCache};
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -32,6 +32,9 @@ pub(crate) struct ScenePipeline {
     /// The fragment shader with shadow rays: by ray queries, or by the shader's walk of the occluders' BVH on
     /// devices without them (`ray_bvh`); null with the naive-math diagnostic.
     ray_module: vk::ShaderModule,
+    /// The same with the lights' visible fractions by slices (`SUNSHADE_SLICES`): the variants with
+    /// `VISIBILITY_SLICES`, so that the grid's do not compile the slices' code.
+    slices_module: vk::ShaderModule,
     ray_bvh: bool,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
@@ -57,13 +60,14 @@ pub enum ShadowRays {
 
 impl ScenePipeline {
     /// `with_normals`: the vertex shader also reads the normal (for device interpolation). `cache_dir`: where the
-    /// pipeline cache lives on disk (`None`: in memory only).
+    /// pipeline cache lives on disk (`None`: in memory only). `ray_spirv`: the fragment stage with shadow rays,
+    /// without and with the slices' code (`SUNSHADE_SLICES`), and how it casts them.
     pub fn new(
         dev: &Arc<Device>,
         vertex_spirv: &[u32],
         fragment_spirv: &[u32],
         shadow_mask_spirv: &[u32],
-        ray_spirv: Option<(&[u32], ShadowRays)>,
+        ray_spirv: Option<(&[u32], &[u32], ShadowRays)>,
         with_normals: bool,
         cache_dir: Option<&Path>,
     ) -> Result<Self, GpuError> {
@@ -77,7 +81,8 @@ impl ScenePipeline {
             vertex_module: vk::ShaderModule::null(),
             fragment_module: vk::ShaderModule::null(),
             ray_module: vk::ShaderModule::null(),
-            ray_bvh: matches!(ray_spirv, Some((_, ShadowRays::Bvh))),
+            slices_module: vk::ShaderModule::null(),
+            ray_bvh: matches!(ray_spirv, Some((_, _, ShadowRays::Bvh))),
             with_normals,
             variants: HashMap::new(),
             shadow: vk::Pipeline::null(),
@@ -109,13 +114,13 @@ impl ScenePipeline {
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];
             match ray_spirv {
-                Some((_, ShadowRays::Query)) => {
+                Some((_, _, ShadowRays::Query)) => {
                     table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
                     table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((14, vk::DescriptorType::STORAGE_BUFFER, 1));
                 }
-                Some((_, ShadowRays::Bvh)) => {
+                Some((_, _, ShadowRays::Bvh)) => {
                     table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                 }
@@ -174,13 +179,16 @@ impl ScenePipeline {
             out.shadow_mask_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(shadow_mask_spirv), None)
                 .vk("vkCreateShaderModule")?;
-            if let Some((words, _)) = ray_spirv {
+            if let Some((words, sliced, _)) = ray_spirv {
                 out.ray_module = d
                     .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
                     .vk("vkCreateShaderModule")?;
+                out.slices_module = d
+                    .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(sliced), None)
+                    .vk("vkCreateShaderModule")?;
             }
             let mut hashed = vec![vertex_spirv, fragment_spirv, shadow_mask_spirv];
-            hashed.extend(ray_spirv.map(|(words, _)| words));
+            hashed.extend(ray_spirv.iter().flat_map(|&(words, sliced, _)| [words, sliced]));
             let name = pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&hashed));
             out.cache = Some(DiskPipelineCache::open(d, cache_dir, &name)?);
         }
@@ -229,7 +237,8 @@ impl ScenePipeline {
             return Ok(p);
         }
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
-        let variant = ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface, quantity: 0 };
+        let variant =
+            ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface, quantity: 0, visibility: 0 };
         // SAFETY: valid device, layout, modules and cache owned by self.
         let p = unsafe {
             create_pipeline(
@@ -283,14 +292,19 @@ impl ScenePipeline {
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
         let (d, layout, with_normals) = (&self.dev.device, self.layout, self.with_normals);
-        let (vertex, fragment, rays) = (self.vertex_module, self.fragment_module, self.ray_module);
+        let (vertex, fragment, rays, slices) =
+            (self.vertex_module, self.fragment_module, self.ray_module, self.slices_module);
         let mut first_error = None;
         for chunk in missing.chunks(threads) {
             let created: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|scope| {
                 let handles: Vec<_> = chunk
                     .iter()
                     .map(|&variant| {
-                        let fs = if variant.shadows == SHADOWS_RAY { rays } else { fragment };
+                        let fs = match (variant.shadows, variant.visibility) {
+                            (SHADOWS_RAY, VISIBILITY_SLICES) => slices,
+                            (SHADOWS_RAY, _) => rays,
+                            _ => fragment,
+                        };
                         // SAFETY: valid device, layout, modules and cache, owned by self and alive for the scope;
                         // vkCreateGraphicsPipelines may be called from several threads at once.
                         scope.spawn(move || unsafe {
@@ -347,7 +361,7 @@ unsafe fn create_pipeline(
     unsafe {
         // `depth_only`: a shadow map's pipeline, no colour attachment; its fragment stage (a null `fs`: none)
         // only discards.
-        let constants = variant.map_or([0; 7], |v| v.constants());
+        let constants = variant.map_or([0; 8], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();
@@ -436,6 +450,7 @@ impl Drop for ScenePipeline {
             d.destroy_shader_module(self.vertex_module, None);
             d.destroy_shader_module(self.fragment_module, None);
             d.destroy_shader_module(self.ray_module, None);
+            d.destroy_shader_module(self.slices_module, None);
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

@@ -173,7 +173,7 @@ impl Renderer {
             _ => compile_stages(interpolation, options.naive_math)?,
         };
         // The fragment shader with shadow rays: by ray queries where the device has them, else by walking the
-        // occluders' BVH in the shader (not with the naive-math diagnostic).
+        // occluders' BVH in the shader (not with the naive-math diagnostic); without and with the slices' code.
         let rays = if options.naive_math {
             None
         } else {
@@ -184,7 +184,10 @@ impl Renderer {
             };
             let words = shaders::stage_spirv("scene.frag", &[interpolation_define(interpolation), define])
                 .map_err(GpuError::ShaderCompile)?;
-            Some((words, kind))
+            let sliced =
+                shaders::stage_spirv("scene.frag", &[interpolation_define(interpolation), define, "SUNSHADE_SLICES"])
+                    .map_err(GpuError::ShaderCompile)?;
+            Some((words, sliced, kind))
         };
         let shadow_mask = shaders::stage_spirv("shadow_mask.frag", &[interpolation_define(interpolation)])
             .map_err(GpuError::ShaderCompile)?;
@@ -193,7 +196,7 @@ impl Renderer {
             &vs,
             &fs,
             &shadow_mask,
-            rays.as_ref().map(|(words, kind)| (&words[..], *kind)),
+            rays.as_ref().map(|(words, sliced, kind)| (&words[..], &sliced[..], *kind)),
             interpolation == Interpolation::Device,
             options.pipeline_cache_dir.as_deref(),
         )?;

@@ -83,9 +83,13 @@ mod tests {
             }
             if name.ends_with(".frag") {
                 for rays in ["SUNSHADE_RAY_QUERY", "SUNSHADE_RAY_BVH"] {
-                    let words =
-                        compile(name, SOURCES, &["SUNSHADE_F64_BARYCENTRICS", rays]).unwrap_or_else(|e| panic!("{e}"));
-                    assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+                    for defines in [
+                        &["SUNSHADE_F64_BARYCENTRICS", rays][..],
+                        &["SUNSHADE_F64_BARYCENTRICS", rays, "SUNSHADE_SLICES"],
+                    ] {
+                        let words = compile(name, SOURCES, defines).unwrap_or_else(|e| panic!("{e}"));
+                        assert_eq!(words[0], 0x0723_0203, "{name}: not SPIR-V");
+                    }
                 }
             }
         }
@@ -95,8 +99,8 @@ mod tests {
     fn modules_built_ahead_equal_run_time_compilation() {
         // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
         // 2 stages × 3 interpolations × (plain, naive math), the fragment stage's 3 with ray queries and 3 with
-        // the BVH walk, and the masked shadow-map stage's 3.
-        assert_eq!(MODULES.len(), 21);
+        // the BVH walk, each with and without slices, and the masked shadow-map stage's 3.
+        assert_eq!(MODULES.len(), 27);
         for m in MODULES {
             let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);
