@@ -2,8 +2,9 @@
 //! `$OUT_DIR`, embedded in the binary by `src/gpu/shaders.rs` (the table `spirv_modules.rs` generated here).
 //!
 //! Variants are the `#define`s chosen when the device is known: one interpolation mode of three, and the
-//! `SUNSHADE_NAIVE_MATH` diagnostic, and for fragment shaders `SUNSHADE_RAY_QUERY` or `SUNSHADE_RAY_BVH` (shadow rays, by ray queries or by
-//! the shader's own BVH walk), each with or without `SUNSHADE_SLICES` (the lights' visible fractions by slices). Everything else is a specialization constant, set at pipeline creation.
+//! `SUNSHADE_NAIVE_MATH` diagnostic, and for fragment shaders `SUNSHADE_RAY_QUERY` or `SUNSHADE_RAY_BVH` (shadow
+//! rays, by ray queries or by the shader's own BVH walk), each with or without `SUNSHADE_SLICES` (the lights' visible
+//! fractions by slices). Everything else is a specialization constant, set at pipeline creation.
 //! A compile error fails the build with shaderc's `file:line: error` message.
 
 use std::path::{Path, PathBuf};

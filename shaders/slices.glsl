@@ -1,10 +1,11 @@
 // The lights' visible fractions by slices, in the modules with shadow rays built for them (SUNSHADE_SLICES: the
-// shader walks the occluders' BVH for them, with ray queries or without). Mirrors src/shading/sun_slices.rs and disk_slices.rs (the rule: half-planes
-// through an axis across the light, rows along psi = mid - half cos u, each row's chord of the light cut by the
-// surface's horizon and by the intervals that the triangles in its plane block, a disk light's segments first
-// clipped to where its rays end; the visible weight closed-form), sky_slices.rs (segments, pseudo-angles),
-// slices_about_centre.rs (the chords measured by gamma = beta - pi/2, which keeps f32's digits on the sun's chord
-// within 0.0046 rad of beta = pi/2; see its text) and visibility/bvh.rs (within_reach, sphere_meets_cone).
+// shader walks the occluders' BVH for them, with ray queries or without). Mirrors src/shading/sun_slices.rs and
+// disk_slices.rs (the rule: half-planes through an axis across the light, rows along psi = mid - half cos u, each
+// row's chord of the light cut by the surface's horizon and by the intervals that the triangles in its plane block, a
+// disk light's segments first clipped to where its rays end; the visible weight closed-form), sky_slices.rs
+// (segments, pseudo-angles), slices_about_centre.rs (the chords measured by gamma = beta - pi/2, which keeps f32's
+// digits on the sun's chord within 0.0046 rad of beta = pi/2; see its text) and visibility/bvh.rs (within_reach,
+// sphere_meets_cone).
 //
 // One walk a pixel and light gathers the triangles within its reach (above the surface's horizon, in front, in
 // the light's cone, before a disk light's near side) into a local array of MAX_SLICE_TRIANGLES; every row then

@@ -94,12 +94,14 @@ impl ScenePipeline {
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
             // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table, 9 the surface
-            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the texels (a uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel
-            // buffer holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always
-            // bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices
-            // with ray queries, and 12 the occluders' BVH nodes and 13 the sky's fractions from its passes of slices
-            // (storage buffers) on every device with shadow rays (the slices walk the tree), 14 the walk's records
-            // in the tree's leaf order with ray queries (binding 10 holds them without). All read by the fragment shader. The descriptor pool is sized from the same table.
+            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the texels (a
+            // uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel buffer holds
+            // maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps
+            // until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices with ray queries,
+            // and 12 the occluders' BVH nodes and 13 the sky's fractions from its passes of slices (storage buffers) on
+            // every device with shadow rays (the slices walk the tree), 14 the walk's records in the tree's leaf order
+            // with ray queries (binding 10 holds them without). All read by the fragment shader. The descriptor pool is
+            // sized from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),

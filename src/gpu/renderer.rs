@@ -645,11 +645,11 @@ impl Renderer {
         Ok((image, FrameTimings { pipelines, render, readback }))
     }
 
-    /// The sky's visible fraction at every pixel by its slices, taken in passes before the frame (`sky_passes`):
-    /// each pass draws the scene with `variants` turned to `QUANTITY_SKY_ROWS` and the light buffer `lights` (its
-    /// bytes) naming the pass's rows; a pass the loop budget cuts short is split in two and drawn again (a single
-    /// row cut short refuses the image), one with a row meeting more triangles than a fragment keeps refuses it. The fractions' buffer, and the time spent making the
-    /// passes' pipelines.
+    /// The sky's visible fraction at every pixel by its slices, taken in passes before the frame (`sky_passes`): each
+    /// pass draws the scene with `variants` turned to `QUANTITY_SKY_ROWS` and the light buffer `lights` (its bytes)
+    /// naming the pass's rows; a pass the loop budget cuts short is split in two and drawn again (a single row cut
+    /// short refuses the image), one with a row meeting more triangles than a fragment keeps refuses it. The fractions'
+    /// buffer, and the time spent making the passes' pipelines.
     fn sky_fractions(
         &mut self,
         scene: &GpuScene,

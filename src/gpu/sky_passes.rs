@@ -6,10 +6,10 @@
 //! from the point passes through the teapot (measured at 64 × 48: wedges of 45° gathered up to all 2256). A row's
 //! plane cuts far fewer, so each row walks the BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on
 //! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and
-//! the rows are taken in passes before the frame, as many a pass as the loop budget (65 535 iterations, `loop_budget`) holds: each
-//! pass draws the scene with the variant `QUANTITY_SKY_ROWS`, whose fragment writes its rows' visible and
-//! unoccluded weights; the host sums the passes per pixel in f64 ([`SkySums`]) and the frame reads each pixel's
-//! fraction from a buffer (`SKY_ROWS_READ`).
+//! the rows are taken in passes before the frame, as many a pass as the loop budget (65 535 iterations,
+//! `loop_budget`) holds: each pass draws the scene with the variant `QUANTITY_SKY_ROWS`, whose fragment writes its
+//! rows' visible and unoccluded weights; the host sums the passes per pixel in f64 ([`SkySums`]) and the frame
+//! reads each pixel's fraction from a buffer (`SKY_ROWS_READ`).
 //!
 //! The passes start as [`first_passes`] cuts the rows, at most [`ROWS_A_PASS`] each. A pass that the limiter cuts
 //! short is split in two and drawn again ([`refusal`]; a single row still cut short refuses the image); a row whose
