@@ -21,8 +21,7 @@
 #define SHADOWS_NONE 0u
 #define SHADOWS_RAY 1u
 #define SHADOWS_MAP 2u
-// The rule for the lights' visible fractions with shadow rays (VARIANT_VISIBILITY, and lights.sampling.w); values
-// match gpu::layout.
+// The rule for the lights' visible fractions with shadow rays (VARIANT_VISIBILITY); values match gpu::layout.
 #define VISIBILITY_GRID 0u
 #define VISIBILITY_SLICES 1u
 // The coverage alpha of a fragment whose loops llvmpipe's limiter cut short (fragment.glsl's coverage_alpha), and
@@ -142,8 +141,7 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
                     // (disks, sky: the render's; each draw reads its material's from pc.lobe_samples)
     uvec4 sampling; // x: samples per axis over the sun's disk (the render's; each draw reads its material's from
                     // pc.sun_samples); y: shadow samples per axis (visible fractions);
-                    // z: shadow-map filter, 1 PCSS, 2 nearest; w: the sun's and disk lights' visibility rule
-                    // with rays, VISIBILITY_GRID or VISIBILITY_SLICES (slices.glsl; the code is the variant's,
+                    // z: shadow-map filter, 1 PCSS, 2 nearest; w unused (the visibility rule is the variant's,
                     // VARIANT_VISIBILITY)
     mat4 sun_map_from_world; // world -> the sun's shadow map (x, y in [-1, 1], depth in [0, 1]); visibility/shadow_map.rs
     vec4 sun_map;            // x: texel side [m]; y: depth extent [m]; z: size [texels]; w: 0 none, 1 PCSS, 2 nearest

@@ -22,8 +22,8 @@ pub const SKY_PRESENT: u32 = 1;
 pub const SHADOWS_NONE: u32 = 0;
 pub const SHADOWS_RAY: u32 = 1;
 pub const SHADOWS_MAP: u32 = 2;
-/// The sun's and disk lights' visibility rule with shadow rays (`lights.sampling.w`): the located grid, or slices
-/// (shaders/slices.glsl, where the fragment shader walks the occluders' BVH; elsewhere the grid).
+/// The lights' visibility rule with shadow rays (`VARIANT_VISIBILITY`): the located grid, or slices
+/// (shaders/slices.glsl, a fragment module of their own).
 pub const VISIBILITY_GRID: u32 = 0;
 pub const VISIBILITY_SLICES: u32 = 1;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
@@ -354,10 +354,6 @@ pub fn lights_bytes(
         ShadowMapFilter::Pcss => 1,
         ShadowMapFilter::Nearest => 2,
     };
-    let visibility_rule = match shading.visibility_rule {
-        crate::shading::VisibilityRule::Grid => VISIBILITY_GRID,
-        crate::shading::VisibilityRule::Slices => VISIBILITY_SLICES,
-    };
     let mut disk_map_from_world = [[0.0f32; 16]; MAX_DISK_MAPS];
     let mut disk_map = [[0.0f32; 4]; MAX_DISK_MAPS];
     for (i, m) in disk_maps.iter().enumerate().take(MAX_DISK_MAPS) {
@@ -381,7 +377,7 @@ pub fn lights_bytes(
         sun,
         sky,
         counts: [lights.disks.len() as u32, 0, super::loop_budget::LOOP_PROBE_ITERATIONS, shading.samples_per_axis],
-        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, visibility_rule],
+        sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, 0],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
         sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
         disk_map_from_world,

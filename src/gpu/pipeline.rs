@@ -335,18 +335,13 @@ impl ScenePipeline {
         first_error.map_or(Ok(()), Err)
     }
 
-    /// The pipeline of a variant, created on first use ([`Self::prepare_variants`]). Returns it and whether it was
-    /// created now.
-    pub fn variant(&mut self, variant: ShaderVariant) -> Result<(vk::Pipeline, bool), GpuError> {
-        let created = !self.variants.contains_key(&variant);
-        self.prepare_variants(&[variant])?;
-        // prepare_variants made it or returned its error.
-        let p = self
-            .variants
-            .get(&variant)
-            .copied()
-            .ok_or(GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result: vk::Result::ERROR_UNKNOWN })?;
-        Ok((p, created))
+    /// The pipelines of `variants`, in their order, those that do not exist yet created together
+    /// ([`Self::prepare_variants`]).
+    pub fn pipelines_of(&mut self, variants: &[ShaderVariant]) -> Result<Vec<vk::Pipeline>, GpuError> {
+        self.prepare_variants(variants)?;
+        // prepare_variants made each or returned its error.
+        let missing = || GpuError::Vulkan { what: "vkCreateGraphicsPipelines", result: vk::Result::ERROR_UNKNOWN };
+        variants.iter().map(|v| self.variants.get(v).copied().ok_or_else(missing)).collect()
     }
 }
 

@@ -113,8 +113,10 @@ pub struct Renderer {
     // Field order is drop order: everything that uses the device goes before `dev`.
     target: Option<Target>,
     lights: Option<Buffer>,
-    /// The sky's fractions from its passes of slices (`sky_passes`), or one unused value: binding 13.
+    /// The sky's fractions from its passes of slices (`sky_passes`) of the last frame that took them, and the one
+    /// unused value bound at 13 where a frame takes none.
     sky_fractions: Option<Buffer>,
+    no_sky_fractions: Buffer,
     sun_map: DepthMap,
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
@@ -204,10 +206,12 @@ impl Renderer {
         let commands = Commands::new(&dev)?;
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
+        let no_sky_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?;
         let renderer = Self {
             target: None,
             lights: None,
             sky_fractions: None,
+            no_sky_fractions,
             sun_map,
             disk_maps,
             pipeline,
@@ -437,16 +441,16 @@ impl Renderer {
         })
     }
 
-    /// Refuses `visibility_rule: Slices` where the GPU cannot take the slices the reference would: with shadow maps.
+    /// Refuses `visibility_rule: Slices` with shadow maps: slices take the place of shadow rays.
     fn check_slices(&self, technique: Shadows) -> Result<(), GpuError> {
-        let why = if technique == Shadows::None || technique == Shadows::Ray {
-            return Ok(()); // nothing to slice, or the rays' place taken
-        } else {
-            "slices take the place of shadow rays (--shadows ray)"
-        };
-        Err(GpuError::Unsupported(format!(
-            "--visibility slices: {why}; `sunshade reference --visibility slices` takes them for every light"
-        )))
+        if technique != Shadows::Map {
+            return Ok(());
+        }
+        Err(GpuError::Unsupported(
+            "--visibility slices: slices take the place of shadow rays (--shadows ray); `sunshade reference \
+             --visibility slices` takes them for every light"
+                .into(),
+        ))
     }
 
     /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
@@ -549,17 +553,12 @@ impl Renderer {
                 disk_maps.push(frame.map(|f| (f, size)));
             }
         }
-        let lights = Buffer::with_data(
-            &self.dev,
-            &lights_bytes(
-                &settings.lights,
-                &settings.shading,
-                sun_map.as_ref().map(|f| (f, self.sun_map.size)),
-                &disk_maps,
-            ),
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            "lights",
-        )?;
+        let light_bytes = lights_bytes(
+            &settings.lights,
+            &settings.shading,
+            sun_map.as_ref().map(|f| (f, self.sun_map.size)),
+            &disk_maps,
+        );
         let any_map = sun_map.is_some() || disk_maps.iter().any(Option::is_some);
         let shadows = match technique {
             // Rays need something to meet: the acceleration structure, or the BVH (every scene with geometry).
@@ -578,11 +577,7 @@ impl Renderer {
                 ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &shading, shadows)
             })
             .collect();
-        self.pipeline.prepare_variants(&variants)?;
-        let mut draw_pipelines = Vec::with_capacity(scene.draws.len());
-        for &variant in &variants {
-            draw_pipelines.push(self.pipeline.variant(variant)?.0);
-        }
+        let draw_pipelines = self.pipeline.pipelines_of(&variants)?;
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
         // Alpha-masked draws test their alpha in the maps too (shadow_mask.frag).
         let mut map_pipelines = Vec::new();
@@ -601,23 +596,18 @@ impl Renderer {
         let sky_sliced = shadows == SHADOWS_RAY
             && settings.shading.visibility_rule == VisibilityRule::Slices
             && settings.lights.sky.is_some();
-        let mut passes_pipelines = Duration::ZERO;
-        let sky_fractions = if sky_sliced {
-            let (fractions, made) = self.sky_fractions(scene, settings, lights.mapped(), &variants)?;
-            passes_pipelines = made;
-            fractions
+        let (sky_fractions, passes_pipelines) = if sky_sliced {
+            let (fractions, made) = self.sky_fractions(scene, settings, &light_bytes, &variants)?;
+            (Some(fractions), made)
         } else {
-            Buffer::storage(&self.dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?
+            (None, Duration::ZERO)
         };
-        let lights = if sky_sliced {
-            Buffer::storage(&self.dev, &with_sky_rows(lights.mapped(), [0, 0, SKY_ROWS_READ, 0]), "lights")?
-        } else {
-            lights
-        };
+        let light_bytes = if sky_sliced { with_sky_rows(&light_bytes, [0, 0, SKY_ROWS_READ, 0]) } else { light_bytes };
+        let lights = Buffer::storage(&self.dev, &light_bytes, "lights")?;
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
         unsafe {
-            self.write_descriptors(scene, &lights, &sky_fractions);
+            self.write_descriptors(scene, &lights, sky_fractions.as_ref().unwrap_or(&self.no_sky_fractions));
             let cb = self.commands.begin(&self.dev)?;
             if shadow_pipeline.is_some() {
                 if let Some(frame) = &sun_map {
@@ -640,7 +630,7 @@ impl Renderer {
         super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
-        self.sky_fractions = Some(sky_fractions);
+        self.sky_fractions = sky_fractions;
         self.check_validation()?;
         Ok((image, FrameTimings { pipelines, render, readback }))
     }
@@ -660,13 +650,8 @@ impl Renderer {
         let t = Instant::now();
         let pass_variants: Vec<_> =
             variants.iter().map(|&v| ShaderVariant { quantity: QUANTITY_SKY_ROWS, ..v }).collect();
-        self.pipeline.prepare_variants(&pass_variants)?;
-        let mut pass_pipelines = Vec::with_capacity(pass_variants.len());
-        for &variant in &pass_variants {
-            pass_pipelines.push(self.pipeline.variant(variant)?.0);
-        }
+        let pass_pipelines = self.pipeline.pipelines_of(&pass_variants)?;
         let made = t.elapsed();
-        let unused = Buffer::storage(&self.dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?;
         let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
         let mut passes: std::collections::VecDeque<_> = sky_passes::first_passes(rows).into();
         let mut sums = sky_passes::SkySums::new((settings.width * settings.height) as usize);
@@ -675,7 +660,7 @@ impl Renderer {
                 Buffer::storage(&self.dev, &with_sky_rows(lights, [first, count, SKY_ROWS_NONE, 0]), "lights")?;
             // SAFETY: as in `render`: the GPU is idle between submissions.
             unsafe {
-                self.write_descriptors(scene, &pass_lights, &unused);
+                self.write_descriptors(scene, &pass_lights, &self.no_sky_fractions);
                 let cb = self.commands.begin(&self.dev)?;
                 self.record_scene_pass(cb, scene, settings, &pass_pipelines);
                 self.commands.submit_and_wait(&self.dev, cb)?;
@@ -757,13 +742,13 @@ impl Renderer {
                 // structure's own order at 10.
                 let walk_records = scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, r)| r.buffer);
                 let nodes = scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer);
-                if self.pipeline.rays_walk_bvh() {
-                    buffers.extend([(10, walk_records), (12, nodes), (13, sky_fractions.buffer)]);
-                } else if self.pipeline.has_ray_queries() {
-                    buffers.extend([(10, scene.occluder_triangles.buffer), (12, nodes), (13, sky_fractions.buffer)]);
+                let walks = self.pipeline.rays_walk_bvh();
+                buffers.push((10, if walks { walk_records } else { scene.occluder_triangles.buffer }));
+                if self.pipeline.has_shadow_rays() {
+                    buffers.extend([(12, nodes), (13, sky_fractions.buffer)]);
+                }
+                if self.pipeline.has_ray_queries() {
                     buffers.push((14, walk_records));
-                } else {
-                    buffers.push((10, scene.occluder_triangles.buffer));
                 }
                 let infos: Vec<_> = buffers
                     .into_iter()
