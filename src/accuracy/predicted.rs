@@ -76,12 +76,11 @@ impl Prediction {
     /// Adds the bound of f32 interpolation (`accuracy::interpolation`), which it no longer lists as unbounded.
     pub fn add_f32_bound(&mut self, bound: f64) {
         self.unbounded.retain(|u| u != F32_UNBOUNDED);
-        self.terms.push(("f32 interpolation (barycentric rounding, per pixel):".into(), bound));
-        self.max_relative = (self.max_relative + bound).min(1.0);
+        self.add_term("f32 interpolation (barycentric rounding, per pixel):", bound);
     }
 
-    /// Adds a term measured rather than bounded (`what` says so), to the bound and its terms.
-    pub fn add_measured(&mut self, what: &str, value: f64) {
+    /// Adds a term to the bound and its terms: a derived bound, or a measured value (`what` says which).
+    pub fn add_term(&mut self, what: &str, value: f64) {
         self.terms.push((what.into(), value));
         self.max_relative = (self.max_relative + value).min(1.0);
     }

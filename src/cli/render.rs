@@ -173,10 +173,10 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         asked: a.scene.shadows,
         scene_can_occlude: gpu_scene.can_occlude(),
     };
-    // Where the GPU slices the sky through occluders the promise holds in penumbrae too, asked or not, as the
-    // reference's does (`accuracy::trial::reference_within_tolerance`): the sky's penumbra is nearly the whole image.
+    // Where the GPU slices the sky through occluders, its grids are studied on the reference, whose promise then
+    // holds in penumbrae too, asked or not (`sky_studied_on_the_reference`).
     let sky_sliced = crate::accuracy::trial::sky_by_slices(scene_data, &settings, gpu_scene.can_occlude());
-    let tolerance = a.scene.tolerance().map(|t| Tolerance { in_penumbrae: t.in_penumbrae || sky_sliced, ..t });
+    let tolerance = a.scene.tolerance();
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
     let mut gpu_render = |s: &RenderSettings| {
@@ -229,7 +229,8 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 }
 
 /// `--tolerance` where the GPU slices the sky through occluders: the grids are studied on the reference, the same
-/// rule in f64 (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps), then the
+/// rule in f64 (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the
+/// promise there holds in penumbrae too, asked or not: the sky's penumbra is nearly the whole image), then the
 /// GPU renders once with them (`render`), and the distance of its image from the reference's at those settings
 /// (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to the prediction, T
 /// refused by name where the sum exceeds it. The GPU's sky passes cost some 40 ms a row at 64 × 48 on lavapipe
@@ -254,20 +255,34 @@ fn sky_studied_on_the_reference(
     )
     .map_err(CliError::Usage)?;
     let image = render(settings)?;
-    let apart = crate::accuracy::refinement::max_difference(&image, &studied);
-    prediction.add_measured(
-        "the GPU against the reference at the kept settings (measured; studied on the reference):",
-        apart,
-    );
-    if prediction.max_relative > tolerance.max_relative {
-        return Err(CliError::Usage(format!(
-            "--tolerance {:e}: the GPU's image is {apart:.1e} from the reference's at the settings kept (its f32 \
-             shading, interpolation and slices), which with the rest ({:.1e}) exceeds it; `sunshade reference` with \
-             the same scene flags has no f32",
-            tolerance.max_relative, prediction.max_relative
-        )));
-    }
+    let what = "the GPU against the reference at the kept settings (measured; studied on the reference):";
+    measured_against_the_reference(&image, &studied, what, tolerance.max_relative, &mut prediction, |apart, sum| {
+        format!(
+            "the GPU's image is {apart:.1e} from the reference's at the settings kept (its f32 shading, interpolation \
+             and slices), which with the rest ({sum:.1e}) exceeds it; `sunshade reference` with the same scene flags \
+             has no f32"
+        )
+    })?;
     Ok((image, prediction))
+}
+
+/// The GPU's `image` against the reference's f64 image at the same settings (`f64_image`): their distance added to
+/// the prediction as the term `what`, measured where no bound is derived, and `tolerance` refused by name where the
+/// sum exceeds it (`refusal(apart, sum)` says why).
+fn measured_against_the_reference(
+    image: &Image,
+    f64_image: &Image,
+    what: &str,
+    tolerance: f64,
+    prediction: &mut Prediction,
+    refusal: impl FnOnce(f64, f64) -> String,
+) -> Result<(), CliError> {
+    let apart = crate::accuracy::refinement::max_difference(image, f64_image);
+    prediction.add_term(what, apart);
+    if prediction.max_relative > tolerance {
+        return Err(CliError::Usage(format!("--tolerance {tolerance:e}: {}", refusal(apart, prediction.max_relative))));
+    }
+    Ok(())
 }
 
 /// What f32 geometry costs the GPU's slices where `--tolerance` holds in penumbrae: a point millimetres to
@@ -290,17 +305,14 @@ fn slices_measured_against_the_reference(
         return Ok(());
     }
     let f64_slices = cpu::render(scene, settings, reference);
-    let apart = crate::accuracy::refinement::max_difference(image, &f64_slices);
-    prediction.add_measured("GPU f32 slices (measured against the reference's):", apart);
-    if prediction.max_relative > tolerance {
-        return Err(CliError::Usage(format!(
-            "--tolerance {tolerance:e}: the GPU's slices of the lights are {apart:.1e} from the reference's f64 slices \
-             (f32 geometry near the occluders), which with the rest ({:.1e}) exceeds it; `sunshade reference` with \
-             the same scene flags has no f32 geometry",
-            prediction.max_relative
-        )));
-    }
-    Ok(())
+    let what = "GPU f32 slices (measured against the reference's):";
+    measured_against_the_reference(image, &f64_slices, what, tolerance, prediction, |apart, sum| {
+        format!(
+            "the GPU's slices of the lights are {apart:.1e} from the reference's f64 slices (f32 geometry near the \
+             occluders), which with the rest ({sum:.1e}) exceeds it; `sunshade reference` with the same scene flags \
+             has no f32 geometry"
+        )
+    })
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
