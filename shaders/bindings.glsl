@@ -35,13 +35,20 @@ bool slices_overflowed = false;
 // What the fragment shader writes (VARIANT_QUANTITY); values match gpu::layout.
 #define QUANTITY_RADIANCE 0u
 #define QUANTITY_IRRADIANCE 1u
-// One pass of the sky's slices (slices.glsl's sky_rows_weights: the rows lights.sky_rows.x and on, .y of them),
-// written as (visible, whole, 0, coverage) for the renderer to sum (gpu::sky_passes).
-#define QUANTITY_SKY_ROWS 2u
-// Where the sky's visible fraction comes from (lights.sky_rows.z): the shader's own (SKY_ROWS_NONE), or the
-// fractions the sky's passes left in sky_fractions (SKY_ROWS_READ); values match gpu::layout.
-#define SKY_ROWS_NONE 0u
-#define SKY_ROWS_READ 1u
+// One pass of a light's slices (slices.glsl's sky_rows_weights, sun_rows_weights, disk_rows_weights: the rows
+// lights.light_rows.x and on, .y of them, of the light lights.light_rows.z), written as (visible, whole, 0,
+// coverage) for the renderer to sum (gpu::slice_passes).
+#define QUANTITY_LIGHT_ROWS 2u
+// The light a pass slices (lights.light_rows.z), and its layer of light_fractions: the sky, the sun, disk light i
+// at ROWS_OF_DISK + i. Values match gpu::layout.
+#define ROWS_OF_SKY 0u
+#define ROWS_OF_SUN 1u
+#define ROWS_OF_DISK 2u
+// The lights whose visible fractions the frame reads from light_fractions, left there by their passes, rather than
+// taking them itself (lights.light_rows.w's bits).
+#define READ_SKY 1u
+#define READ_SUN 2u
+#define READ_DISKS 4u
 
 // The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
 // material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
@@ -53,7 +60,7 @@ layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EX
 layout(constant_id = 3) const uint VARIANT_SKY = 0u;   // LIGHT_ABSENT or SKY_PRESENT
 layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOWS_MAP, or SHADOWS_RAY (SUNSHADE_RAY_QUERY modules)
 layout(constant_id = 5) const uint VARIANT_SURFACE = 0u; // SURFACE_* bits: what the material needs per pixel
-layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE, QUANTITY_IRRADIANCE or QUANTITY_SKY_ROWS
+layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE, QUANTITY_IRRADIANCE or QUANTITY_LIGHT_ROWS
 layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID or VISIBILITY_SLICES, with shadow rays
 
 // What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
@@ -149,8 +156,8 @@ layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     // clip space, and (tan of the half field of view, near [m], far [m], size [texels] or 0 if not rendered).
     mat4 disk_map_from_world[MAX_DISK_MAPS];
     vec4 disk_map[MAX_DISK_MAPS];
-    uvec4 sky_rows;          // the sky's slices in passes (gpu::sky_passes): x the pass's first row, y its rows,
-                             // z SKY_ROWS_NONE or SKY_ROWS_READ; w unused
+    uvec4 light_rows;        // the lights' slices in passes (gpu::slice_passes): x the pass's first row, y its rows,
+                             // z its light (ROWS_OF_*); w the lights the frame reads (READ_* bits)
     DiskGpu disks[];
 } lights;
 
@@ -204,12 +211,17 @@ struct BvhNode {
 layout(std430, set = 0, binding = 12) readonly buffer BvhNodes {
     BvhNode bvh_nodes[];
 };
-// The sky's visible fraction at each pixel (row-major, pc.framebuffer_size.x a row), summed by the renderer from
-// the sky's passes of slices (gpu::sky_passes; read where lights.sky_rows.z is SKY_ROWS_READ), or one unused
-// value; negative where the pixel's slices could not be taken (the grid's rays then).
-layout(std430, set = 0, binding = 13) readonly buffer SkyFractions {
-    float sky_fractions[];
+// The lights' visible fractions at each pixel, summed by the renderer from their passes of slices
+// (gpu::slice_passes): a layer a light (ROWS_OF_*), each row-major (pc.framebuffer_size.x a row), read where
+// lights.light_rows.w has the light's READ_* bit; or one unused value. Negative where the pixel's slices could not
+// be taken (the grid's rays then).
+layout(std430, set = 0, binding = 13) readonly buffer LightFractions {
+    float light_fractions[];
 };
+// The passes' fraction of light `layer` (ROWS_OF_*) at this fragment's pixel.
+#define PASSED_FRACTION(layer) \
+    light_fractions[((layer) * uint(pc.framebuffer_size.y) + uint(gl_FragCoord.y)) * uint(pc.framebuffer_size.x) \
+                    + uint(gl_FragCoord.x)]
 #ifdef SUNSHADE_RAY_QUERY
 // With ray queries OccluderTriangles is in the acceleration structure's order (its masked hits read it by
 // primitive index), so the walk's records, in the tree's leaf order, are a buffer of their own.

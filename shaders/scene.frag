@@ -116,12 +116,23 @@ void main() {
         }
     }
 #ifdef SUNSHADE_SLICES
-    if (VARIANT_QUANTITY == QUANTITY_SKY_ROWS) {
-        // One pass of the sky's slices: its rows' visible and unoccluded weights (gpu::sky_passes sums them).
+    if (VARIANT_QUANTITY == QUANTITY_LIGHT_ROWS) {
+        // One pass of a light's slices: its rows' visible and unoccluded weights (gpu::slice_passes sums them).
+        uint rows = 4u * lights.sampling.y * lights.sampling.y;
+        uint light = lights.light_rows.z;
+        uvec2 taken = lights.light_rows.xy;
         vec2 weights = vec2(0.0);
-        if (frame.normal.y > -1.0) {
-            weights = sky_rows_weights(frame.shadow_origin, frame.normal, 4u * lights.sampling.y * lights.sampling.y,
-                                       lights.sky_rows.x, lights.sky_rows.y);
+        if (light == ROWS_OF_SKY) {
+            if (frame.normal.y > -1.0) {
+                weights = sky_rows_weights(frame.shadow_origin, frame.normal, rows, taken.x, taken.y);
+            }
+        } else if (light == ROWS_OF_SUN) {
+            weights = sun_rows_weights(frame.shadow_origin, frame.normal, lights.sun.direction.xyz,
+                                       lights.sun.direction.w, rows, taken.x, taken.y);
+        } else {
+            DiskGpu d = lights.disks[light - ROWS_OF_DISK];
+            weights = disk_rows_weights(frame.shadow_origin, frame.normal, d.center_radius.xyz, d.direction.xyz,
+                                        d.center_radius.w, rows, taken.x, taken.y);
         }
         out_radiance = vec4(weights, 0.0, coverage_alpha());
         return;

@@ -68,11 +68,14 @@ vec3 irradiance_visible(Frame p) {
                 v = visible_along(p.shadow_origin, l) ? 1.0 : 0.0;
             } else {
                 // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
-                // sky_slices::slice_rows), the grid where they cannot be taken.
+                // sky_slices::slice_rows), or as their passes took them before this one where the frame could not
+                // (gpu::slice_passes); the grid where they cannot be taken.
                 v = -1.0;
 #ifdef SUNSHADE_SLICES
                 if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
-                    v = sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
+                    v = (lights.light_rows.w & READ_SUN) != 0u
+                        ? PASSED_FRACTION(ROWS_OF_SUN)
+                        : sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
                 }
 #endif
                 if (v < 0.0) {
@@ -98,12 +101,14 @@ vec3 irradiance_visible(Frame p) {
             if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
                 v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
             } else {
-                // By slices where asked and the shader walks the BVH itself, as the sun's.
+                // By slices where asked and the shader walks the BVH itself, or by their passes, as the sun's.
                 v = -1.0;
 #ifdef SUNSHADE_SLICES
                 if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
-                    v = disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
-                                                     d.center_radius.w, 4u * k * k);
+                    v = (lights.light_rows.w & READ_DISKS) != 0u
+                        ? PASSED_FRACTION(ROWS_OF_DISK + i)
+                        : disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
+                                                       d.center_radius.w, 4u * k * k);
                 }
 #endif
                 if (v < 0.0) {
@@ -124,12 +129,11 @@ vec3 irradiance_visible(Frame p) {
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
         float v = 1.0;
         if (SHADOWS_ON && normal.y > -1.0) {
-            // By the slices the sky's passes took before this one, where they did (gpu::sky_passes).
+            // By the slices the sky's passes took before this one, where they did (gpu::slice_passes).
             v = -1.0;
 #ifdef SUNSHADE_SLICES
-            if (lights.sky_rows.z == SKY_ROWS_READ) {
-                uvec2 pixel = uvec2(gl_FragCoord.xy);
-                v = sky_fractions[pixel.y * uint(pc.framebuffer_size.x) + pixel.x];
+            if ((lights.light_rows.w & READ_SKY) != 0u) {
+                v = PASSED_FRACTION(ROWS_OF_SKY);
             }
 #endif
             if (v < 0.0) {

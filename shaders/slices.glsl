@@ -489,20 +489,21 @@ bool clip_segment(inout vec2 e0, inout vec2 e1, vec2 a, float b) {
     return true;
 }
 
-// A light's visible fraction by its rows, the part the sun's and disk lights' slices share (sky_slices'
-// sliced_fraction): one walk within reach gathers the triangles (1 at once where it gathers none); they are
-// filed under their rows' ranges and ordered along the chords; the rows psi = mid - half cos u about the axis c,
-// in the frame (h, q), each give their chord's span (the sun's: +-chi about its middle, `sigma` its half-angle;
-// a disk light's, `disk`: its chord (D, d, radius) seen from the origin, with the chord line that clips the
-// segments to where the rays end), cut by the surface's horizon, and its visible weight; sum(visible) /
-// sum(whole) over the rows. SLICES_UNSLICEABLE where the walk cannot gather.
-float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bool disk, vec3 d_vec, vec3 d,
-                      float radius, float sigma) {
+// The rows first .. first + rows_taken - 1 of a light's `rows`, the part the sun's and disk lights' slices share
+// (sky_slices::sliced_rows_weights): one walk within reach gathers the triangles; they are filed under their rows'
+// ranges and ordered along the chords; the rows psi = mid - half cos u about the axis c, in the frame (h, q), each
+// give their chord's span (the sun's: +-chi about its middle, `sigma` its half-angle; a disk light's, `disk`: its
+// chord (D, d, radius) seen from the origin, with the chord line that clips the segments to where the rays end),
+// cut by the surface's horizon, and its visible weight: (visible, whole) summed over the rows taken. (0, 0) at once
+// where the walk gathers nothing that a row may cut: every row clear, in every pass (the gather does not depend on
+// the rows taken), so the fraction is 1 (rows_fraction); (SLICES_UNSLICEABLE, 0) where the walk cannot gather.
+vec2 sliced_rows_weights(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, uint first, uint rows_taken,
+                         bool disk, vec3 d_vec, vec3 d, float radius, float sigma) {
     vec3 n = r.n;
     vec3 h = r.h;
     int gathered = gather(r);
     if (gathered < 0) {
-        return SLICES_UNSLICEABLE;
+        return vec2(SLICES_UNSLICEABLE, 0.0);
     }
     // The triangles that some row may cut, first ordered by where their centroids lie along the chords (the
     // pseudo-angle about the axis, seen along h; Shell's sort, Ciura's gaps: about count^1.25 of the budget).
@@ -521,7 +522,7 @@ float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bo
         }
     }
     if (count == 0u) {
-        return 1.0;
+        return vec2(0.0);
     }
     const uint gaps[4] = uint[](23u, 10u, 4u, 1u);
     for (uint g = 0u; g < 4u; ++g) {
@@ -539,7 +540,7 @@ float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bo
     float n_c = dot(n, c);
     float visible = 0.0;
     float total = 0.0;
-    for (uint i = 0u; i < rows; ++i) {
+    for (uint i = first; i < first + rows_taken; ++i) {
         vec2 su = cosine_row(i, rows);
         float psi = mid_half.x - mid_half.y * su.y;
         vec3 p = cos(psi) * h + sin(psi) * q;
@@ -588,41 +589,60 @@ float sliced_fraction(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, bo
         }
         visible += row_visible_weight(n_c, n_p, span, union_piece, pieces, spilled, whole, jacobian);
     }
-    return fraction(visible, total);
+    return vec2(visible, total);
 }
 
-// The sun's cosine-weighted visible fraction from `origin` on a surface of unit normal n, the sun in unit
-// direction l with angular diameter [rad], by `rows` slices (sun_slices.rs): the rows psi = -sigma cos u across
-// an axis perpendicular to l; SLICES_UNSLICEABLE where they cannot be taken (module text).
-float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows) {
+// A light's visible fraction from its rows' summed weights (sky_slices::rows_fraction): SLICES_UNSLICEABLE passed
+// on, and (0, 0), nothing to weigh or nothing in the way, 1.
+float rows_fraction(vec2 weights) {
+    return weights.x < 0.0 ? SLICES_UNSLICEABLE : fraction(weights.x, weights.y);
+}
+
+// The rows first .. first + count - 1 of the sun's `rows` slices (sun_slices::sun_rows_weights) from `origin` on a
+// surface of unit normal n, the sun in unit direction l with angular diameter [rad]: the rows psi = -sigma cos u
+// across an axis perpendicular to l; their cosine-weighted (visible, whole) as sliced_rows_weights gives them.
+vec2 sun_rows_weights(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows, uint first, uint count) {
     float sigma = 0.5 * angular_diameter;
     vec3 c = sun_slice_axis(l);
     SliceReach r = SliceReach(origin, n, l, cos(sigma), sin(sigma), vec3(0.0), -1.0);
-    return sliced_fraction(r, c, cross(c, l), vec2(0.0, sigma), rows, false, vec3(0.0), vec3(0.0), 0.0, sigma);
+    return sliced_rows_weights(r, c, cross(c, l), vec2(0.0, sigma), rows, first, count, false, vec3(0.0), vec3(0.0),
+                               0.0, sigma);
 }
 
-// The visible fraction of the disk light (centre [m], unit emission direction d, radius [m]) from `origin` on a
-// surface of unit normal n, weighted by projected solid angle, by `rows` slices (disk_slices.rs): 1 where the disk
-// gives nothing (seen from behind); SLICES_UNSLICEABLE where the origin is too near the disk for the slices' range
-// or the walk cannot gather.
-float disk_visible_fraction_sliced(vec3 origin, vec3 n, vec3 center, vec3 d, float radius, uint rows) {
+// The rows first .. first + count - 1 of the `rows` slices (disk_slices::disk_rows_weights) of the disk light
+// (centre [m], unit emission direction d, radius [m]) from `origin` on a surface of unit normal n, weighted by
+// projected solid angle, as sliced_rows_weights gives them: (0, 0) where the disk gives nothing (seen from
+// behind); (SLICES_UNSLICEABLE, 0) where the origin is too near the disk for the slices' range.
+vec2 disk_rows_weights(vec3 origin, vec3 n, vec3 center, vec3 d, float radius, uint rows, uint first,
+                       uint count) {
     vec3 d_vec = center - origin;
     float dist = length(d_vec);
     if (!(dot(d, d_vec) < 0.0 && dist > 0.0)) {
-        return 1.0;
+        return vec2(0.0);
     }
     vec3 dhat = d_vec / dist;
     vec3 c = sun_slice_axis(dhat);
     vec3 q = cross(c, dhat);
     vec2 range;
     if (!psi_range(dist, radius, dot(q, d), dot(dhat, d), range)) {
-        return SLICES_UNSLICEABLE;
+        return vec2(SLICES_UNSLICEABLE, 0.0);
     }
     vec2 mid_half = vec2(0.5 * (range.x + range.y), 0.5 * (range.y - range.x));
     float sin_a = radius / dist;
     vec2 cone = dist > radius ? vec2(sqrt(1.0 - sin_a * sin_a), sin_a) : vec2(-2.0, 0.0);
     SliceReach r = SliceReach(origin, n, dhat, cone.x, cone.y, d, SEGMENT_T_MAX * dot(d, d_vec));
-    return sliced_fraction(r, c, q, mid_half, rows, true, d_vec, d, radius, 0.0);
+    return sliced_rows_weights(r, c, q, mid_half, rows, first, count, true, d_vec, d, radius, 0.0);
+}
+
+// The sun's visible fraction by all its `rows` (sun_rows_weights), as the frame takes it where it slices the sun
+// itself; SLICES_UNSLICEABLE where the slices cannot be taken.
+float sun_visible_fraction_sliced(vec3 origin, vec3 n, vec3 l, float angular_diameter, uint rows) {
+    return rows_fraction(sun_rows_weights(origin, n, l, angular_diameter, rows, 0u, rows));
+}
+
+// A disk light's visible fraction by all its `rows` (disk_rows_weights), likewise.
+float disk_visible_fraction_sliced(vec3 origin, vec3 n, vec3 center, vec3 d, float radius, uint rows) {
+    return rows_fraction(disk_rows_weights(origin, n, center, d, radius, rows, 0u, rows));
 }
 
 // Whether a node's box may hold a part of the sky row's half-plane {s c + t p : t >= 0} (unit normal m) that lies
@@ -684,7 +704,7 @@ uint row_leaves[MAX_SLICE_TRIANGLES];
 // half great circles through SLICE_AXIS at the midpoints psi = 2 pi (i + 1/2) / rows (sky_slices'
 // sky_visible_fraction_sliced), from `origin` on a surface of unit normal n: (visible, whole), their visible and
 // unoccluded weights summed over the pass; (SLICES_UNSLICEABLE, 0) where an alpha-masked occluder is cut. The
-// renderer sums the passes and divides (gpu::sky_passes). A pixel's sky reaches every occluder above its
+// renderer sums the passes and divides (gpu::slice_passes). A pixel's sky reaches every occluder above its
 // horizons, thousands of triangles, more than one gather keeps (the sun's and disk lights' slices gather once);
 // but a plane cuts some hundred of them, so each row walks the BVH for its own (within_row): some hundred of the
 // budget's iterations a row on overcast.glb, and the renderer gives each pass as many rows as the budget holds.

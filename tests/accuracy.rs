@@ -900,7 +900,7 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
 }
 
 /// `render --tolerance` on the sky through occluders (overcast.glb, the sky through the teapot onto its floor):
-/// the sky is taken by slices in passes (`gpu::sky_passes`), the grids are
+/// the sky is taken by slices in passes (`gpu::slice_passes`), the grids are
 /// studied on the reference (the same rows in f64), and the GPU's image, measured against the reference's at the
 /// kept settings, meets T = 1e-2 and 1e-3 over every pixel against a truth whose every pixel's last doubling moved
 /// it by less than a tenth of 1e-4. Measured 2026-12-05 at 32 × 24 on Mesa 22.3.6: 9², 19², measured 1.3e-3,

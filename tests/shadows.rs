@@ -1075,7 +1075,7 @@ fn gpu_sun_slices_agree_with_the_reference_and_beat_the_grid() {
 #[test]
 fn gpu_sky_slices_in_passes_agree_with_the_reference_and_beat_the_grid() {
     // overcast.glb's sky through the teapot: the GPU's slices of the sky, taken in passes of rows before the frame
-    // (gpu::sky_passes; each row walks the BVH for its own triangles), against the reference's slices at the same
+    // (gpu::slice_passes; each row walks the BVH for its own triangles), against the reference's slices at the same
     // 4k² rows, and both rules at k = 4 against the reference's slices at k = 16 (the shadows' truth). Measured at
     // 64 × 48 on Mesa 22.3.6: 2.3e-6 apart at k = 4, 2.2e-6 at k = 8; at 32 × 24, k = 4, 8.1e-7 apart, and against
     // k = 16 the slices err 7.3e-3, the grid 0.54. With the sun too (its slices in the frame, the sky's before it),

@@ -234,7 +234,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 /// GPU renders once with them (`render`), and the distance of its image from the reference's at those settings
 /// (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to the prediction, T
 /// refused by name where the sum exceeds it. The GPU's sky passes cost some 40 ms a row at 64 × 48 on lavapipe
-/// (`gpu::sky_passes`) and a study's rungs thousands of rows: on overcast.glb at 64 × 48 and 1e-3 a study on the
+/// (`gpu::slice_passes`) and a study's rungs thousands of rows: on overcast.glb at 64 × 48 and 1e-3 a study on the
 /// GPU took 6 min and kept 27² (its order capped at 1), the reference's takes 4 s and keeps 19².
 /// `(asked, can_occlude)`: the shadows asked for, and whether the scene can shadow itself.
 fn sky_studied_on_the_reference(

@@ -29,11 +29,18 @@ pub const VISIBILITY_SLICES: u32 = 1;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
-/// One pass of the sky's slices (`gpu::sky_passes`): the fragment writes its rows' visible and unoccluded weights.
-pub const QUANTITY_SKY_ROWS: u32 = 2;
-/// `LightsHeader::sky_rows[2]`: the shader takes the sky's visible fraction itself, or reads the passes' sums.
-pub const SKY_ROWS_NONE: u32 = 0;
-pub const SKY_ROWS_READ: u32 = 1;
+/// One pass of a light's slices (`gpu::slice_passes`): the fragment writes its rows' visible and unoccluded weights.
+pub const QUANTITY_LIGHT_ROWS: u32 = 2;
+/// `LightsHeader::light_rows[2]`, the light a pass slices, and its layer of the fractions the passes leave: the sky,
+/// the sun, disk light `i` at `ROWS_OF_DISK + i`.
+pub const ROWS_OF_SKY: u32 = 0;
+pub const ROWS_OF_SUN: u32 = 1;
+pub const ROWS_OF_DISK: u32 = 2;
+/// `LightsHeader::light_rows[3]`'s bits: the lights whose visible fractions the frame reads from the passes' sums
+/// rather than taking them itself.
+pub const READ_SKY: u32 = 1;
+pub const READ_SUN: u32 = 2;
+pub const READ_DISKS: u32 = 4;
 /// Disk lights with a shadow map of their own (`MAX_DISK_MAPS` in the shaders).
 pub const MAX_DISK_MAPS: usize = crate::shading::MAPPED_DISKS;
 pub const WRAP_REPEAT: u32 = 0;
@@ -64,7 +71,7 @@ pub struct ShaderVariant {
     pub shadows: u32,
     /// `shading::surface::SURFACE_*` bits of the draw's material (0: untextured, opaque, not emissive).
     pub surface: u32,
-    /// `QUANTITY_RADIANCE`, `QUANTITY_IRRADIANCE`, or `QUANTITY_SKY_ROWS` (`gpu::sky_passes`).
+    /// `QUANTITY_RADIANCE`, `QUANTITY_IRRADIANCE`, or `QUANTITY_LIGHT_ROWS` (`gpu::slice_passes`).
     pub quantity: u32,
     /// `VISIBILITY_GRID` or `VISIBILITY_SLICES` with shadow rays (`VISIBILITY_GRID` without: nothing to take), so
     /// that the grid's pipelines leave the slices' code out (on Mesa 25 with ray queries it cost their creation 0.4 s).
@@ -186,9 +193,9 @@ pub struct LightsHeader {
     pub disk_map_from_world: [[f32; 16]; MAX_DISK_MAPS],
     /// tan of the half field of view, near \[m\], far \[m\], size \[texels\] (0: no map this frame).
     pub disk_map: [[f32; 4]; MAX_DISK_MAPS],
-    /// The sky's slices in passes (`gpu::sky_passes`): the pass's first row and its rows, `SKY_ROWS_NONE` or
-    /// `SKY_ROWS_READ`; the last unused.
-    pub sky_rows: [u32; 4],
+    /// The lights' slices in passes (`gpu::slice_passes`): a pass's first row, its rows and its light (`ROWS_OF_*`);
+    /// the lights whose fractions the frame reads (`READ_*` bits).
+    pub light_rows: [u32; 4],
 }
 
 #[repr(C)]
@@ -382,7 +389,7 @@ pub fn lights_bytes(
         sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
         disk_map_from_world,
         disk_map,
-        sky_rows: [0, 0, SKY_ROWS_NONE, 0],
+        light_rows: [0, 0, ROWS_OF_SKY, 0],
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     for d in &lights.disks {
@@ -396,11 +403,11 @@ pub fn lights_bytes(
     bytes
 }
 
-/// The light buffer's bytes (`lights_bytes`) with the sky's passes' word `sky_rows` set.
-pub fn with_sky_rows(bytes: &[u8], sky_rows: [u32; 4]) -> Vec<u8> {
+/// The light buffer's bytes (`lights_bytes`) with the slices' passes' word `light_rows` set.
+pub fn with_light_rows(bytes: &[u8], light_rows: [u32; 4]) -> Vec<u8> {
     let mut bytes = bytes.to_vec();
-    let at = std::mem::offset_of!(LightsHeader, sky_rows);
-    bytes[at..at + 16].copy_from_slice(bytemuck::bytes_of(&sky_rows));
+    let at = std::mem::offset_of!(LightsHeader, light_rows);
+    bytes[at..at + 16].copy_from_slice(bytemuck::bytes_of(&light_rows));
     bytes
 }
 
@@ -446,9 +453,13 @@ mod tests {
             ("VISIBILITY_SLICES", VISIBILITY_SLICES),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
-            ("QUANTITY_SKY_ROWS", QUANTITY_SKY_ROWS),
-            ("SKY_ROWS_NONE", SKY_ROWS_NONE),
-            ("SKY_ROWS_READ", SKY_ROWS_READ),
+            ("QUANTITY_LIGHT_ROWS", QUANTITY_LIGHT_ROWS),
+            ("ROWS_OF_SKY", ROWS_OF_SKY),
+            ("ROWS_OF_SUN", ROWS_OF_SUN),
+            ("ROWS_OF_DISK", ROWS_OF_DISK),
+            ("READ_SKY", READ_SKY),
+            ("READ_SUN", READ_SUN),
+            ("READ_DISKS", READ_DISKS),
             ("WRAP_REPEAT", WRAP_REPEAT),
             ("WRAP_MIRRORED_REPEAT", WRAP_MIRRORED_REPEAT),
             ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),
@@ -518,7 +529,7 @@ mod tests {
         assert_eq!(std::mem::offset_of!(MaterialGpu, tex), 112);
         assert_eq!(std::mem::size_of::<TextureRefGpu>(), 48);
         assert_eq!(std::mem::size_of::<LightsHeader>(), 496);
-        assert_eq!(std::mem::offset_of!(LightsHeader, sky_rows), 480);
+        assert_eq!(std::mem::offset_of!(LightsHeader, light_rows), 480);
         assert_eq!(std::mem::offset_of!(LightsHeader, disk_map_from_world), 160);
         assert_eq!(std::mem::offset_of!(LightsHeader, disk_map), 416);
         assert_eq!(std::mem::offset_of!(LightsHeader, sun_map_from_world), 80);

@@ -10,7 +10,7 @@
 //! - `commands`: record, submit, wait;
 //! - `accel`: acceleration structures for the shadow rays (ray queries);
 //! - `shadow_map`: the sun's shadow-map pass;
-//! - `sky_passes`: the sky's slices, taken in passes before the frame;
+//! - `slice_passes`: the lights' slices, taken in passes before the frame where a fragment cannot take them;
 //! - `renderer`: upload, draw, readback.
 
 mod accel;
@@ -27,8 +27,8 @@ mod renderer;
 pub mod shaders;
 pub mod shadow_bvh;
 mod shadow_map;
-pub mod sky_passes;
 pub mod slice_gather;
+pub mod slice_passes;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;

@@ -12,16 +12,16 @@ use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
-    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_sky_rows,
-    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, QUANTITY_SKY_ROWS, SHADOWS_MAP,
-    SHADOWS_NONE, SHADOWS_RAY, SKY_ROWS_NONE, SKY_ROWS_READ,
+    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_light_rows,
+    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, READ_SKY,
+    ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
-use super::sky_passes;
+use super::slice_passes;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -113,10 +113,10 @@ pub struct Renderer {
     // Field order is drop order: everything that uses the device goes before `dev`.
     target: Option<Target>,
     lights: Option<Buffer>,
-    /// The sky's fractions from its passes of slices (`sky_passes`) of the last frame that took them, and the one
-    /// unused value bound at 13 where a frame takes none.
-    sky_fractions: Option<Buffer>,
-    no_sky_fractions: Buffer,
+    /// The lights' fractions from their passes of slices (`slice_passes`) of the last frame that took them, and the
+    /// one unused value bound at 13 where a frame takes none.
+    light_fractions: Option<Buffer>,
+    no_light_fractions: Buffer,
     sun_map: DepthMap,
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
@@ -206,12 +206,12 @@ impl Renderer {
         let commands = Commands::new(&dev)?;
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
-        let no_sky_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "sky fractions (unused)")?;
+        let no_light_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "light fractions (unused)")?;
         let renderer = Self {
             target: None,
             lights: None,
-            sky_fractions: None,
-            no_sky_fractions,
+            light_fractions: None,
+            no_light_fractions,
             sun_map,
             disk_maps,
             pipeline,
@@ -514,7 +514,7 @@ impl Renderer {
     }
 
     /// Draws an uploaded scene and reads the radiance back: the sun's shadow-map pass where the technique is
-    /// `map`, the sky's passes of slices where its visible fraction is taken by them (`sky_passes`, with rays
+    /// `map`, the sky's passes of slices where its visible fraction is taken by them (`slice_passes`, with rays
     /// walking the BVH and `--visibility slices`), the scene pass, the readback.
     pub fn render(&mut self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Image, FrameTimings), GpuError> {
         let (width, height) = (settings.width, settings.height);
@@ -592,22 +592,23 @@ impl Renderer {
         }
         let pipelines = t_pipelines.elapsed();
         let t_render = Instant::now();
-        // The sky's visible fractions by its passes of slices, where the frame takes them (`sky_passes`).
+        // The sky's visible fractions by its passes of slices, where the frame takes them (`slice_passes`).
         let sky_sliced = shadows == SHADOWS_RAY
             && settings.shading.visibility_rule == VisibilityRule::Slices
             && settings.lights.sky.is_some();
-        let (sky_fractions, passes_pipelines) = if sky_sliced {
-            let (fractions, made) = self.sky_fractions(scene, settings, &light_bytes, &variants)?;
+        let (light_fractions, passes_pipelines) = if sky_sliced {
+            let (fractions, made) = self.light_fractions(scene, settings, &light_bytes, &variants, &[ROWS_OF_SKY])?;
             (Some(fractions), made)
         } else {
             (None, Duration::ZERO)
         };
-        let light_bytes = if sky_sliced { with_sky_rows(&light_bytes, [0, 0, SKY_ROWS_READ, 0]) } else { light_bytes };
+        let light_bytes =
+            if sky_sliced { with_light_rows(&light_bytes, [0, 0, ROWS_OF_SKY, READ_SKY]) } else { light_bytes };
         let lights = Buffer::storage(&self.dev, &light_bytes, "lights")?;
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
         unsafe {
-            self.write_descriptors(scene, &lights, sky_fractions.as_ref().unwrap_or(&self.no_sky_fractions));
+            self.write_descriptors(scene, &lights, light_fractions.as_ref().unwrap_or(&self.no_light_fractions));
             let cb = self.commands.begin(&self.dev)?;
             if shadow_pipeline.is_some() {
                 if let Some(frame) = &sun_map {
@@ -630,58 +631,68 @@ impl Renderer {
         super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
         let readback = t_readback.elapsed();
         self.lights = Some(lights);
-        self.sky_fractions = sky_fractions;
+        self.light_fractions = light_fractions;
         self.check_validation()?;
         Ok((image, FrameTimings { pipelines, render, readback }))
     }
 
-    /// The sky's visible fraction at every pixel by its slices, taken in passes before the frame (`sky_passes`): each
-    /// pass draws the scene with `variants` turned to `QUANTITY_SKY_ROWS` and the light buffer `lights` (its bytes)
-    /// naming the pass's rows; a pass the loop budget cuts short is split in two and drawn again (a single row cut
-    /// short refuses the image), one with a row meeting more triangles than a fragment keeps refuses it. The fractions'
-    /// buffer, and the time spent making the passes' pipelines.
-    fn sky_fractions(
+    /// The visible fractions at every pixel of the lights `slots` (`ROWS_OF_*`) by their slices, taken in passes
+    /// before the frame (`slice_passes`): each pass draws the scene with `variants` turned to
+    /// `QUANTITY_LIGHT_ROWS` and the light buffer `lights` (its bytes) naming the pass's light and rows; a pass the
+    /// loop budget cuts short is split in two and drawn again (a single row cut short refuses the image), one with a
+    /// row meeting more triangles than a fragment keeps refuses it. The fractions' buffer, a layer a slot up to the
+    /// last of `slots` (−1 in the others), and the time spent making the passes' pipelines.
+    fn light_fractions(
         &mut self,
         scene: &GpuScene,
         settings: &RenderSettings,
         lights: &[u8],
         variants: &[ShaderVariant],
+        slots: &[u32],
     ) -> Result<(Buffer, Duration), GpuError> {
         let t = Instant::now();
         let pass_variants: Vec<_> =
-            variants.iter().map(|&v| ShaderVariant { quantity: QUANTITY_SKY_ROWS, ..v }).collect();
+            variants.iter().map(|&v| ShaderVariant { quantity: QUANTITY_LIGHT_ROWS, ..v }).collect();
         let pass_pipelines = self.pipeline.pipelines_of(&pass_variants)?;
         let made = t.elapsed();
         let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
-        let mut passes: std::collections::VecDeque<_> = sky_passes::first_passes(rows).into();
-        let mut sums = sky_passes::SkySums::new((settings.width * settings.height) as usize);
-        while let Some((first, count)) = passes.pop_front() {
-            let pass_lights =
-                Buffer::storage(&self.dev, &with_sky_rows(lights, [first, count, SKY_ROWS_NONE, 0]), "lights")?;
-            // SAFETY: as in `render`: the GPU is idle between submissions.
-            unsafe {
-                self.write_descriptors(scene, &pass_lights, &self.no_sky_fractions);
-                let cb = self.commands.begin(&self.dev)?;
-                self.record_scene_pass(cb, scene, settings, &pass_pipelines);
-                self.commands.submit_and_wait(&self.dev, cb)?;
+        let pixels = (settings.width * settings.height) as usize;
+        let layers = slots.iter().max().map_or(0, |&s| s as usize + 1);
+        let mut fractions = vec![-1.0f32; pixels * layers];
+        for &slot in slots {
+            let mut passes: std::collections::VecDeque<_> = slice_passes::first_passes(rows).into();
+            let mut sums = slice_passes::RowSums::new(pixels);
+            while let Some((first, count)) = passes.pop_front() {
+                let pass_lights =
+                    Buffer::storage(&self.dev, &with_light_rows(lights, [first, count, slot, 0]), "lights")?;
+                // SAFETY: as in `render`: the GPU is idle between submissions.
+                unsafe {
+                    self.write_descriptors(scene, &pass_lights, &self.no_light_fractions);
+                    let cb = self.commands.begin(&self.dev)?;
+                    self.record_scene_pass(cb, scene, settings, &pass_pipelines);
+                    self.commands.submit_and_wait(&self.dev, cb)?;
+                }
+                let image = self.read_back(settings.width, settings.height)?;
+                match slice_passes::refusal(&image) {
+                    None => sums.add(&image),
+                    Some(slice_passes::Refusal::Overflowed) => {
+                        let light = slice_passes::light_name(slot);
+                        return Err(GpuError::Unsupported(slice_passes::overflowed(&image, &light, (first, count))));
+                    }
+                    Some(slice_passes::Refusal::LoopBudget) if count > 1 => {
+                        let half = count / 2;
+                        passes.push_front((first + half, count - half));
+                        passes.push_front((first, half));
+                    }
+                    Some(slice_passes::Refusal::LoopBudget) => {
+                        super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
+                    }
+                }
             }
-            let image = self.read_back(settings.width, settings.height)?;
-            match sky_passes::refusal(&image) {
-                None => sums.add(&image),
-                Some(sky_passes::Refusal::Overflowed) => {
-                    return Err(GpuError::Unsupported(sky_passes::overflowed(&image, (first, count))));
-                }
-                Some(sky_passes::Refusal::LoopBudget) if count > 1 => {
-                    let half = count / 2;
-                    passes.push_front((first + half, count - half));
-                    passes.push_front((first, half));
-                }
-                Some(sky_passes::Refusal::LoopBudget) => {
-                    super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
-                }
-            }
+            let at = slot as usize * pixels;
+            fractions[at..at + pixels].copy_from_slice(&sums.fractions());
         }
-        let fractions = Buffer::storage(&self.dev, bytemuck::cast_slice(&sums.fractions()), "sky fractions")?;
+        let fractions = Buffer::storage(&self.dev, bytemuck::cast_slice(&fractions), "light fractions")?;
         Ok((fractions, made))
     }
 
@@ -721,14 +732,14 @@ impl Renderer {
     }
 
     /// Bindings 0 materials, 1 lights, 2 indices, 3 vertices, 4 the acceleration structure, 5 the sun's map.
-    unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer, sky_fractions: &Buffer) {
+    unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer, light_fractions: &Buffer) {
         let d = &self.dev.device;
         // SAFETY: the caller guarantees the GPU is idle; every handle belongs to this renderer.
         unsafe {
             // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
             if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
                 // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
-                // 12 the occluders' BVH and 13 the sky's fractions for the pipelines with shadow rays.
+                // 12 the occluders' BVH and 13 the lights' fractions for the pipelines with shadow rays.
                 let mut buffers = vec![
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
@@ -745,7 +756,7 @@ impl Renderer {
                 let walks = self.pipeline.rays_walk_bvh();
                 buffers.push((10, if walks { walk_records } else { scene.occluder_triangles.buffer }));
                 if self.pipeline.has_shadow_rays() {
-                    buffers.extend([(12, nodes), (13, sky_fractions.buffer)]);
+                    buffers.extend([(12, nodes), (13, light_fractions.buffer)]);
                 }
                 if self.pipeline.has_ray_queries() {
                     buffers.push((14, walk_records));

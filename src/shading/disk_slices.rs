@@ -21,8 +21,8 @@
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, clip_segment, cosine_rows, row_visible_weight, segment_interval, slice_segment, sliced_fraction,
-    weight_integral, CosineRow,
+    above, clip_segment, cosine_rows, row_visible_weight, rows_fraction, segment_interval, slice_segment,
+    sliced_rows_weights, weight_integral, CosineRow,
 };
 use super::slice_buckets::frame_about;
 use super::sun_slices::sun_slice_axis;
@@ -84,13 +84,29 @@ pub fn disk_visible_fraction_sliced(
     radius: f64,
     rows: u32,
 ) -> Option<f64> {
+    let rows = rows.max(1);
+    let (visible, total) = disk_rows_weights(s, n, (center, d, radius), rows, 0, rows)?;
+    Some(rows_fraction(visible, total))
+}
+
+/// The rows `first .. first + count` of [`disk_visible_fraction_sliced`]'s `rows` for the disk `(centre, d,
+/// radius)`: their visible and unoccluded weights ([`sliced_rows_weights`]; `(0, 0)` where the disk gives nothing),
+/// the GPU's unit of work where one fragment cannot take every row (`gpu::slice_passes`).
+pub fn disk_rows_weights(
+    s: &Shadowing,
+    n: DVec3,
+    (center, d, radius): (DVec3, DVec3, f64),
+    rows: u32,
+    first: u32,
+    count: u32,
+) -> Option<(f64, f64)> {
     let d_vec = center - s.origin;
     let dist = d_vec.length();
     // Seen from behind its emitting side, the disk gives nothing (the grid's weights are all 0 there).
     // (A NaN from a non-finite disk reads as behind: nothing to weigh.)
     let in_front = d.dot(d_vec) < 0.0 && dist > 0.0;
     if !in_front {
-        return Some(1.0);
+        return Some((0.0, 0.0));
     }
     let dhat = d_vec / dist;
     let c = sun_slice_axis(dhat);
@@ -112,7 +128,8 @@ pub fn disk_visible_fraction_sliced(
     // where the walk keeps one.
     let reach = SliceReach { origin: s.origin, above: [n, dhat], cone, beyond, row: None };
     let rows = || cosine_rows(dhat, q, (mid, half), rows.max(1));
-    sliced_fraction(s, &reach, before, (frame_about(dhat, q), rows, |r: &CosineRow| r.p), |i, row, buckets, blocked| {
+    let frame = (frame_about(dhat, q), rows, |r: &CosineRow| r.p);
+    sliced_rows_weights(s, &reach, before, frame, first..first + count, |i, row, buckets, blocked| {
         let &CosineRow { sin_u, sin_psi: sin_p, cos_psi: cos_p, p, .. } = row;
         let jacobian = half * sin_u;
         let m = cos_p * q - sin_p * dhat;

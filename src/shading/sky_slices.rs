@@ -1,7 +1,7 @@
 //! The sky's visible fraction by slices: exact along one angle, a midpoint rule along the other. The reference's
 //! alternative to the located grid (`visibility::grid_fraction`) where its occluders are opaque triangles. The GPU
 //! takes the same rows in passes, each row walking the occluders for its own triangles ([`sky_rows_weights`],
-//! shaders/slices.glsl, `gpu::sky_passes`).
+//! shaders/slices.glsl, `gpu::slice_passes`).
 //!
 //! The sphere of directions is cut into half great circles through a fixed axis `c` ([`SLICE_AXIS`]):
 //! `ω(β, ψ) = cos β c + sin β p(ψ)`, `p(ψ) = cos ψ p₁ + sin ψ p₂`, `β ∈ [0, π]`, `ψ ∈ [0, 2π)`, the area element
@@ -277,38 +277,53 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
     }
 }
 
-/// A light's visible fraction by its rows, the part the sky's, the sun's and disk lights' slices share: one walk
-/// within `reach` gathers the triangles `keep` keeps (a light's own test of a whole triangle,
-/// [`RowBuckets::gather`]); where it keeps none the fraction is exactly 1 at once (every row would be clear: the
-/// same sums), before any row is made. Otherwise `rows()` makes the rows, each filed with its triangles
-/// ([`RowBuckets::file`]: `frame` across the axis, `direction` a row's unit direction), and `row(i, row,
-/// buckets, blocked)` gives row `i`'s visible and unoccluded weights (`None` where the row gives nothing;
-/// `blocked` the rows' shared buffer), summed in the rows' order into [`rows_fraction`]. `None` where the
-/// occluders cannot be sliced.
-pub fn sliced_fraction<R>(
+/// The rows `taken` of a light's rows, the part the sky's, the sun's and disk lights' slices share: one walk within
+/// `reach` gathers the triangles `keep` keeps (a light's own test of a whole triangle, [`RowBuckets::gather`]);
+/// where it keeps none, `(0, 0)` at once, before any row is made (every row clear, whichever rows are taken: the
+/// fraction is 1, [`rows_fraction`]). Otherwise `rows()` makes the rows, each filed with its triangles
+/// ([`RowBuckets::file`]: `frame` across the axis, `direction` a row's unit direction), and `row(i, row, buckets,
+/// blocked)` gives row `i`'s visible and unoccluded weights (`None` where the row gives nothing; `blocked` the
+/// rows' shared buffer), summed in the rows' order over those taken. `None` where the occluders cannot be sliced.
+/// (The GPU takes a light's rows in passes where one fragment cannot take them all, `gpu::slice_passes`.)
+pub fn sliced_rows_weights<R>(
     s: &Shadowing,
     reach: &SliceReach,
     keep: impl Fn(&[DVec3; 3]) -> bool,
     (frame, rows, direction): ((DVec3, DVec3), impl FnOnce() -> Vec<R>, impl Fn(&R) -> DVec3),
+    taken: std::ops::Range<u32>,
     mut row: impl FnMut(usize, &R, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let mut buckets = RowBuckets::default();
     if !buckets.gather(s, reach, keep) {
         return None;
     }
     if buckets.is_empty() {
-        return Some(1.0);
+        return Some((0.0, 0.0));
     }
     let rows = rows();
     buckets.file(frame, rows.iter().map(direction));
     let (mut visible, mut total) = (0.0, 0.0);
     let mut blocked = Vec::new();
-    for (i, r) in rows.iter().enumerate() {
+    let taken = taken.start as usize..taken.end as usize;
+    for (i, r) in rows.iter().enumerate().skip(taken.start).take(taken.len()) {
         if let Some((v, w)) = row(i, r, &buckets, &mut blocked) {
             visible += v;
             total += w;
         }
     }
+    Some((visible, total))
+}
+
+/// A light's visible fraction by all its `rows` ([`sliced_rows_weights`] of every row, [`rows_fraction`]).
+pub fn sliced_fraction<R>(
+    s: &Shadowing,
+    reach: &SliceReach,
+    keep: impl Fn(&[DVec3; 3]) -> bool,
+    (frame, rows, direction): ((DVec3, DVec3), impl FnOnce() -> Vec<R>, impl Fn(&R) -> DVec3),
+    count: u32,
+    row: impl FnMut(usize, &R, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
+) -> Option<f64> {
+    let (visible, total) = sliced_rows_weights(s, reach, keep, (frame, rows, direction), 0..count, row)?;
     Some(rows_fraction(visible, total))
 }
 
@@ -336,8 +351,9 @@ fn sky_row(n: DVec3, c: DVec3, p: DVec3) -> Option<SkyRow> {
 /// gives nothing (a surface facing straight down).
 pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option<f64> {
     let (c, p1, p2) = sky_frame();
+    let count = rows.max(1);
     let rows = || {
-        midpoint_rows(rows.max(1))
+        midpoint_rows(count)
             .map(|psi| {
                 let (sin_p, cos_p) = psi.sin_cos();
                 cos_p * p1 + sin_p * p2
@@ -352,6 +368,7 @@ pub fn sky_visible_fraction_sliced(s: &Shadowing, n: DVec3, rows: u32) -> Option
         &reach,
         |_| true,
         ((p1, p2), rows, |&p: &DVec3| p),
+        count,
         |i, &p, buckets, blocked| {
             let SkyRow { n_cp: (n_c, n_p), span, whole } = sky_row(n, c, p)?;
             let m = c.cross(p);
@@ -369,7 +386,7 @@ fn sky_frame() -> (DVec3, DVec3, DVec3) {
     (c, p1, c.cross(p1))
 }
 
-/// One pass of the sky's slices, the GPU's unit of work (`gpu::sky_passes`, shaders/slices.glsl): the rows
+/// One pass of the sky's slices, the GPU's unit of work (`gpu::slice_passes`, shaders/slices.glsl): the rows
 /// `first .. first + count` of [`sky_visible_fraction_sliced`]'s `rows`, each walking the occluders for the
 /// triangles its own half-plane may cut (`SliceReach::row`; a pixel's sky reaches more triangles than a fragment
 /// gathers, a row's plane some hundred); `(visible, whole)` summed over them, or `None` where the occluders cannot

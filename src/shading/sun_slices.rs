@@ -29,7 +29,8 @@ use std::f64::consts::FRAC_PI_2;
 use glam::DVec3;
 
 use super::sky_slices::{
-    above, blocked_interval, cosine_rows, row_visible_weight, sliced_fraction, weight_integral, CosineRow, SLICE_AXIS,
+    above, blocked_interval, cosine_rows, row_visible_weight, rows_fraction, sliced_rows_weights, weight_integral,
+    CosineRow, SLICE_AXIS,
 };
 use super::slice_buckets::frame_about;
 use super::visibility::{Shadowing, SliceReach};
@@ -95,6 +96,23 @@ pub fn slice_row_range(
 /// the occluders cannot be sliced (alpha masks). 1 where no row meets an occluder, and where the sun gives
 /// nothing (wholly below the surface's horizon).
 pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64, rows: u32) -> Option<f64> {
+    let rows = rows.max(1);
+    let (visible, total) = sun_rows_weights(s, n, l, angular_diameter, rows, 0, rows)?;
+    Some(rows_fraction(visible, total))
+}
+
+/// The rows `first .. first + count` of [`sun_visible_fraction_sliced`]'s `rows`: their cosine-weighted visible and
+/// unoccluded weights ([`sliced_rows_weights`]), the GPU's unit of work where one fragment cannot take every row
+/// (`gpu::slice_passes`).
+pub fn sun_rows_weights(
+    s: &Shadowing,
+    n: DVec3,
+    l: DVec3,
+    angular_diameter: f64,
+    rows: u32,
+    first: u32,
+    count: u32,
+) -> Option<(f64, f64)> {
     let sigma = 0.5 * angular_diameter;
     let c = sun_slice_axis(l);
     let q = c.cross(l);
@@ -103,11 +121,12 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     let cone = Some((l, sigma.cos(), sigma.sin()));
     let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None, row: None };
     let rows = || cosine_rows(l, q, (0.0, sigma), rows.max(1));
-    sliced_fraction(
+    sliced_rows_weights(
         s,
         &reach,
         |_| true,
         (frame_about(l, q), rows, |r: &CosineRow| r.p),
+        first..first + count,
         |i, row, buckets, blocked| {
             let &CosineRow { sin_u, psi, p, .. } = row;
             let jacobian = sigma * sin_u;

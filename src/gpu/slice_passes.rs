@@ -7,19 +7,20 @@
 //! plane cuts far fewer, so each row walks the BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on
 //! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and
 //! the rows are taken in passes before the frame, as many a pass as the loop budget (65 535 iterations,
-//! `loop_budget`) holds: each pass draws the scene with the variant `QUANTITY_SKY_ROWS`, whose fragment writes its
-//! rows' visible and unoccluded weights; the host sums the passes per pixel in f64 ([`SkySums`]) and the frame
-//! reads each pixel's fraction from a buffer (`SKY_ROWS_READ`).
+//! `loop_budget`) holds: each pass draws the scene with the variant `QUANTITY_LIGHT_ROWS`, whose fragment writes its
+//! rows' visible and unoccluded weights; the host sums the passes per pixel in f64 ([`RowSums`]) and the frame
+//! reads each pixel's fraction from a buffer, a layer a light (`READ_SKY`).
 //!
 //! The passes start as [`first_passes`] cuts the rows, at most [`ROWS_A_PASS`] each. A pass that the limiter cuts
 //! short is split in two and drawn again ([`refusal`]; a single row still cut short refuses the image); a row whose
 //! walk meets more triangles than a fragment keeps (`MAX_SLICE_TRIANGLES`) refuses it at once ([`overflowed`]).
 //! The sums are those of the reference's rows in another order (f32 within a pass), so a clear sky still reads
-//! exactly 1 ([`SkySums::fractions`]: `rows_fraction`'s rule).
+//! exactly 1 ([`RowSums::fractions`]: `rows_fraction`'s rule).
 
 use crate::film::Image;
 use crate::shading::sky_slices::rows_fraction;
 
+use super::layout::{ROWS_OF_DISK, ROWS_OF_SKY, ROWS_OF_SUN};
 use super::loop_budget::LOOP_BUDGET_SPENT;
 use super::slice_gather::{MAX_SLICE_TRIANGLES, SLICES_OVERFLOWED};
 
@@ -64,12 +65,21 @@ pub fn refusal(image: &Image) -> Option<Refusal> {
     }
 }
 
-/// Why a pass (its first row and rows) with a row whose walk met more triangles than a fragment keeps refuses the
-/// image.
-pub fn overflowed(image: &Image, (first, count): (u32, u32)) -> String {
+/// A light slot's name (`ROWS_OF_*`) for messages: "the sky", "the sun", "disk light i".
+pub fn light_name(slot: u32) -> String {
+    match slot {
+        ROWS_OF_SKY => "the sky".to_string(),
+        ROWS_OF_SUN => "the sun".to_string(),
+        _ => format!("disk light {}", slot - ROWS_OF_DISK),
+    }
+}
+
+/// Why a pass of `light`'s slices (its first row and rows) with a row whose walk met more triangles than a fragment
+/// keeps refuses the image.
+pub fn overflowed(image: &Image, light: &str, (first, count): (u32, u32)) -> String {
     let (pixels, (x, y)) = image.alpha_count_and_first(SLICES_OVERFLOWED).unwrap_or((0, (0, 0)));
     format!(
-        "--visibility slices: a row of the sky's slices (of rows {first} to {}) meets more than {MAX_SLICE_TRIANGLES} \
+        "--visibility slices: a row of {light}'s slices (of rows {first} to {}) meets more than {MAX_SLICE_TRIANGLES} \
          triangles at {pixels} pixel(s) (the first at ({x}, {y})), more than the GPU's slices keep a row; \
          --visibility grid casts rays there, and `sunshade reference --visibility slices` has no such limit",
         first + count - 1
@@ -77,13 +87,13 @@ pub fn overflowed(image: &Image, (first, count): (u32, u32)) -> String {
 }
 
 /// The passes' weights summed per pixel: visible and unoccluded, f64, and the pixels a pass could not slice.
-pub struct SkySums {
+pub struct RowSums {
     visible: Vec<f64>,
     total: Vec<f64>,
     unsliceable: Vec<bool>,
 }
 
-impl SkySums {
+impl RowSums {
     pub fn new(pixels: usize) -> Self {
         Self { visible: vec![0.0; pixels], total: vec![0.0; pixels], unsliceable: vec![false; pixels] }
     }
@@ -139,7 +149,7 @@ mod tests {
         // Pixel 0 clear in both passes, pixel 1 half hidden in the second, pixel 2 unsliceable in the first.
         a.pixels_mut().copy_from_slice(&[[0.3, 0.3, 0.0, 1.0], [0.2, 0.2, 0.0, 1.0], [-1.0, 0.0, 0.0, 1.0]]);
         b.pixels_mut().copy_from_slice(&[[0.7, 0.7, 0.0, 1.0], [0.1, 0.2, 0.0, 1.0], [0.5, 0.5, 0.0, 1.0]]);
-        let mut sums = SkySums::new(3);
+        let mut sums = RowSums::new(3);
         sums.add(&a);
         sums.add(&b);
         let f = sums.fractions();
@@ -151,7 +161,13 @@ mod tests {
         assert_eq!(refusal(&a), Some(Refusal::LoopBudget));
         a.pixels_mut()[1][3] = SLICES_OVERFLOWED;
         assert_eq!(refusal(&a), Some(Refusal::Overflowed));
-        let e = overflowed(&a, (17, 4));
-        assert!(e.contains("rows 17 to 20") && e.contains("1 pixel(s)") && e.contains("(1, 0)"), "{e}");
+        let e = overflowed(&a, "the sky", (17, 4));
+        assert!(
+            e.contains("the sky's slices")
+                && e.contains("rows 17 to 20")
+                && e.contains("1 pixel(s)")
+                && e.contains("(1, 0)"),
+            "{e}"
+        );
     }
 }
