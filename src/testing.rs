@@ -33,7 +33,7 @@ use crate::cli::{load_only, resolve_settings, CliError};
 use crate::compare::{self, DiffOptions, DiffReport};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{read_image, write_image, Exposure, Image, ImageIoError};
-use crate::gpu::{ContextOptions, GpuError, Renderer, ValidationLog};
+use crate::gpu::{ContextOptions, FrameTimings, GpuError, Renderer, ValidationLog};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
@@ -140,9 +140,15 @@ impl CheckedRenderer {
 
     /// Renders a loaded scene; panics on a validation message.
     pub fn render(&mut self, scene: &Scene, settings: &RenderSettings) -> Image {
-        let (image, _) = self.renderer().render_scene(scene, settings).unwrap_or_else(|e| panic!("render failed: {e}"));
+        self.render_timed(scene, settings).0
+    }
+
+    /// Renders a loaded scene, with the frame's timings (and what it took in passes); panics on a validation
+    /// message.
+    pub fn render_timed(&mut self, scene: &Scene, settings: &RenderSettings) -> (Image, FrameTimings) {
+        let rendered = self.renderer().render_scene(scene, settings).unwrap_or_else(|e| panic!("render failed: {e}"));
         assert_no_validation_messages(&self.log);
-        image
+        rendered
     }
 
     /// Renders a job as `sunshade render` would.

@@ -13,8 +13,8 @@ use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::layout::{
     lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_light_rows,
-    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, READ_SKY,
-    ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY,
+    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, BRDF_LAMBERT, DISKS_EXACT, LIGHT_ABSENT,
+    MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_DISK,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
@@ -52,6 +52,9 @@ pub struct FrameTimings {
     pub render: Duration,
     /// Copying the colour target to host memory and into the [`Image`].
     pub readback: Duration,
+    /// The lights whose visible fractions the frame read from their passes of slices (`slice_passes::read_bits`:
+    /// `READ_SKY`, `READ_SUN`, `READ_DISKS`), 0 where it took every light itself.
+    pub lights_in_passes: u32,
 }
 
 /// A scene's geometry and materials on the device.
@@ -592,48 +595,64 @@ impl Renderer {
         }
         let pipelines = t_pipelines.elapsed();
         let t_render = Instant::now();
-        // The sky's visible fractions by its passes of slices, where the frame takes them (`slice_passes`).
-        let sky_sliced = shadows == SHADOWS_RAY
-            && settings.shading.visibility_rule == VisibilityRule::Slices
-            && settings.lights.sky.is_some();
-        let (light_fractions, passes_pipelines) = if sky_sliced {
-            let (fractions, made) = self.light_fractions(scene, settings, &light_bytes, &variants, &[ROWS_OF_SKY])?;
-            (Some(fractions), made)
+        // The lights whose visible fractions the frame reads from their passes of slices (`slice_passes`): the
+        // sky's always (a pixel's sky reaches more occluders than a fragment gathers); the sun's and disk lights'
+        // where the frame that sliced them itself ran out of llvmpipe's loop budget: it is drawn again.
+        let sliced = shadows == SHADOWS_RAY && settings.shading.visibility_rule == VisibilityRule::Slices;
+        let mut slots = if sliced && settings.lights.sky.is_some() { vec![ROWS_OF_SKY] } else { Vec::new() };
+        let sun_sliced = settings.lights.sun.is_some() && variants.iter().any(|v| v.sun == SUN_DISK);
+        let disks_sliced = variants.iter().any(|v| v.disks == DISKS_EXACT);
+        let passable = if sliced {
+            slice_passes::passable(sun_sliced, if disks_sliced { settings.lights.disks.len() } else { 0 })
         } else {
-            (None, Duration::ZERO)
+            Vec::new()
         };
-        let light_bytes =
-            if sky_sliced { with_light_rows(&light_bytes, [0, 0, ROWS_OF_SKY, READ_SKY]) } else { light_bytes };
-        let lights = Buffer::storage(&self.dev, &light_bytes, "lights")?;
-        // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
-        // for), so the descriptor set may be updated and the command buffer re-recorded.
-        unsafe {
-            self.write_descriptors(scene, &lights, light_fractions.as_ref().unwrap_or(&self.no_light_fractions));
-            let cb = self.commands.begin(&self.dev)?;
-            if shadow_pipeline.is_some() {
-                if let Some(frame) = &sun_map {
-                    self.record_depth_pass(cb, scene, settings, &self.sun_map, frame.map_from_world, &map_pipelines);
+        let mut passes_pipelines = Duration::ZERO;
+        let (image, lights, light_fractions, readback) = loop {
+            let light_fractions = if slots.is_empty() {
+                None
+            } else {
+                let (fractions, made) = self.light_fractions(scene, settings, &light_bytes, &variants, &slots)?;
+                passes_pipelines += made;
+                Some(fractions)
+            };
+            let read = slice_passes::read_bits(&slots);
+            let lights = Buffer::storage(&self.dev, &with_light_rows(&light_bytes, [0, 0, 0, read]), "lights")?;
+            // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
+            // for), so the descriptor set may be updated and the command buffer re-recorded.
+            unsafe {
+                self.write_descriptors(scene, &lights, light_fractions.as_ref().unwrap_or(&self.no_light_fractions));
+                let cb = self.commands.begin(&self.dev)?;
+                if shadow_pipeline.is_some() {
+                    if let Some(frame) = &sun_map {
+                        let to_map = frame.map_from_world;
+                        self.record_depth_pass(cb, scene, settings, &self.sun_map, to_map, &map_pipelines);
+                    }
+                    for (map, (frame, _)) in
+                        self.disk_maps.iter().zip(&disk_maps).filter_map(|(m, f)| Some((m, f.as_ref()?)))
+                    {
+                        self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, &map_pipelines);
+                    }
                 }
-                for (map, (frame, _)) in
-                    self.disk_maps.iter().zip(&disk_maps).filter_map(|(m, f)| Some((m, f.as_ref()?)))
-                {
-                    self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, &map_pipelines);
-                }
+                self.record_scene_pass(cb, scene, settings, &draw_pipelines);
+                self.commands.submit_and_wait(&self.dev, cb)?;
             }
-            self.record_scene_pass(cb, scene, settings, &draw_pipelines);
-            self.commands.submit_and_wait(&self.dev, cb)?;
-        }
-        let render = t_render.elapsed() - passes_pipelines;
+            let t_readback = Instant::now();
+            let image = self.read_back(width, height)?;
+            match super::loop_budget::check(&image, &self.dev.info.name) {
+                Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => slots.extend(&passable),
+                Err(e) => return Err(GpuError::LoopBudget(e)),
+                Ok(()) => break (image, lights, light_fractions, t_readback.elapsed()),
+            }
+        };
+        let render = t_render.elapsed() - passes_pipelines - readback;
         let pipelines = pipelines + passes_pipelines;
-        let t_readback = Instant::now();
-        let image = self.read_back(width, height)?;
-        super::loop_budget::check(&image, &self.dev.info.name).map_err(GpuError::LoopBudget)?;
         super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
-        let readback = t_readback.elapsed();
         self.lights = Some(lights);
         self.light_fractions = light_fractions;
         self.check_validation()?;
-        Ok((image, FrameTimings { pipelines, render, readback }))
+        let lights_in_passes = slice_passes::read_bits(&slots);
+        Ok((image, FrameTimings { pipelines, render, readback, lights_in_passes }))
     }
 
     /// The visible fractions at every pixel of the lights `slots` (`ROWS_OF_*`) by their slices, taken in passes
@@ -651,8 +670,18 @@ impl Renderer {
         slots: &[u32],
     ) -> Result<(Buffer, Duration), GpuError> {
         let t = Instant::now();
-        let pass_variants: Vec<_> =
-            variants.iter().map(|&v| ShaderVariant { quantity: QUANTITY_LIGHT_ROWS, ..v }).collect();
+        // A pass's fragment reads neither its draw's BRDF nor its light models, only its surface (alpha masks,
+        // normal maps): materials that differ in those alone share a pass's pipeline (room.gltf's five, one).
+        let pass_variants: Vec<_> = variants
+            .iter()
+            .map(|&v| ShaderVariant {
+                quantity: QUANTITY_LIGHT_ROWS,
+                brdf: BRDF_LAMBERT,
+                sun: LIGHT_ABSENT,
+                disks: LIGHT_ABSENT,
+                ..v
+            })
+            .collect();
         let pass_pipelines = self.pipeline.pipelines_of(&pass_variants)?;
         let made = t.elapsed();
         let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);

@@ -1,26 +1,37 @@
-//! The sky's visible fraction by slices on the GPU, in passes. The reference slices the sky through occluders
-//! (`shading::sky_slices`: half great circles through a fixed axis, each row's blocked intervals exact, midpoints
-//! in the rows' angle). The sun's and disk lights' slices on the GPU gather the occluders in the light's cone once
-//! a pixel (`MAX_SLICE_TRIANGLES`, 1024); a pixel's sky reaches every occluder above its horizons, on overcast.glb
-//! the whole teapot (2256 triangles), and a wedge of rows about the axis does not narrow that where the axis line
-//! from the point passes through the teapot (measured at 64 × 48: wedges of 45° gathered up to all 2256). A row's
-//! plane cuts far fewer, so each row walks the BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on
-//! overcast.glb some 80 of llvmpipe's loop iterations a row for 155 boxes, and 20 for the 38 triangles met), and
-//! the rows are taken in passes before the frame, as many a pass as the loop budget (65 535 iterations,
-//! `loop_budget`) holds: each pass draws the scene with the variant `QUANTITY_LIGHT_ROWS`, whose fragment writes its
-//! rows' visible and unoccluded weights; the host sums the passes per pixel in f64 ([`RowSums`]) and the frame
-//! reads each pixel's fraction from a buffer, a layer a light (`READ_SKY`).
+//! The lights' visible fractions by slices on the GPU, in passes, where one fragment cannot take all of a light's
+//! rows within llvmpipe's loop budget (65 535 iterations a fragment, every loop together, `loop_budget`).
+//!
+//! **The sky, always.** The reference slices the sky through occluders (`shading::sky_slices`: half great circles
+//! through a fixed axis, each row's blocked intervals exact, midpoints in the rows' angle). The sun's and disk
+//! lights' slices on the GPU gather the occluders in the light's cone once a pixel (`MAX_SLICE_TRIANGLES`, 1024); a
+//! pixel's sky reaches every occluder above its horizons, on overcast.glb the whole teapot (2256 triangles), and a
+//! wedge of rows about the axis does not narrow that where the axis line from the point passes through the teapot
+//! (measured at 64 × 48: wedges of 45° gathered up to all 2256). A row's plane cuts far fewer, so each row walks the
+//! BVH for its own (shaders/slices.glsl, `sky_rows_weights`: on overcast.glb some 80 of llvmpipe's loop iterations
+//! a row for 155 boxes, and 20 for the 38 triangles met), and the rows are taken in passes before the frame.
+//!
+//! **The sun and disk lights, where the frame runs out.** Their slices gather once a pixel and cut the gathered
+//! triangles row by row in the frame (`sun_rows_weights`, `disk_rows_weights` over every row). Under a wide disk
+//! light a penumbra's pixel gathers hundreds of triangles, and 4k² rows of them pass the budget (room.gltf's
+//! skylight over its sphere at k = 9: 324 rows, 25 pixels cut short at 64 × 64). A frame cut short where it sliced
+//! them itself is drawn again with their rows taken in passes ([`passable`]: the sun's and every disk's), each
+//! pass gathering again and cutting only its rows.
+//!
+//! Each pass draws the scene with the variant `QUANTITY_LIGHT_ROWS`, its light (`ROWS_OF_*`) and rows named in
+//! the light buffer, and its fragment writes the rows' visible and unoccluded weights; the host sums the passes per
+//! pixel in f64 ([`RowSums`]) and the frame reads each pixel's fraction from a buffer, a layer a light
+//! ([`read_bits`]: `READ_SKY`, `READ_SUN`, `READ_DISKS`).
 //!
 //! The passes start as [`first_passes`] cuts the rows, at most [`ROWS_A_PASS`] each. A pass that the limiter cuts
-//! short is split in two and drawn again ([`refusal`]; a single row still cut short refuses the image); a row whose
+//! short is split in two and drawn again ([`refusal`]; a single row still cut short refuses the image); a pass whose
 //! walk meets more triangles than a fragment keeps (`MAX_SLICE_TRIANGLES`) refuses it at once ([`overflowed`]).
-//! The sums are those of the reference's rows in another order (f32 within a pass), so a clear sky still reads
-//! exactly 1 ([`RowSums::fractions`]: `rows_fraction`'s rule).
+//! The sums are those of the reference's rows in another order (f32 within a pass), so a light with nothing in the
+//! way still reads exactly 1 ([`RowSums::fractions`]: `rows_fraction`'s rule).
 
 use crate::film::Image;
 use crate::shading::sky_slices::rows_fraction;
 
-use super::layout::{ROWS_OF_DISK, ROWS_OF_SKY, ROWS_OF_SUN};
+use super::layout::{READ_DISKS, READ_SKY, READ_SUN, ROWS_OF_DISK, ROWS_OF_SKY, ROWS_OF_SUN};
 use super::loop_budget::LOOP_BUDGET_SPENT;
 use super::slice_gather::{MAX_SLICE_TRIANGLES, SLICES_OVERFLOWED};
 
@@ -65,6 +76,25 @@ pub fn refusal(image: &Image) -> Option<Refusal> {
     }
 }
 
+/// The lights whose slices a frame may pass, given whether the sun is sliced and how many disk lights are: the
+/// sun's slot ([`ROWS_OF_SUN`]) and every disk's (`ROWS_OF_DISK + i`). A frame that slices them itself and runs
+/// out of the loop budget passes them all (the renderer), every disk together (one bit, `READ_DISKS`).
+pub fn passable(sun: bool, disks: usize) -> Vec<u32> {
+    let sun = sun.then_some(ROWS_OF_SUN);
+    sun.into_iter().chain((0..disks as u32).map(|i| ROWS_OF_DISK + i)).collect()
+}
+
+/// The `READ_*` bits of the lights `slots` whose fractions the frame reads from the passes' layers.
+pub fn read_bits(slots: &[u32]) -> u32 {
+    slots.iter().fold(0, |bits, &slot| {
+        bits | match slot {
+            ROWS_OF_SKY => READ_SKY,
+            ROWS_OF_SUN => READ_SUN,
+            _ => READ_DISKS,
+        }
+    })
+}
+
 /// A light slot's name (`ROWS_OF_*`) for messages: "the sky", "the sun", "disk light i".
 pub fn light_name(slot: u32) -> String {
     match slot {
@@ -74,13 +104,13 @@ pub fn light_name(slot: u32) -> String {
     }
 }
 
-/// Why a pass of `light`'s slices (its first row and rows) with a row whose walk met more triangles than a fragment
-/// keeps refuses the image.
+/// Why a pass of `light`'s slices (its first row and rows) whose walk met more triangles than a fragment keeps (a
+/// sky row's, the sun's or a disk light's cone) refuses the image.
 pub fn overflowed(image: &Image, light: &str, (first, count): (u32, u32)) -> String {
     let (pixels, (x, y)) = image.alpha_count_and_first(SLICES_OVERFLOWED).unwrap_or((0, (0, 0)));
     format!(
-        "--visibility slices: a row of {light}'s slices (of rows {first} to {}) meets more than {MAX_SLICE_TRIANGLES} \
-         triangles at {pixels} pixel(s) (the first at ({x}, {y})), more than the GPU's slices keep a row; \
+        "--visibility slices: {light}'s slices (rows {first} to {}) meet more than {MAX_SLICE_TRIANGLES} triangles \
+         at {pixels} pixel(s) (the first at ({x}, {y})), more than the GPU's slices gather a fragment; \
          --visibility grid casts rays there, and `sunshade reference --visibility slices` has no such limit",
         first + count - 1
     )
@@ -140,6 +170,20 @@ mod tests {
             let sizes = passes.iter().map(|p| p.1);
             assert!(sizes.clone().max().unwrap() - sizes.min().unwrap() <= 1);
         }
+    }
+
+    #[test]
+    fn the_passable_lights_and_their_bits() {
+        assert_eq!(passable(false, 0), Vec::<u32>::new());
+        assert_eq!(passable(true, 0), vec![ROWS_OF_SUN]);
+        assert_eq!(passable(true, 2), vec![ROWS_OF_SUN, ROWS_OF_DISK, ROWS_OF_DISK + 1]);
+        assert_eq!(passable(false, 1), vec![ROWS_OF_DISK]);
+        assert_eq!(read_bits(&[]), 0);
+        assert_eq!(read_bits(&[ROWS_OF_SKY]), READ_SKY);
+        assert_eq!(read_bits(&[ROWS_OF_SKY, ROWS_OF_SUN, ROWS_OF_DISK + 3]), READ_SKY | READ_SUN | READ_DISKS);
+        assert_eq!(read_bits(&[ROWS_OF_DISK, ROWS_OF_DISK + 1]), READ_DISKS);
+        assert_eq!(light_name(ROWS_OF_SKY), "the sky");
+        assert_eq!(light_name(ROWS_OF_DISK + 1), "disk light 1");
     }
 
     #[test]
