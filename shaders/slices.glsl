@@ -495,8 +495,8 @@ bool clip_segment(inout vec2 e0, inout vec2 e1, vec2 a, float b) {
 // give their chord's span (the sun's: +-chi about its middle, `sigma` its half-angle; a disk light's, `disk`: its
 // chord (D, d, radius) seen from the origin, with the chord line that clips the segments to where the rays end),
 // cut by the surface's horizon, and its visible weight: (visible, whole) summed over the rows taken. (0, 0) at once
-// where the walk gathers nothing that a row may cut: every row clear, in every pass (the gather does not depend on
-// the rows taken), so the fraction is 1 (rows_fraction); (SLICES_UNSLICEABLE, 0) where the walk cannot gather.
+// where the walk gathers nothing that any row may cut: every row clear, in every pass (the fraction is 1,
+// rows_fraction); (SLICES_UNSLICEABLE, 0) where the walk cannot gather.
 vec2 sliced_rows_weights(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows, uint first, uint rows_taken,
                          bool disk, vec3 d_vec, vec3 d, float radius, float sigma) {
     vec3 n = r.n;
@@ -505,9 +505,12 @@ vec2 sliced_rows_weights(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows,
     if (gathered < 0) {
         return vec2(SLICES_UNSLICEABLE, 0.0);
     }
-    // The triangles that some row may cut, first ordered by where their centroids lie along the chords (the
-    // pseudo-angle about the axis, seen along h; Shell's sort, Ciura's gaps: about count^1.25 of the budget).
+    // The triangles that some row taken may cut, first ordered by where their centroids lie along the chords (the
+    // pseudo-angle about the axis, seen along h; Shell's sort, Ciura's gaps: about count^1.25 of the budget). A
+    // pass (gpu::slice_passes) keeps only those of its rows, so that its rows test fewer.
     uint count = 0u;
+    uint last = first + rows_taken - 1u;
+    bool any_row = false;
     for (uint j = 0u; j < uint(gathered); ++j) {
         vec3 a = slice_corners[3u * j];
         vec3 b = slice_corners[3u * j + 1u];
@@ -516,12 +519,15 @@ vec2 sliced_rows_weights(SliceReach r, vec3 c, vec3 q, vec2 mid_half, uint rows,
         slice_ranges[j] = range;
         vec3 g = a + b + e;
         slice_keys[j] = pseudo_angle(dot(g, c), max(dot(g, h), 0.0));
-        if (range.x <= range.y) {
+        any_row = any_row || range.x <= range.y;
+        if (range.x <= range.y && range.x <= last && range.y >= first) {
             slice_order[count] = j;
             count += 1u;
         }
     }
-    if (count == 0u) {
+    // Every row clear, whichever rows are taken: the fraction is 1 at once. (Where only this pass's rows are clear,
+    // they still weigh their light, all of it visible: row_visible_weight gives `whole` with nothing blocked.)
+    if (!any_row) {
         return vec2(0.0);
     }
     const uint gaps[4] = uint[](23u, 10u, 4u, 1u);

@@ -292,12 +292,17 @@ fn penumbrae_by_slices_alone(request: Request, settings: &RenderSettings) -> boo
         && only_lambertian(request.scene)
 }
 
-/// Whether the reference's shadow rays see the sky through occluders by slices: the sky lit, shadows by rays in a
-/// scene that can shadow itself, `--visibility slices`, and no alpha-masked material (whose occluders send
-/// the slices back to the grid, `shading::sky_slices`).
+/// Whether the reference's shadow rays see the sky through occluders by slices: the sky lit and
+/// [`lights_by_slices`].
 pub fn sky_by_slices(scene: &Scene, settings: &RenderSettings, scene_can_occlude: bool) -> bool {
-    settings.lights.sky.is_some()
-        && scene_can_occlude
+    settings.lights.sky.is_some() && lights_by_slices(scene, settings, scene_can_occlude)
+}
+
+/// Whether every shadowed light's visible fraction is taken by slices: shadows by rays in a scene that can shadow
+/// itself, `--visibility slices`, and no alpha-masked material (whose occluders send the slices back to the grid,
+/// `shading::sky_slices`).
+pub fn lights_by_slices(scene: &Scene, settings: &RenderSettings, scene_can_occlude: bool) -> bool {
+    scene_can_occlude
         && settings.shading.shadows == Shadows::Ray
         && settings.shading.visibility_rule == VisibilityRule::Slices
         && !scene.has_alpha_masks()

@@ -173,10 +173,14 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         asked: a.scene.shadows,
         scene_can_occlude: gpu_scene.can_occlude(),
     };
-    // Where the GPU slices the sky through occluders, its grids are studied on the reference, whose promise then
-    // holds in penumbrae too, asked or not (`sky_studied_on_the_reference`).
-    let sky_sliced = crate::accuracy::trial::sky_by_slices(scene_data, &settings, gpu_scene.can_occlude());
     let tolerance = a.scene.tolerance();
+    // Where the GPU slices the lights in their penumbrae (the sky through occluders, whose penumbra is the image,
+    // or every light with `--tolerance-in-penumbrae`), the grids are studied on the reference, whose promise then
+    // holds in penumbrae too (`studied_on_the_reference`).
+    let can_occlude = gpu_scene.can_occlude();
+    let study_on_the_reference = crate::accuracy::trial::sky_by_slices(scene_data, &settings, can_occlude)
+        || (tolerance.is_some_and(|t| t.in_penumbrae)
+            && crate::accuracy::trial::lights_by_slices(scene_data, &settings, can_occlude));
     // Every render `--tolerance` makes (a delta trial, a lobe study's rungs) is part of this render's cost.
     let mut spent = FrameTimings::default();
     let mut gpu_render = |s: &RenderSettings| {
@@ -197,9 +201,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         (e, _) => CliError::from(e),
     };
     let (image, prediction) = match tolerance {
-        Some(t) if sky_sliced => {
-            let scene_flags = (a.scene.shadows, gpu_scene.can_occlude());
-            sky_studied_on_the_reference(scene_data, &mut settings, &reference, scene_flags, t, |s| {
+        Some(t) if study_on_the_reference => {
+            let scene_flags = (a.scene.shadows, can_occlude);
+            studied_on_the_reference(scene_data, &mut settings, &reference, scene_flags, t, |s| {
                 gpu_render(s).map(|(image, _)| image).map_err(|e| beyond(e, s))
             })?
         }
@@ -228,16 +232,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
 }
 
-/// `--tolerance` where the GPU slices the sky through occluders: the grids are studied on the reference, the same
-/// rule in f64 (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the
-/// promise there holds in penumbrae too, asked or not: the sky's penumbra is nearly the whole image), then the
-/// GPU renders once with them (`render`), and the distance of its image from the reference's at those settings
-/// (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to the prediction, T
-/// refused by name where the sum exceeds it. The GPU's sky passes cost some 40 ms a row at 64 × 48 on lavapipe
-/// (`gpu::slice_passes`) and a study's rungs thousands of rows: on overcast.glb at 64 × 48 and 1e-3 a study on the
-/// GPU took 6 min and kept 27² (its order capped at 1), the reference's takes 4 s and keeps 19².
-/// `(asked, can_occlude)`: the shadows asked for, and whether the scene can shadow itself.
-fn sky_studied_on_the_reference(
+/// `--tolerance` where the GPU slices the lights in their penumbrae (the sky through occluders, or every light with
+/// `--tolerance-in-penumbrae`): the grids are studied on the reference, the same rule in f64
+/// (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the promise there
+/// holds in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
+/// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and
+/// added to the prediction, T refused by name where the sum exceeds it: the image is within the sum of the truth.
+/// A study's rungs cost the GPU far more than the reference: the sky's passes some 40 ms a row at 64 × 48 on
+/// lavapipe (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27²,
+/// its order capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame
+/// runs out of the loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the
+/// shadows asked for, and whether the scene can shadow itself.
+fn studied_on_the_reference(
     scene: &crate::scene::Scene,
     settings: &mut RenderSettings,
     reference: &ReferenceOptions,

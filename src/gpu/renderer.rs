@@ -84,6 +84,10 @@ pub struct GpuScene {
     can_occlude: bool,
     /// The scene's bounds (the sun's shadow map is fitted to them).
     bounds: Option<crate::scene::Aabb>,
+    /// The fewest rows (`sky_slices::slice_rows`) at which a frame of this scene that sliced the sun and disk lights
+    /// itself ran out of the loop budget (`u32::MAX`: none has): a render with as many takes them in passes from
+    /// the start (`slice_passes`) rather than draw a frame that would be cut short (a study's rungs only grow).
+    passes_from_rows: std::cell::Cell<u32>,
 }
 
 impl GpuScene {
@@ -424,6 +428,7 @@ impl Renderer {
         // The walk's source where the pipelines have shadow rays: their walk without ray queries, the slices' with.
         let walk_source = (bvh || rq).then(|| WalkSource::new(scene, &vertex_offsets));
         Ok(GpuScene {
+            passes_from_rows: std::cell::Cell::new(u32::MAX),
             accel,
             vertices,
             indices,
@@ -607,6 +612,10 @@ impl Renderer {
         } else {
             Vec::new()
         };
+        let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
+        if rows >= scene.passes_from_rows.get() {
+            slots.extend(&passable);
+        }
         let mut passes_pipelines = Duration::ZERO;
         let (image, lights, light_fractions, readback) = loop {
             let light_fractions = if slots.is_empty() {
@@ -640,7 +649,10 @@ impl Renderer {
             let t_readback = Instant::now();
             let image = self.read_back(width, height)?;
             match super::loop_budget::check(&image, &self.dev.info.name) {
-                Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => slots.extend(&passable),
+                Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {
+                    scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
+                    slots.extend(&passable);
+                }
                 Err(e) => return Err(GpuError::LoopBudget(e)),
                 Ok(()) => break (image, lights, light_fractions, t_readback.elapsed()),
             }
