@@ -161,6 +161,7 @@ pub fn disk_rows_weights(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shading::sun_slices::{sun_rows_weights, sun_visible_fraction_sliced};
     use crate::shading::visibility::{disk_visible_fraction, test_shadowing};
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
@@ -212,6 +213,45 @@ mod tests {
             }
         }
         assert!(partial >= 8, "points in the penumbra: {partial}");
+    }
+
+    /// The GPU's passes of a disk light's rows (`gpu::slice_passes`), and of the sun's, sum to the fraction by all
+    /// rows, however the rows are cut.
+    #[test]
+    fn passes_of_rows_sum_to_the_fraction_by_slices() {
+        let center = DVec3::new(0.0, 2.0, 0.0);
+        let occ = plate(0.35, 1.0, 0.1, 0.5);
+        let rows = 144;
+        let cuts = [vec![0, rows], vec![0, 1, 50, 51, 100, rows], vec![0, 7, 72, rows - 1, rows]];
+        let sum = |pass: &dyn Fn(u32, u32) -> (f64, f64), cuts: &[u32]| {
+            let (visible, total) =
+                cuts.windows(2).map(|w| pass(w[0], w[1] - w[0])).fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+            rows_fraction(visible, total)
+        };
+        let (mut partial, mut sun_partial) = (0, 0);
+        // x = 0.4: the sun's penumbra from the plate's edge at x = 0.85.
+        for ox in [-0.4, 0.0, 0.3, 0.4, 0.9] {
+            let o = DVec3::new(ox, 0.0, 0.05);
+            let s = shadowing(&occ, o, 6);
+            for n in [DVec3::Y, DVec3::new(0.4, 1.0, -0.2).normalize()] {
+                let disk = (center, -DVec3::Y, 0.6);
+                let whole = disk_visible_fraction_sliced(&s, n, center, -DVec3::Y, 0.6, rows).unwrap();
+                partial += usize::from(whole > 0.01 && whole < 0.99);
+                for c in &cuts {
+                    let passes = sum(&|first, count| disk_rows_weights(&s, n, disk, rows, first, count).unwrap(), c);
+                    assert!((passes - whole).abs() < 1e-13, "o {o} n {n} {c:?}: {passes} against {whole}");
+                }
+                // The sun low behind the plate's edge, from the same points.
+                let l = DVec3::new(0.45, 1.0, 0.05).normalize();
+                let sun = |first, count| sun_rows_weights(&s, n, l, 0.02, rows, first, count).unwrap();
+                let whole = sun_visible_fraction_sliced(&s, n, l, 0.02, rows).unwrap();
+                sun_partial += usize::from(whole > 0.01 && whole < 0.99);
+                for c in &cuts {
+                    assert!((sum(&sun, c) - whole).abs() < 1e-13, "sun o {o} n {n} {c:?}");
+                }
+            }
+        }
+        assert!(partial >= 2 && sun_partial >= 1, "points in the penumbrae: disk {partial}, sun {sun_partial}");
     }
 
     #[test]
