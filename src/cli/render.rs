@@ -114,6 +114,9 @@ pub struct Rendered {
     /// The session's scene and renderer it used.
     pub scene: usize,
     pub renderer: usize,
+    /// The reference's image at `settings`, mirroring the device, where `--tolerance` rendered it to measure the
+    /// GPU's against it: `--check` compares with it rather than render it again ([`reference_of`]).
+    pub reference: Option<Image>,
 }
 
 /// Renders one job on the session's renderer for its device: the scene loaded (unless the session has it), the
@@ -200,7 +203,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         )),
         (e, _) => CliError::from(e),
     };
-    let (image, prediction) = match tolerance {
+    let (image, prediction, reference_image) = match tolerance {
         Some(t) if study_on_the_reference => {
             let scene_flags = (a.scene.shadows, can_occlude);
             studied_on_the_reference(scene_data, &mut settings, &reference, scene_flags, t, |s| {
@@ -214,8 +217,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
                 TrialError::Render(e) => beyond(e, &settings),
             })?;
             let ((image, _), mut prediction) = (done.kept, done.prediction);
+            let mut reference_image = None;
             if let Some(t) = tolerance.filter(|t| t.in_penumbrae) {
-                slices_measured_against_the_reference(
+                reference_image = slices_measured_against_the_reference(
                     &image,
                     scene_data,
                     &settings,
@@ -224,12 +228,24 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
                     &mut prediction,
                 )?;
             }
-            (image, prediction)
+            (image, prediction, reference_image)
         }
     };
     let frame = spent;
     warn_if_nothing_covered(&image, &a.scene.scene);
-    Ok(Rendered { image, settings, shadow_reason: choice.reason, prediction, frame, load, upload, scene, renderer })
+    let reference = reference_image;
+    Ok(Rendered {
+        image,
+        settings,
+        shadow_reason: choice.reason,
+        prediction,
+        frame,
+        load,
+        upload,
+        scene,
+        renderer,
+        reference,
+    })
 }
 
 /// `--tolerance` where the GPU slices the lights in their penumbrae (the sky through occluders, or every light with
@@ -250,7 +266,7 @@ fn studied_on_the_reference(
     (asked, can_occlude): (Shadows, bool),
     tolerance: Tolerance,
     render: impl FnOnce(&RenderSettings) -> Result<Image, CliError>,
-) -> Result<(Image, Prediction), CliError> {
+) -> Result<(Image, Prediction, Option<Image>), CliError> {
     let (studied, mut prediction) = crate::accuracy::trial::reference_within_tolerance(
         scene,
         settings,
@@ -269,7 +285,7 @@ fn studied_on_the_reference(
              has no f32"
         )
     })?;
-    Ok((image, prediction))
+    Ok((image, prediction, Some(studied)))
 }
 
 /// The GPU's `image` against the reference's f64 image at the same settings (`f64_image`): their distance added to
@@ -304,11 +320,11 @@ fn slices_measured_against_the_reference(
     reference: &ReferenceOptions,
     tolerance: f64,
     prediction: &mut Prediction,
-) -> Result<(), CliError> {
+) -> Result<Option<Image>, CliError> {
     if settings.shading.visibility_rule != crate::shading::VisibilityRule::Slices
         || settings.shading.shadows != Shadows::Ray
     {
-        return Ok(());
+        return Ok(None);
     }
     let f64_slices = cpu::render(scene, settings, reference);
     let what = "GPU f32 slices (measured against the reference's):";
@@ -318,7 +334,8 @@ fn slices_measured_against_the_reference(
              occluders), which with the rest ({sum:.1e}) exceeds it; `sunshade reference` with the same scene flags \
              has no f32 geometry"
         )
-    })
+    })?;
+    Ok(Some(f64_slices))
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
@@ -357,8 +374,12 @@ pub(super) fn beyond_this_device(settings: &RenderSettings, why: &str) -> String
 /// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
 /// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
 /// For a shadow-map render, also the pixels where the maps may answer otherwise than its rays
-/// (`cpu::render_with_map_edges`), which a check counts apart.
+/// (`cpu::render_with_map_edges`), which a check counts apart. The one `--tolerance` rendered, where it did
+/// ([`Rendered::reference`]).
 pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> (Image, Option<Vec<bool>>) {
+    if let (Some(image), false) = (&job.reference, job.settings.shading.shadows == Shadows::Map) {
+        return (image.clone(), None);
+    }
     let options = reference_options(session, a, job);
     let scene = session.scene_ref(job.scene);
     if job.settings.shading.shadows == Shadows::Map {
