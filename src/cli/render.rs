@@ -191,6 +191,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         spent.pipelines += t.pipelines;
         spent.render += t.render;
         spent.readback += t.readback;
+        spent.lights_in_passes |= t.lights_in_passes;
         Ok::<_, crate::gpu::GpuError>((image, t))
     };
     let beyond = |e: crate::gpu::GpuError, settings: &RenderSettings| match (e, tolerance) {
@@ -515,6 +516,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         eprintln!("sunshade: {sun_line}");
         if let Some(line) = lobe_line {
             eprintln!("sunshade: {line}");
+        }
+        if let Some(lights) = crate::gpu::slice_passes::passed_lights(job.frame.lights_in_passes) {
+            eprintln!("sunshade: slices in passes before the frame: {lights} (gpu::slice_passes)");
         }
         eprintln!("sunshade: {}", job.prediction.line());
         print_exposure(ev);

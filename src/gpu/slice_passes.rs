@@ -95,6 +95,13 @@ pub fn read_bits(slots: &[u32]) -> u32 {
     })
 }
 
+/// The lights that `read_bits` names, for `-v` ("the sky, the sun, disk lights"), or `None` where it names none.
+pub fn passed_lights(bits: u32) -> Option<String> {
+    let names = [(READ_SKY, "the sky"), (READ_SUN, "the sun"), (READ_DISKS, "disk lights")];
+    let named: Vec<_> = names.iter().filter(|(bit, _)| bits & bit != 0).map(|(_, name)| *name).collect();
+    (!named.is_empty()).then(|| named.join(", "))
+}
+
 /// A light slot's name (`ROWS_OF_*`) for messages: "the sky", "the sun", "disk light i".
 pub fn light_name(slot: u32) -> String {
     match slot {
@@ -183,6 +190,8 @@ mod tests {
         assert_eq!(read_bits(&[ROWS_OF_SKY, ROWS_OF_SUN, ROWS_OF_DISK + 3]), READ_SKY | READ_SUN | READ_DISKS);
         assert_eq!(read_bits(&[ROWS_OF_DISK, ROWS_OF_DISK + 1]), READ_DISKS);
         assert_eq!(light_name(ROWS_OF_SKY), "the sky");
+        assert_eq!(passed_lights(0), None);
+        assert_eq!(passed_lights(READ_SKY | READ_DISKS).as_deref(), Some("the sky, disk lights"));
         assert_eq!(light_name(ROWS_OF_DISK + 1), "disk light 1");
     }
 
