@@ -1131,7 +1131,7 @@ fn gpu_disk_slices_agree_with_the_reference() {
         assert!(apart.max_rel <= 1e-5, "{}", apart.text("gpu", "reference"));
         assert!(from_grid.max_rel >= 1e-3, "the slices are the grid: {}", from_grid.text("slices", "grid"));
     }
-    // At k = 9 (324 rows) the frame's own slices of the skylight run past llvmpipe's loop budget at the penumbra's
+    // At k = 9 (324 rows) the frame's own slices of the skylight run past Mesa 22's loop budget at the penumbra's
     // pixels (25 of them at 64 x 64, each cutting some 200 gathered triangles a row): the renderer takes the disk's
     // rows in passes before the frame (gpu::slice_passes) and draws the frame again, reading them. The same
     // agreement with the reference's slices (measured 2026-12-05 on Mesa 22.3.6: see the eprintln).
@@ -1144,7 +1144,10 @@ fn gpu_disk_slices_agree_with_the_reference() {
         apart.max_rel, timings.lights_in_passes
     );
     assert!(apart.max_rel <= 1e-5, "{}", apart.text("gpu", "reference"));
-    if gpu.renderer().device_info().name.contains("llvmpipe") {
+    // Mesa 22.3.6's lavapipe (no ray queries) has the loop limiter; Mesa 25.0.7's (ray queries) did not cut these
+    // loops short (docs/platform.md), so its frame keeps the disk's slices.
+    let info = gpu.renderer().device_info();
+    if info.name.contains("llvmpipe") && !info.ray_query {
         assert_eq!(timings.lights_in_passes, sunshade::gpu::layout::READ_DISKS, "the disk's slices fit the frame here");
     }
 }
