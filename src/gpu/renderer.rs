@@ -57,6 +57,16 @@ pub struct FrameTimings {
     pub lights_in_passes: u32,
 }
 
+/// What a frame draws besides the lights' passes: the shadow maps' transforms (world → map) where the technique
+/// is `map` (the sun's, and the first disk lights', aligned with `Renderer::disk_maps`), with the pipelines that
+/// draw each mesh into them, and the scene pass's pipelines, a draw each.
+struct FrameDraws<'a> {
+    sun_map: Option<glam::DMat4>,
+    disk_maps: Vec<Option<glam::DMat4>>,
+    map_pipelines: &'a [vk::Pipeline],
+    draw_pipelines: &'a [vk::Pipeline],
+}
+
 /// A scene's geometry and materials on the device.
 pub struct GpuScene {
     // The acceleration structure goes before the buffers it was built from.
@@ -617,35 +627,25 @@ impl Renderer {
             slots.extend(&passable);
         }
         let mut passes_pipelines = Duration::ZERO;
+        let draws = FrameDraws {
+            sun_map: sun_map.as_ref().filter(|_| shadow_pipeline.is_some()).map(|f| f.map_from_world),
+            disk_maps: disk_maps
+                .iter()
+                .map(|f| f.as_ref().filter(|_| shadow_pipeline.is_some()).map(|(f, _)| f.map_from_world))
+                .collect(),
+            map_pipelines: &map_pipelines,
+            draw_pipelines: &draw_pipelines,
+        };
+        let mut passed = slice_passes::PassedFractions::new((width * height) as usize);
         let (image, lights, light_fractions, readback) = loop {
-            let light_fractions = if slots.is_empty() {
-                None
-            } else {
-                let (fractions, made) = self.light_fractions(scene, settings, &light_bytes, &variants, &slots)?;
-                passes_pipelines += made;
-                Some(fractions)
+            passes_pipelines += self.light_fractions(scene, settings, &light_bytes, &variants, &slots, &mut passed)?;
+            let light_fractions = match passed.layered() {
+                Some(layers) => Some(Buffer::storage(&self.dev, bytemuck::cast_slice(&layers), "light fractions")?),
+                None => None,
             };
             let read = slice_passes::read_bits(&slots);
             let lights = Buffer::storage(&self.dev, &with_light_rows(&light_bytes, [0, 0, 0, read]), "lights")?;
-            // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
-            // for), so the descriptor set may be updated and the command buffer re-recorded.
-            unsafe {
-                self.write_descriptors(scene, &lights, light_fractions.as_ref().unwrap_or(&self.no_light_fractions));
-                let cb = self.commands.begin(&self.dev)?;
-                if shadow_pipeline.is_some() {
-                    if let Some(frame) = &sun_map {
-                        let to_map = frame.map_from_world;
-                        self.record_depth_pass(cb, scene, settings, &self.sun_map, to_map, &map_pipelines);
-                    }
-                    for (map, (frame, _)) in
-                        self.disk_maps.iter().zip(&disk_maps).filter_map(|(m, f)| Some((m, f.as_ref()?)))
-                    {
-                        self.record_depth_pass(cb, scene, settings, map, frame.map_from_world, &map_pipelines);
-                    }
-                }
-                self.record_scene_pass(cb, scene, settings, &draw_pipelines);
-                self.commands.submit_and_wait(&self.dev, cb)?;
-            }
+            self.draw_frame(scene, settings, &lights, light_fractions.as_ref(), &draws)?;
             let t_readback = Instant::now();
             let image = self.read_back(width, height)?;
             match super::loop_budget::check(&image, &self.dev.info.name) {
@@ -667,12 +667,40 @@ impl Renderer {
         Ok((image, FrameTimings { pipelines, render, readback, lights_in_passes }))
     }
 
-    /// The visible fractions at every pixel of the lights `slots` (`ROWS_OF_*`) by their slices, taken in passes
-    /// before the frame (`slice_passes`): each pass draws the scene with `variants` turned to
-    /// `QUANTITY_LIGHT_ROWS` and the light buffer `lights` (its bytes) naming the pass's light and rows; a pass the
-    /// loop budget cuts short is split in two and drawn again (a single row cut short refuses the image), one with a
-    /// row meeting more triangles than a fragment keeps refuses it. The fractions' buffer, a layer a slot up to the
-    /// last of `slots` (−1 in the others), and the time spent making the passes' pipelines.
+    /// One frame's draws, with the light buffer `lights` and the passes' fractions (binding 13; the unused one
+    /// where `None`): the shadow maps' depth passes (`draws`' maps, where the technique is `map`), then the scene
+    /// pass; submitted and waited for.
+    fn draw_frame(
+        &mut self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        lights: &Buffer,
+        fractions: Option<&Buffer>,
+        draws: &FrameDraws,
+    ) -> Result<(), GpuError> {
+        // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
+        // for), so the descriptor set may be updated and the command buffer re-recorded.
+        unsafe {
+            self.write_descriptors(scene, lights, fractions.unwrap_or(&self.no_light_fractions));
+            let cb = self.commands.begin(&self.dev)?;
+            if let Some(to_map) = draws.sun_map {
+                self.record_depth_pass(cb, scene, settings, &self.sun_map, to_map, draws.map_pipelines);
+            }
+            for (map, to_map) in self.disk_maps.iter().zip(&draws.disk_maps).filter_map(|(m, f)| Some((m, (*f)?))) {
+                self.record_depth_pass(cb, scene, settings, map, to_map, draws.map_pipelines);
+            }
+            self.record_scene_pass(cb, scene, settings, draws.draw_pipelines);
+            self.commands.submit_and_wait(&self.dev, cb)?;
+        }
+        Ok(())
+    }
+
+    /// The visible fractions at every pixel of the lights `slots` (`ROWS_OF_*`) that `passed` does not hold yet,
+    /// by their slices, taken in passes before the frame (`slice_passes`) and added to `passed`: each pass draws the
+    /// scene with `variants` turned to `QUANTITY_LIGHT_ROWS` and the light buffer `lights` (its bytes) naming the
+    /// pass's light and rows; a pass the loop budget cuts short is split in two and drawn again (a single row cut
+    /// short refuses the image), one with a row meeting more triangles than a fragment keeps refuses it. The time
+    /// spent making the passes' pipelines.
     fn light_fractions(
         &mut self,
         scene: &GpuScene,
@@ -680,7 +708,12 @@ impl Renderer {
         lights: &[u8],
         variants: &[ShaderVariant],
         slots: &[u32],
-    ) -> Result<(Buffer, Duration), GpuError> {
+        passed: &mut slice_passes::PassedFractions,
+    ) -> Result<Duration, GpuError> {
+        let slots: Vec<u32> = slots.iter().copied().filter(|&s| !passed.has(s)).collect();
+        if slots.is_empty() {
+            return Ok(Duration::ZERO);
+        }
         let t = Instant::now();
         // A pass's fragment reads neither its draw's BRDF nor its light models, only its surface (alpha masks,
         // normal maps): materials that differ in those alone share a pass's pipeline (room.gltf's five, one).
@@ -698,9 +731,7 @@ impl Renderer {
         let made = t.elapsed();
         let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
         let pixels = (settings.width * settings.height) as usize;
-        let layers = slots.iter().max().map_or(0, |&s| s as usize + 1);
-        let mut fractions = vec![-1.0f32; pixels * layers];
-        for &slot in slots {
+        for slot in slots {
             let mut passes: std::collections::VecDeque<_> = slice_passes::first_passes(rows).into();
             let mut sums = slice_passes::RowSums::new(pixels);
             while let Some((first, count)) = passes.pop_front() {
@@ -730,11 +761,9 @@ impl Renderer {
                     }
                 }
             }
-            let at = slot as usize * pixels;
-            fractions[at..at + pixels].copy_from_slice(&sums.fractions());
+            passed.insert(slot, sums.fractions());
         }
-        let fractions = Buffer::storage(&self.dev, bytemuck::cast_slice(&fractions), "light fractions")?;
-        Ok((fractions, made))
+        Ok(made)
     }
 
     /// The colour and depth targets and the readback buffer, (re)made for this size.

@@ -158,6 +158,41 @@ impl RowSums {
     }
 }
 
+/// The lights' fractions the passes have left, one layer a light slot (`ROWS_OF_*`), on the host: a frame drawn
+/// again after its loop budget ran out passes more lights without drawing the earlier ones' passes again.
+pub struct PassedFractions {
+    pixels: usize,
+    layers: Vec<(u32, Vec<f32>)>,
+}
+
+impl PassedFractions {
+    pub fn new(pixels: usize) -> Self {
+        Self { pixels, layers: Vec::new() }
+    }
+
+    /// Whether light `slot`'s fractions are here.
+    pub fn has(&self, slot: u32) -> bool {
+        self.layers.iter().any(|(s, _)| *s == slot)
+    }
+
+    /// Light `slot`'s fractions, one a pixel ([`RowSums::fractions`]).
+    pub fn insert(&mut self, slot: u32, fractions: Vec<f32>) {
+        debug_assert_eq!(fractions.len(), self.pixels);
+        self.layers.push((slot, fractions));
+    }
+
+    /// Binding 13's contents: a layer a slot up to the last held, −1 in the slots not held; `None` where none is.
+    pub fn layered(&self) -> Option<Vec<f32>> {
+        let count = self.layers.iter().map(|(s, _)| *s as usize + 1).max()?;
+        let mut out = vec![-1.0; count * self.pixels];
+        for (slot, layer) in &self.layers {
+            let at = *slot as usize * self.pixels;
+            out[at..at + self.pixels].copy_from_slice(layer);
+        }
+        Some(out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +228,16 @@ mod tests {
         assert_eq!(passed_lights(0), None);
         assert_eq!(passed_lights(READ_SKY | READ_DISKS).as_deref(), Some("the sky, disk lights"));
         assert_eq!(light_name(ROWS_OF_DISK + 1), "disk light 1");
+    }
+
+    #[test]
+    fn passed_fractions_lay_each_light_in_its_slot() {
+        let mut f = PassedFractions::new(2);
+        assert_eq!(f.layered(), None);
+        f.insert(ROWS_OF_DISK, vec![0.5, 0.25]);
+        f.insert(ROWS_OF_SKY, vec![1.0, 0.75]);
+        assert!(f.has(ROWS_OF_SKY) && f.has(ROWS_OF_DISK) && !f.has(ROWS_OF_SUN));
+        assert_eq!(f.layered(), Some(vec![1.0, 0.75, -1.0, -1.0, 0.5, 0.25]));
     }
 
     #[test]
