@@ -275,8 +275,10 @@ pub struct SceneArgs {
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
     /// penumbra, the lights' located edges at second; 2 on the reference where every light is taken by slices
     /// and every material the meshes use is Lambertian). Light of the sky through occluders is then estimated
-    /// instead of refused. Costly, and refused where the ladder cannot reach T: in the dark end of a penumbra the
-    /// visible fraction must be right to T/100 of the peak (the diff's floor).
+    /// instead of refused. Where `render` takes every light by slices (its default here: shadow rays, no alpha
+    /// masks), the study runs on the reference and the GPU renders once, its distance from the reference's image
+    /// measured and added to the prediction. Costly, and refused where the ladder cannot reach T: in the dark end
+    /// of a penumbra the visible fraction must be right to T/100 of the peak (the diff's floor).
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
     pub tolerance_in_penumbrae: bool,
 
