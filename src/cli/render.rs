@@ -234,7 +234,6 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     };
     let frame = spent;
     warn_if_nothing_covered(&image, &a.scene.scene);
-    let reference = reference_image;
     Ok(Rendered {
         image,
         settings,
@@ -245,7 +244,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         upload,
         scene,
         renderer,
-        reference,
+        reference: reference_image,
     })
 }
 
@@ -259,7 +258,8 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 /// lavapipe (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27²,
 /// its order capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame
 /// runs out of the loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the
-/// shadows asked for, and whether the scene can shadow itself.
+/// shadows asked for, and whether the scene can shadow itself. The GPU's image, its prediction, and the
+/// reference's image it was measured against.
 fn studied_on_the_reference(
     scene: &crate::scene::Scene,
     settings: &mut RenderSettings,
