@@ -910,12 +910,8 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
 #[test]
 fn render_tolerance_meets_it_on_the_sky_through_occluders() {
     let dir = common::TempDir::new("tolerance-sky");
-    let scene = common::load(std::path::Path::new("models/overcast.glb"));
-    let mut s = settings::resolve(&scene, 32, 24, &CameraOptions::default(), &SunOptions::default()).unwrap();
-    s.shading.shadows = Shadows::Ray;
-    s.shading.visibility_rule = VisibilityRule::Slices;
     // The truth's ladder from 7² shares no rung with `--tolerance`'s (from 6²: 9, 13, 19, 27, ...).
-    s.shading.shadow_samples_per_axis = 7;
+    let (scene, s) = common::sliced("overcast.glb", (32, 24), 7);
     let truth = render_converged(
         &scene,
         &s,
@@ -961,14 +957,10 @@ fn render_tolerance_meets_it_on_the_sky_through_occluders() {
 #[test]
 fn render_tolerance_in_penumbrae_meets_it_there() {
     let dir = common::TempDir::new("tolerance-penumbrae");
-    let scene = common::load(std::path::Path::new("models/sunset.glb"));
-    let mut s = settings::resolve(&scene, 48, 36, &CameraOptions::default(), &SunOptions::default()).unwrap();
-    s.shading.shadows = Shadows::Ray;
+    let (scene, mut s) = common::sliced("sunset.glb", (48, 36), 64);
     s.shading.sun = sunshade::shading::SunModel::Disk;
     s.shading.samples_per_axis = 181;
     s.shading.sun_samples_per_axis = 181;
-    s.shading.shadow_samples_per_axis = 64;
-    s.shading.visibility_rule = VisibilityRule::Slices;
     for t in [1e-2, 1e-3, 1e-4] {
         let out = dir.path(&format!("sunset-{t:e}.exr"));
         let flags = format!("models/sunset.glb --width 48 --height 36 --tolerance {t:e} --tolerance-in-penumbrae -v");
@@ -992,11 +984,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     // the skylight ran past the loop budget at the penumbra's pixels); the disk's rows are now taken in passes where
     // the frame runs out (gpu::slice_passes). Measured at 64² against `reference --converged`: 1e-2 5.6e-4, 1e-3
     // 1.0e-4 (docs/accuracy.md); here 1e-2 at 32², against the reference with 64² shadow samples by slices.
-    let scene = common::load(std::path::Path::new("models/room.gltf"));
-    let mut s = settings::resolve(&scene, 32, 32, &CameraOptions::default(), &SunOptions::default()).unwrap();
-    s.shading.shadows = Shadows::Ray;
-    s.shading.shadow_samples_per_axis = 64;
-    s.shading.visibility_rule = VisibilityRule::Slices;
+    let (scene, s) = common::sliced("room.gltf", (32, 32), 64);
     let out = dir.path("room.exr");
     let flags = "models/room.gltf --width 32 --height 32 --tolerance 1e-2 --tolerance-in-penumbrae -v";
     if let Some(e) = render_with_tolerance(flags, &out) {
@@ -1007,13 +995,9 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     }
     // cube.glb at 64²: its contact shadows put pixels a centimetre from the cube, where f32 corners leave the GPU's
     // slices 1.5e-4 from the reference's: T = 1e-4 is refused for it, by name, or met.
-    let scene = common::load(std::path::Path::new("models/cube.glb"));
-    let mut s = settings::resolve(&scene, 64, 64, &CameraOptions::default(), &SunOptions::default()).unwrap();
-    s.shading.shadows = Shadows::Ray;
+    let (scene, mut s) = common::sliced("cube.glb", (64, 64), 64);
     s.shading.samples_per_axis = 181;
     s.shading.sun_samples_per_axis = 181;
-    s.shading.shadow_samples_per_axis = 64;
-    s.shading.visibility_rule = VisibilityRule::Slices;
     let out = dir.path("cube.exr");
     let o = render_to("models/cube.glb --width 64 --height 64 --tolerance 1e-4 --tolerance-in-penumbrae -v", &out);
     let e = String::from_utf8_lossy(&o.stderr);

@@ -1016,24 +1016,6 @@ fn specular_lobes_in_the_suns_penumbra_meet_their_quadrature() {
     assert!(report.pass, "{}", report.text("gpu", "reference"));
 }
 
-/// The model `models/{model}` at `width` × `height`, shadowed by rays whose visible fractions are taken by slices:
-/// `4k²` rows a light for `k²` shadow rays.
-fn sliced(model: &str, (width, height): (u32, u32), k: u32) -> (Scene, RenderSettings) {
-    let scene = common::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(model));
-    let mut s = sunshade::settings::resolve(
-        &scene,
-        width,
-        height,
-        &Default::default(),
-        &sunshade::settings::SunOptions::default(),
-    )
-    .unwrap();
-    s.shading.shadows = Shadows::Ray;
-    s.shading.shadow_samples_per_axis = k;
-    s.shading.visibility_rule = VisibilityRule::Slices;
-    (scene, s)
-}
-
 /// The GPU's slices at `s` (k² shadow rays, slices) against the reference's at the same settings, and the GPU's
 /// slices and grid against the reference's slices at k = 16 (the shadows' truth: everything else is the same):
 /// `(apart, slices' error, grid's error)`, max relative.
@@ -1062,7 +1044,7 @@ fn gpu_sun_slices_agree_with_the_reference_and_beat_the_grid() {
     // slices err 5.7e-5, the grid 1.6e-2; on Mesa 25 with ray queries (the slices walk the BVH there too), 8.3e-7
     // apart. (shaders/slices.glsl.)
     let mut gpu = CheckedRenderer::new();
-    let (scene, s) = sliced("sunset.glb", (64, 48), 4);
+    let (scene, s) = common::sliced("sunset.glb", (64, 48), 4);
     let (apart, sliced_error, grid_error) = slices_against_the_reference_and_the_grid(&mut gpu, &scene, &s);
     eprintln!("GPU slices vs reference {apart:.1e}; against k = 16: slices {sliced_error:.1e}, grid {grid_error:.1e}");
     assert!(apart <= 1e-5, "the GPU's slices {apart:e} from the reference's");
@@ -1081,7 +1063,7 @@ fn gpu_sky_slices_in_passes_agree_with_the_reference_and_beat_the_grid() {
     // k = 16 the slices err 7.3e-3, the grid 0.54. With the sun too (its slices in the frame, the sky's before it),
     // the same.
     let mut gpu = CheckedRenderer::new();
-    let (scene, mut s) = sliced("overcast.glb", (32, 24), 4);
+    let (scene, mut s) = common::sliced("overcast.glb", (32, 24), 4);
     assert!(s.lights.sky.is_some());
     let (apart, sliced_error, grid_error) = slices_against_the_reference_and_the_grid(&mut gpu, &scene, &s);
     eprintln!(
@@ -1113,7 +1095,7 @@ fn gpu_disk_slices_agree_with_the_reference() {
     // there gathers hundreds of the sphere's triangles under the skylight's wide cone (measured 3.6e-6 and 3.9e-6
     // apart). A light cone holding more than the slices keep refuses the image (gpu::slice_gather).
     let mut gpu = CheckedRenderer::new();
-    let (scene, mut s) = sliced("room.gltf", (64, 48), 4);
+    let (scene, mut s) = common::sliced("room.gltf", (64, 48), 4);
     assert!(!s.lights.disks.is_empty() && s.lights.sky.is_none());
     for k in [4, 6] {
         s.shading.shadow_samples_per_axis = k;

@@ -165,3 +165,21 @@ pub fn error_against_fine(
     let line = stderr.lines().find(|l| l.contains("predicted max relative error")).unwrap_or_default();
     (measured, line.to_string())
 }
+
+/// The model `models/{model}` at `width` × `height` (the default camera and sun), shadowed by rays whose visible
+/// fractions are taken by slices: `4k²` rows a light for `k²` shadow rays.
+pub fn sliced(model: &str, (width, height): (u32, u32), k: u32) -> (Scene, sunshade::settings::RenderSettings) {
+    let scene = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(model));
+    let mut s = sunshade::settings::resolve(
+        &scene,
+        width,
+        height,
+        &Default::default(),
+        &sunshade::settings::SunOptions::default(),
+    )
+    .unwrap();
+    s.shading.shadows = sunshade::shading::Shadows::Ray;
+    s.shading.shadow_samples_per_axis = k;
+    s.shading.visibility_rule = sunshade::shading::VisibilityRule::Slices;
+    (scene, s)
+}
