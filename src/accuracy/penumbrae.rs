@@ -1,6 +1,6 @@
 //! Where an image's shadows are soft: the pixels in a penumbra, as the reference's shadow rays see it.
 //!
-//! `--tolerance` without `--tolerance-in-penumbrae` promises its T outside the penumbrae (where a light is partly
+//! `--tolerance` with `--tolerance-outside-penumbrae` promises its T outside the penumbrae (where a light is partly
 //! hidden, its visible fraction is a grid's count and has no bound), so a measurement of that promise needs those
 //! pixels named. A pixel is in a penumbra where some light is neither wholly visible nor wholly hidden from
 //! it; there, and only there, the light's visible fraction from one ray to its centre (a hard shadow: 0 or 1)

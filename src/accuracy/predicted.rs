@@ -4,8 +4,8 @@
 //! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
 //! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
 //! than bounded, where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular
-//! surfaces, a measured material's grids, the sun's included, and with `--tolerance-in-penumbrae` in a scene that
-//! shadows itself every grid with the shadow rays' ([`super::refinement`]). What is not, and is named in
+//! surfaces, a measured material's grids, the sun's included, and where it holds in penumbrae (`--tolerance`'s
+//! default, not `--tolerance-outside-penumbrae`) in a scene that shadows itself every grid with the shadow rays' ([`super::refinement`]). What is not, and is named in
 //! [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on Lambertian
 //! surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is unbounded),
 //! penumbrae without that study, shadow maps, the device's interpolation (f32 barycentrics are bounded where
@@ -130,7 +130,7 @@ pub fn sun_needs_study(scene: &Scene, settings: &RenderSettings) -> bool {
     settings.lights.sun.is_some() && has_measured(scene)
 }
 
-/// Whether `--tolerance-in-penumbrae` must estimate the visible fractions' shadow-ray grids by refinement (and so
+/// Whether `--tolerance` held in penumbrae (its default) must estimate the visible fractions' shadow-ray grids by refinement (and so
 /// every grid with them, [`super::trial`]): the scene can shadow itself (`can_occlude`, shadows asked for) and
 /// casts shadow rays, whose grids have no derived bound in a penumbra (an occluder's edge across a light: the
 /// share of the cells it cuts, [`super::refinement`]).
@@ -391,7 +391,7 @@ fn occlusion_and_arithmetic(
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
             _ => p
                 .unbounded
-                .push("penumbrae (the shadow rays' visible fractions: --tolerance-in-penumbrae estimates them)".into()),
+                .push("penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae estimates them)".into()),
         }
     }
     if let Renderer::Gpu { barycentrics } = renderer {
@@ -494,8 +494,8 @@ pub fn choose_for_tolerance_with_peak(
 
 /// What `--tolerance` refuses whatever the materials, or the settings with the disk lights' exact model (on
 /// Lambertian surfaces the closed form, no error; the small-source estimate has no bound): the light of the sky
-/// through occluders unless the shadow rays' grids are estimated by refinement (`shadow_grids`:
-/// `--tolerance-in-penumbrae`, [`penumbrae_need_study`]), the device's interpolation, shadows other than rays
+/// through occluders unless the shadow rays' grids are estimated by refinement (`shadow_grids`: the
+/// promise held in penumbrae, [`penumbrae_need_study`]), the device's interpolation, shadows other than rays
 /// where the scene can shadow itself.
 ///
 /// The light of the sun and of disk lights through occluders is held outside their penumbrae, where a light's
@@ -515,9 +515,9 @@ pub(crate) fn techniques_within(
         return Err(format!(
             "--tolerance {tolerance:e}: the scene can shadow itself, and the sky's penumbra is every point that sees \
              an occluder above its horizon (nearly the whole image), where its visible fraction has no bound (a \
-             shadow-ray grid errs by the share of its cells an occluder's edge crosses): --tolerance-in-penumbrae \
-             estimates it by refinement (costly: it converges at first order), --shadows none bounds the render \
-             against the unshadowed truth{}",
+             shadow-ray grid errs by the share of its cells an occluder's edge crosses): --tolerance without \
+             --tolerance-outside-penumbrae estimates it by refinement (costly: it converges at first order), \
+             --shadows none bounds the render against the unshadowed truth{}",
             match renderer {
                 Renderer::Gpu { .. } => {
                     "; `sunshade reference` with the same scene flags studies it on the CPU instead, by slices (second \

@@ -13,7 +13,7 @@
 //! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
 //! only by their lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has
 //! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
-//! With `--tolerance-in-penumbrae` in a scene that shadows itself (shadow rays), every grid is refined on the
+//! Where `--tolerance` holds in penumbrae (its default; not `--tolerance-outside-penumbrae`) in a scene that shadows itself (shadow rays), every grid is refined on the
 //! rungs, the visible fractions' shadow-ray grids too (`shadow_grid`): the penumbrae (below).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of

@@ -34,7 +34,7 @@ pub struct WithinTolerance<T> {
 }
 
 /// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it
-/// holds in penumbrae too (`--tolerance-in-penumbrae`). Without that, the promise holds outside the penumbrae of
+/// holds in penumbrae too (`--tolerance`'s default since 2026-12-05). Without that (`--tolerance-outside-penumbrae`), the promise holds outside the penumbrae of
 /// the sun and of disk lights (where a light is partly hidden), which the prediction names as not bounded
 /// (`super::penumbrae` finds them to measure it), and the sky through occluders is refused (its penumbra is every
 /// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are
@@ -47,12 +47,12 @@ pub struct Tolerance {
 }
 
 impl Tolerance {
-    /// The promise outside the penumbrae (`--tolerance` alone).
+    /// The promise outside the penumbrae (`--tolerance-outside-penumbrae`).
     pub fn outside_penumbrae(max_relative: f64) -> Self {
         Self { max_relative, in_penumbrae: false }
     }
 
-    /// The promise in penumbrae too (`--tolerance-in-penumbrae`).
+    /// The promise in penumbrae too (`--tolerance`'s default).
     pub fn everywhere(max_relative: f64) -> Self {
         Self { max_relative, in_penumbrae: true }
     }
@@ -258,7 +258,7 @@ fn lobe_study<T, E>(
 ///
 /// Where the reference takes the sky through occluders by slices ([`sky_by_slices`]) the promise holds in
 /// penumbrae too, asked or not: the sky's penumbra is nearly the whole image (the reason the grid is refused
-/// without `--tolerance-in-penumbrae`), and the slices converge there at the second order, so the study that
+/// with `--tolerance-outside-penumbrae`), and the slices converge there at the second order, so the study that
 /// estimates it keeps 9², 19² and 39² on overcast.glb at 48 × 36 for 1e-2, 1e-3 and 1e-4 where the grid took
 /// 56² for 1e-2 (docs/accuracy.md, "The converged reference").
 pub fn reference_within_tolerance(

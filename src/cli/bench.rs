@@ -91,8 +91,9 @@ pub struct BenchArgs {
     /// into this PNG, one chart per scene.
     #[arg(long, value_name = "PNG", requires = "pareto")]
     pub plot: Option<PathBuf>,
-    /// With --pareto: its `--tolerance` table holds each T in the sun's penumbrae too, as `render --tolerance T
-    /// --tolerance-in-penumbrae` does (the shadow rays' grids join the study; costly), instead of outside them.
+    /// With --pareto: its `--tolerance` table holds each T in the penumbrae too, as `render --tolerance T` does by
+    /// default (the shadow rays' grids join the study; costly), instead of outside them, as `render --tolerance T
+    /// --tolerance-outside-penumbrae` does (the sweep's default: its two minutes a scene).
     #[arg(long, requires = "pareto")]
     pub tolerance_in_penumbrae: bool,
     /// With --pareto: the accuracy the converged reference claims (relative).

@@ -1,7 +1,8 @@
 //! `bench --pareto`'s `--tolerance` table: for each scene and T = 1e-2, 1e-3, 1e-4, the models `render --tolerance
-//! T` chose, what its renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid
+//! T --tolerance-outside-penumbrae` chose (with `bench --tolerance-in-penumbrae`: `render --tolerance T`, which holds
+//! T in the penumbrae too; costlier, so not the sweep's default, whose two minutes a scene it would break), what its renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid
 //! study's rungs, the image kept), and the kept image's error against a converged reference, over every pixel and
-//! outside the penumbrae (what `--tolerance` promises without `--tolerance-in-penumbrae`); or why it refused.
+//! outside the penumbrae (what `--tolerance-outside-penumbrae` promises); or why it refused.
 //!
 //! On a device without ray queries, a scene that shadows itself gets its table at a smaller size ([`table_size`])
 //! against its own converged reference: its shadow rays walk the BVH in the fragment shader there, seconds a frame
@@ -156,7 +157,7 @@ fn refusal(settings: &RenderSettings, error: TrialError<GpuError>) -> Result<Str
     }
 }
 
-/// The Markdown table of one scene's rows (`in_penumbrae`: rendered with `--tolerance-in-penumbrae`; `smaller`: the
+/// The Markdown table of one scene's rows (`in_penumbrae`: the promise held in penumbrae too, `render`'s default; `smaller`: the
 /// table's size where it is not the sweep's, and how long its own truth took [s]).
 pub(super) fn tolerance_table(
     name: &str,
@@ -164,7 +165,11 @@ pub(super) fn tolerance_table(
     in_penumbrae: bool,
     smaller: Option<((u32, u32), f64)>,
 ) -> String {
-    let flags = if in_penumbrae { "render --tolerance T --tolerance-in-penumbrae" } else { "render --tolerance T" };
+    let flags = if in_penumbrae {
+        "render --tolerance T --tolerance-in-penumbrae"
+    } else {
+        "render --tolerance T --tolerance-outside-penumbrae"
+    };
     let truth = match smaller {
         Some(((w, h), seconds)) => format!(
             "at {w}×{h}, against the converged reference at that size ({seconds:.1} s): the device has no ray \
@@ -179,7 +184,7 @@ pub(super) fn tolerance_table(
     let mut out = format!(
         "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
          rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae (where a light \
-         is partly hidden{penumbrae}): what `--tolerance` promises without `--tolerance-in-penumbrae`; † where the \
+         is partly hidden{penumbrae}): what `--tolerance-outside-penumbrae` promises; † where the \
          prediction names part of the image as not bounded, the penumbrae):\n\n| T | models chosen | renders | GPU \
          time [ms] | max rel | max rel outside penumbrae | predicted |\n\
          |---:|---|---:|---:|---:|---:|---:|\n"

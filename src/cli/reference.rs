@@ -64,7 +64,7 @@ pub struct ReferenceCommand {
     /// the GPU casts, --shadow-samples) or `slices` (exact along one angle of the light, a midpoint rule of 4k²
     /// rows along the other, for k² = --shadow-samples: second order in the rows, where every occluder is opaque;
     /// the grid otherwise). Default: slices with --converged, and
-    /// with --tolerance where it holds in penumbrae (--tolerance-in-penumbrae, or a sky, whose penumbra is the
+    /// with --tolerance where it holds in penumbrae (--tolerance's default, or a sky, whose penumbra is the
     /// image): overcast.glb at 64² converges where the grid leaves 1938 of 2461 pixels moving, and --tolerance
     /// keeps 1e-2 there at 9², where the grid refused it or took 56² in penumbrae. The grid otherwise (what the
     /// GPU casts, so that `render --check` compares like with like).
@@ -98,7 +98,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     // sky's implies: `accuracy::trial::sky_by_slices`); the GPU's grid where it is to be compared with the GPU's,
     // and where the promise leaves the penumbrae out (the slices' walks would cost more for nothing promised:
     // sunset.glb at 256², `--tolerance 1e-2`, 1.5 s against 0.15 s).
-    let in_penumbrae = a.scene.tolerance.is_some() && (a.scene.tolerance_in_penumbrae || settings.lights.sky.is_some());
+    let in_penumbrae = a.scene.tolerance().is_some_and(|t| t.in_penumbrae || settings.lights.sky.is_some());
     settings.shading.visibility_rule = a.visibility_rule.unwrap_or(if a.converged || in_penumbrae {
         VisibilityRule::Slices
     } else {

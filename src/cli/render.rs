@@ -39,7 +39,7 @@ pub struct RenderArgs {
     /// opaque, as `sunshade reference --visibility slices` takes them; refused where a pixel's light cone holds more
     /// than 1024 triangles). On devices without ray queries, whose fragment shader walks the occluders' BVH;
     /// refused where the sky casts shadows (the reference slices it). Default: slices with
-    /// --tolerance-in-penumbrae where those hold (their f32 geometry then measured against the reference's), else
+    /// --tolerance in penumbrae (its default) where those hold (their f32 geometry then measured against the reference's), else
     /// the grid.
     #[arg(long = "visibility", value_name = "grid|slices", help_heading = "Shadows")]
     pub visibility_rule: Option<crate::shading::VisibilityRule>,
@@ -178,7 +178,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     };
     let tolerance = a.scene.tolerance();
     // Where the GPU slices the lights in their penumbrae (the sky through occluders, whose penumbra is the image,
-    // or every light with `--tolerance-in-penumbrae`), the grids are studied on the reference, whose promise then
+    // or every light where the tolerance holds in penumbrae, its default), the grids are studied on the reference, whose promise then
     // holds in penumbrae too (`studied_on_the_reference`).
     let can_occlude = gpu_scene.can_occlude();
     let study_on_the_reference = crate::accuracy::trial::sky_by_slices(scene_data, &settings, can_occlude)
@@ -249,7 +249,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 }
 
 /// `--tolerance` where the GPU slices the lights in their penumbrae (the sky through occluders, or every light with
-/// `--tolerance-in-penumbrae`): the grids are studied on the reference, the same rule in f64
+/// the promise held in penumbrae, `--tolerance`'s default): the grids are studied on the reference, the same rule in f64
 /// (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the promise there
 /// holds in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
 /// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and
@@ -340,7 +340,7 @@ fn slices_measured_against_the_reference(
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
-/// (`--tolerance-in-penumbrae`, or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
+/// (its default, not `--tolerance-outside-penumbrae`; or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
 /// alpha-masked occluders, and shadow rays: `auto` or `ray`, not where `auto` found nothing to shadow), as the
 /// reference defaults to them there; the grid otherwise.
 fn default_visibility(
