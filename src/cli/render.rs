@@ -198,9 +198,15 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         // A render the device cannot run (`settings` holds its grids, the finest of any material's): the models
         // chosen, or a grid the study went on to; no setting it can render meets the tolerance.
         (crate::gpu::GpuError::LoopBudget(why), Some(t)) => CliError::Usage(format!(
-            "--tolerance {:e}: {}; `sunshade reference` with the same scene flags has no such limit",
+            "--tolerance {:e}: {}; `sunshade reference` with the same scene flags has no such limit{}",
             t.max_relative,
-            beyond_this_device(settings, &why)
+            beyond_this_device(settings, &why),
+            if t.in_penumbrae {
+                ", and --tolerance-outside-penumbrae holds T outside the penumbrae of the sun and of disk lights \
+                 only (their shadow rays' grids then stay off the study's ladder)"
+            } else {
+                ""
+            }
         )),
         (e, _) => CliError::from(e),
     };
