@@ -228,10 +228,10 @@ fn a_scene_without_sampled_integrals_converges_at_once_and_exactly() {
     assert_eq!(common::bits(&c.image), common::bits(&cpu::render(&scene, &s, &reference)));
 }
 
-/// The sun's bounds (`accuracy::bounds`) against measurement: chart materials from the broadest to the sharpest
-/// lobes under a 0.53° and a 5° sun from three directions, the reference with the delta sun and with k × k grids
-/// against the reference with a fine grid (64², itself checked against 90²). The measured max relative error (diff floor) must stay under the bound,
-/// and the bound must not be vacuous where it claims something.
+/// The sun's bounds (`accuracy::bounds`) against measurement: chart materials from the broadest to the sharpest lobes
+/// under a 0.53° and a 5° sun from three directions, the reference with the delta sun and with k × k grids against the
+/// reference with a fine grid (64², itself checked against 90²). The measured max relative error (diff floor) must stay
+/// under the bound, and the bound must not be vacuous where it claims something.
 #[test]
 fn the_suns_error_bounds_hold_against_measurement() {
     use sunshade::accuracy::bounds::{
@@ -865,11 +865,11 @@ fn f32_interpolation_stays_within_its_bound_on_the_gpu() {
 
 /// `render --tolerance --tolerance-outside-penumbrae` on scenes that shadow themselves, on any device: `auto` casts
 /// shadow rays (without ray queries, the fragment shader's walk of the BVH) instead of shadow maps, which have no
-/// bound, and the image meets T against the converged reference with shadow rays outside the penumbrae (and the
-/// truth's unconverged pixels), which `-v` names as not bounded (the promise `--tolerance` made alone before
-/// 2026-12-05; it holds in the penumbrae too since: `render_tolerance_in_penumbrae_meets_it_there`): under the sun (teapot.glb, sunset.glb) and a disk skylight (room.gltf, whose
-/// light through occluders was refused before 2026-12-03). The sky through occluders (overcast.glb):
-/// `render_tolerance_meets_it_on_the_sky_through_occluders`.
+/// bound, and the image meets T against the converged reference with shadow rays outside the penumbrae (and the truth's
+/// unconverged pixels), which `-v` names as not bounded (the promise `--tolerance` made alone before 2026-12-05; it
+/// holds in the penumbrae too since: `render_tolerance_in_penumbrae_meets_it_there`): under the sun (teapot.glb,
+/// sunset.glb) and a disk skylight (room.gltf, whose light through occluders was refused before 2026-12-03). The sky
+/// through occluders (overcast.glb): `render_tolerance_meets_it_on_the_sky_through_occluders`.
 #[test]
 fn render_tolerance_casts_shadow_rays_on_any_device() {
     let dir = common::TempDir::new("tolerance-shadows");

@@ -1,17 +1,17 @@
 //! The predicted error of a render, from the bounds of its models ([`super::bounds`]), and `--tolerance`: for each
 //! material, the cheapest sun model whose bound for its lobe meets a tolerance ([`Choice`]).
 //!
-//! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the
-//! sharpest lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather
-//! than bounded, where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular
-//! surfaces, a measured material's grids, the sun's included, and where it holds in penumbrae (`--tolerance`'s
-//! default, not `--tolerance-outside-penumbrae`) in a scene that shadows itself every grid with the shadow rays' ([`super::refinement`]). What is not, and is named in
-//! [`Prediction::unbounded`] instead of being silently left out: those grids without the study (on Lambertian
-//! surfaces the closed forms of disk lights and the sky are exact; the small-source estimate is unbounded),
-//! penumbrae without that study, shadow maps, the device's interpolation (f32 barycentrics are bounded where
-//! `--tolerance` computes it: `super::interpolation`), and shadows turned off in a scene that can shadow itself
-//! (there the error is up to 100%). An irradiance image has no lobes: its lights'
-//! closed forms are exact (`predict_irradiance`).
+//! What is bounded so far: the sun (delta or disk, its grid) over every analytic material of the scene, the sharpest
+//! lobe a material can show (`bounds::sharpest_brdf`), and the GPU's f32 arithmetic. Estimated rather than bounded,
+//! where `--tolerance` made the study: the lobe grids of disk lights and the sky on specular surfaces, a measured
+//! material's grids, the sun's included, and where it holds in penumbrae (`--tolerance`'s default, not
+//! `--tolerance-outside-penumbrae`) in a scene that shadows itself every grid with the shadow rays'
+//! ([`super::refinement`]). What is not, and is named in [`Prediction::unbounded`] instead of being silently left out:
+//! those grids without the study (on Lambertian surfaces the closed forms of disk lights and the sky are exact; the
+//! small-source estimate is unbounded), penumbrae without that study, shadow maps, the device's interpolation (f32
+//! barycentrics are bounded where `--tolerance` computes it: `super::interpolation`), and shadows turned off in a scene
+//! that can shadow itself (there the error is up to 100%). An irradiance image has no lobes: its lights' closed forms
+//! are exact (`predict_irradiance`).
 
 use crate::scene::{Brdf, Scene};
 use crate::settings::RenderSettings;
@@ -130,10 +130,10 @@ pub fn sun_needs_study(scene: &Scene, settings: &RenderSettings) -> bool {
     settings.lights.sun.is_some() && has_measured(scene)
 }
 
-/// Whether `--tolerance` held in penumbrae (its default) must estimate the visible fractions' shadow-ray grids by refinement (and so
-/// every grid with them, [`super::trial`]): the scene can shadow itself (`can_occlude`, shadows asked for) and
-/// casts shadow rays, whose grids have no derived bound in a penumbra (an occluder's edge across a light: the
-/// share of the cells it cuts, [`super::refinement`]).
+/// Whether `--tolerance` held in penumbrae (its default) must estimate the visible fractions' shadow-ray grids by
+/// refinement (and so every grid with them, [`super::trial`]): the scene can shadow itself (`can_occlude`, shadows
+/// asked for) and casts shadow rays, whose grids have no derived bound in a penumbra (an occluder's edge across a
+/// light: the share of the cells it cuts, [`super::refinement`]).
 pub fn penumbrae_need_study(settings: &RenderSettings, can_occlude: bool) -> bool {
     let lights = &settings.lights;
     let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();

@@ -9,12 +9,12 @@
 //! Roache, P. J. (1994), "Perspective: A Method for Uniform Reporting of Grid Refinement Studies",
 //! J. Fluids Eng. 116(3), 405–413 (the GCI with its factor of safety 1.25 for three grids and an observed order).
 //!
-//! **Ladder**: `k₀ = 4`, `kᵢ₊₁ = ⌈√2 kᵢ⌉` per axis (the samples at least doubled, as the converged reference
-//! refines), to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ
-//! only by their lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has
-//! no derived curvature for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`).
-//! Where `--tolerance` holds in penumbrae (its default; not `--tolerance-outside-penumbrae`) in a scene that shadows itself (shadow rays), every grid is refined on the
-//! rungs, the visible fractions' shadow-ray grids too (`shadow_grid`): the penumbrae (below).
+//! **Ladder**: `k₀ = 4`, `kᵢ₊₁ = ⌈√2 kᵢ⌉` per axis (the samples at least doubled, as the converged reference refines),
+//! to [`MAX_LOBE_GRID`]; everything else (sun model and grid, shadows) fixed, so that the images differ only by their
+//! lobe grids (and rounding). Where a measured material is under the sun, its table's lookup has no derived curvature
+//! for the sun's bound, and the sun's grid is refined on the same rungs (`sun_grid`). Where `--tolerance` holds in
+//! penumbrae (its default; not `--tolerance-outside-penumbrae`) in a scene that shadows itself (shadow rays), every
+//! grid is refined on the rungs, the visible fractions' shadow-ray grids too (`shadow_grid`): the penumbrae (below).
 //!
 //! **Model**: in its asymptotic range a grid of `k` per axis errs at a pixel by `e(k) = C k^−p`. The difference of
 //! consecutive images, `dᵢ` (max over pixels, relative with the diff's floor, less the two renders' rounding,

@@ -1,14 +1,14 @@
-//! `--tolerance` with the delta sun's trial, for any renderer: where only the delta sun's horizon term keeps it
-//! from meeting the tolerance against the floor-based bound (`predicted::delta_worth_trying`), the delta sun is
-//! rendered first, the horizon term taken against that image's peak (`bounds::peak_lower_bound`), and the image
-//! kept when the delta sun then meets the tolerance; otherwise the choice falls back to the disk sun's grid and the
-//! trial's time is the price of asking. Where grids have no derived bound (the lobe grids of specular surfaces
-//! under disk lights or the sky; the sun's grid on measured materials), the image is rendered on a ladder of grids
-//! instead and the finest one's error estimated by refinement ([`super::refinement`]; a ladder per material where
-//! several specular materials share the image, [`super::material_study`]). The sun's models are chosen material
-//! by material (`predicted::choose_sun_within`). The reference (`reference_within_tolerance`) and `sunshade render` (the GPU, `cli::render`) both go through
-//! [`render_within_tolerance`]; every render it makes is the caller's `render`, so a caller that sums their times
-//! has the cost of asking.
+//! `--tolerance` with the delta sun's trial, for any renderer: where only the delta sun's horizon term keeps it from
+//! meeting the tolerance against the floor-based bound (`predicted::delta_worth_trying`), the delta sun is rendered
+//! first, the horizon term taken against that image's peak (`bounds::peak_lower_bound`), and the image kept when the
+//! delta sun then meets the tolerance; otherwise the choice falls back to the disk sun's grid and the trial's time is
+//! the price of asking. Where grids have no derived bound (the lobe grids of specular surfaces under disk lights or the
+//! sky; the sun's grid on measured materials), the image is rendered on a ladder of grids instead and the finest one's
+//! error estimated by refinement ([`super::refinement`]; a ladder per material where several specular materials share
+//! the image, [`super::material_study`]). The sun's models are chosen material by material
+//! (`predicted::choose_sun_within`). The reference (`reference_within_tolerance`) and `sunshade render` (the GPU,
+//! `cli::render`) both go through [`render_within_tolerance`]; every render it makes is the caller's `render`, so a
+//! caller that sums their times has the cost of asking.
 
 use std::convert::Infallible;
 
@@ -33,13 +33,13 @@ pub struct WithinTolerance<T> {
     pub prediction: Prediction,
 }
 
-/// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it
-/// holds in penumbrae too (`--tolerance`'s default since 2026-12-05). Without that (`--tolerance-outside-penumbrae`), the promise holds outside the penumbrae of
-/// the sun and of disk lights (where a light is partly hidden), which the prediction names as not bounded
-/// (`super::penumbrae` finds them to measure it), and the sky through occluders is refused (its penumbra is every
-/// point that sees an occluder above its horizon: nearly the whole image); with it, the shadow rays' grids are
-/// refined by the study with every other grid (`lobe_study`), whose first-order convergence in penumbrae
-/// (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
+/// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it holds in
+/// penumbrae too (`--tolerance`'s default since 2026-12-05). Without that (`--tolerance-outside-penumbrae`), the
+/// promise holds outside the penumbrae of the sun and of disk lights (where a light is partly hidden), which the
+/// prediction names as not bounded (`super::penumbrae` finds them to measure it), and the sky through occluders is
+/// refused (its penumbra is every point that sees an occluder above its horizon: nearly the whole image); with it, the
+/// shadow rays' grids are refined by the study with every other grid (`lobe_study`), whose first-order convergence in
+/// penumbrae (`super::refinement`) makes it costly and refuses what the ladder's finest grid cannot reach.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     pub max_relative: f64,
@@ -157,17 +157,17 @@ fn models_within<T, E>(
 pub const SUN_SHARES: [f64; 3] = [0.25, 0.5, 0.75];
 
 /// `--tolerance` where specular surfaces are lit by disk lights or the sky, a measured material by the sun, or the
-/// scene shadows itself: the sun's models chosen by their bounds for a quarter of the tolerance (or a half, or
-/// three quarters: [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on
-/// the lobe grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits
-/// what the sun's bound and the arithmetic leave; over several specular materials, a ladder per material, each
-/// staying on the rung that fits its own pixels ([`super::material_study`]). With a measured material under the sun, the disk sun's grid is
-/// refined on the same rungs instead, and the estimate gets all of the tolerance but the arithmetic; where the
-/// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]),
-/// the shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a
-/// specular penumbra). Refused as [`techniques_within`] refuses (the sky through occluders without `shadow_grids`,
-/// the device's interpolation, shadows other than rays), where the sun's bound cannot meet three quarters of the
-/// tolerance, or where the ladder's finest grid does not meet it.
+/// scene shadows itself: the sun's models chosen by their bounds for a quarter of the tolerance (or a half, or three
+/// quarters: [`SUN_SHARES`]; the delta sun's horizon term floor-based, no trial), then the image rendered on the lobe
+/// grids' ladder until the refinement's estimate of the finest image's error ([`super::refinement`]) fits what the
+/// sun's bound and the arithmetic leave; over several specular materials, a ladder per material, each staying on the
+/// rung that fits its own pixels ([`super::material_study`]). With a measured material under the sun, the disk sun's
+/// grid is refined on the same rungs instead, and the estimate gets all of the tolerance but the arithmetic; where the
+/// scene shadows itself and the tolerance holds in penumbrae too (`shadow_grids`, [`Tolerance::in_penumbrae`]), the
+/// shadow rays' grids are refined on the rungs too, with the disk sun's (its lobe samples cast rays: a specular
+/// penumbra). Refused as [`techniques_within`] refuses (the sky through occluders without `shadow_grids`, the device's
+/// interpolation, shadows other than rays), where the sun's bound cannot meet three quarters of the tolerance, or where
+/// the ladder's finest grid does not meet it.
 fn lobe_study<T, E>(
     request: Request,
     settings: &mut RenderSettings,

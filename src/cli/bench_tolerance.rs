@@ -1,8 +1,9 @@
-//! `bench --pareto`'s `--tolerance` table: for each scene and T = 1e-2, 1e-3, 1e-4, the models `render --tolerance
-//! T --tolerance-outside-penumbrae` chose (with `bench --tolerance-in-penumbrae`: `render --tolerance T`, which holds
-//! T in the penumbrae too; costlier, so not the sweep's default, whose two minutes a scene it would break), what its renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid
-//! study's rungs, the image kept), and the kept image's error against a converged reference, over every pixel and
-//! outside the penumbrae (what `--tolerance-outside-penumbrae` promises); or why it refused.
+//! `bench --pareto`'s `--tolerance` table: for each scene and T = 1e-2, 1e-3, 1e-4, the models `render --tolerance T
+//! --tolerance-outside-penumbrae` chose (with `bench --tolerance-in-penumbrae`: `render --tolerance T`, which holds T
+//! in the penumbrae too; costlier, so not the sweep's default, whose two minutes a scene it would break), what its
+//! renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid study's rungs, the image
+//! kept), and the kept image's error against a converged reference, over every pixel and outside the penumbrae (what
+//! `--tolerance-outside-penumbrae` promises); or why it refused.
 //!
 //! On a device without ray queries, a scene that shadows itself gets its table at a smaller size ([`table_size`])
 //! against its own converged reference: its shadow rays walk the BVH in the fragment shader there, seconds a frame
@@ -157,8 +158,8 @@ fn refusal(settings: &RenderSettings, error: TrialError<GpuError>) -> Result<Str
     }
 }
 
-/// The Markdown table of one scene's rows (`in_penumbrae`: the promise held in penumbrae too, `render`'s default; `smaller`: the
-/// table's size where it is not the sweep's, and how long its own truth took [s]).
+/// The Markdown table of one scene's rows (`in_penumbrae`: the promise held in penumbrae too, `render`'s default;
+/// `smaller`: the table's size where it is not the sweep's, and how long its own truth took [s]).
 pub(super) fn tolerance_table(
     name: &str,
     table: &ToleranceTable,

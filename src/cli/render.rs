@@ -34,13 +34,12 @@ pub struct RenderArgs {
     #[arg(help_heading = "Device", long)]
     pub no_cache: bool,
     /// How the sun's and disk lights' visible fractions through occluders are taken with shadow rays: `grid` (the
-    /// located grids of --shadow-samples rays) or `slices` (exact across the light along one angle, a midpoint rule
-    /// of 4k² rows along the other, for k² = --shadow-samples: second order in the rows where every occluder is
-    /// opaque, as `sunshade reference --visibility slices` takes them; refused where a pixel's light cone holds more
-    /// than 1024 triangles). On devices without ray queries, whose fragment shader walks the occluders' BVH;
-    /// refused where the sky casts shadows (the reference slices it). Default: slices with
-    /// --tolerance in penumbrae (its default) where those hold (their f32 geometry then measured against the reference's), else
-    /// the grid.
+    /// located grids of --shadow-samples rays) or `slices` (exact across the light along one angle, a midpoint rule of
+    /// 4k² rows along the other, for k² = --shadow-samples: second order in the rows where every occluder is opaque, as
+    /// `sunshade reference --visibility slices` takes them; refused where a pixel's light cone holds more than 1024
+    /// triangles). On devices without ray queries, whose fragment shader walks the occluders' BVH; refused where the
+    /// sky casts shadows (the reference slices it). Default: slices with --tolerance in penumbrae (its default) where
+    /// those hold (their f32 geometry then measured against the reference's), else the grid.
     #[arg(long = "visibility", value_name = "grid|slices", help_heading = "Shadows")]
     pub visibility_rule: Option<crate::shading::VisibilityRule>,
     /// Print the device and the time of each phase (instance, shader compile, upload, pipelines, render, readback,
@@ -177,9 +176,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         scene_can_occlude: gpu_scene.can_occlude(),
     };
     let tolerance = a.scene.tolerance();
-    // Where the GPU slices the lights in their penumbrae (the sky through occluders, whose penumbra is the image,
-    // or every light where the tolerance holds in penumbrae, its default), the grids are studied on the reference, whose promise then
-    // holds in penumbrae too (`studied_on_the_reference`).
+    // Where the GPU slices the lights in their penumbrae (the sky through occluders, whose penumbra is the image, or
+    // every light where the tolerance holds in penumbrae, its default), the grids are studied on the reference, whose
+    // promise then holds in penumbrae too (`studied_on_the_reference`).
     let can_occlude = gpu_scene.can_occlude();
     let study_on_the_reference = crate::accuracy::trial::sky_by_slices(scene_data, &settings, can_occlude)
         || (tolerance.is_some_and(|t| t.in_penumbrae)
@@ -254,18 +253,18 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     })
 }
 
-/// `--tolerance` where the GPU slices the lights in their penumbrae (the sky through occluders, or every light with
-/// the promise held in penumbrae, `--tolerance`'s default): the grids are studied on the reference, the same rule in f64
-/// (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the promise there
-/// holds in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
-/// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and
-/// added to the prediction, T refused by name where the sum exceeds it: the image is within the sum of the truth.
-/// A study's rungs cost the GPU far more than the reference: the sky's passes some 40 ms a row at 64 × 48 on
-/// lavapipe (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27²,
-/// its order capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame
-/// runs out of the loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the
-/// shadows asked for, and whether the scene can shadow itself. The GPU's image, its prediction, and the
-/// reference's image it was measured against.
+/// `--tolerance` where the GPU slices the lights in their penumbrae (the sky through occluders, or every light with the
+/// promise held in penumbrae, `--tolerance`'s default): the grids are studied on the reference, the same rule in f64
+/// (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the promise there holds
+/// in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
+/// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to
+/// the prediction, T refused by name where the sum exceeds it: the image is within the sum of the truth. A study's
+/// rungs cost the GPU far more than the reference: the sky's passes some 40 ms a row at 64 × 48 on lavapipe
+/// (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27², its order
+/// capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame runs out of the
+/// loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the shadows asked for, and
+/// whether the scene can shadow itself. The GPU's image, its prediction, and the reference's image it was measured
+/// against.
 fn studied_on_the_reference(
     scene: &crate::scene::Scene,
     settings: &mut RenderSettings,
@@ -345,8 +344,8 @@ fn slices_measured_against_the_reference(
     Ok(Some(f64_slices))
 }
 
-/// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae
-/// (its default, not `--tolerance-outside-penumbrae`; or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
+/// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae (its default, not
+/// `--tolerance-outside-penumbrae`; or a sky, whose penumbra is nearly the whole image) and the GPU can take them (no
 /// alpha-masked occluders, and shadow rays: `auto` or `ray`, not where `auto` found nothing to shadow), as the
 /// reference defaults to them there; the grid otherwise.
 fn default_visibility(
