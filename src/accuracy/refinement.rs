@@ -72,7 +72,9 @@
 //! criterion for an order that confirms the formal one), the factor of safety is Roache's for an unconfirmed order,
 //! 3 ([`UNCONFIRMED_SAFETY_FACTOR`]): 3.7e-3 there. Under [`MAX_ORDER_WITH_PENUMBRAE`] the cap is the margin
 //! already (the order read past 1 is the located edges' 2, and the cap takes 2.4 times its estimate), so the factor
-//! stays 1.25.
+//! stays 1.25. Below the order used, where Oberkampf and Roy take 3 as well, the study keeps 1.25: it uses the lower
+//! order it observes, which makes the estimate larger by itself (`d₂/(r^p − 1)` grows as `p` falls: at `p` = 1.5 on
+//! rungs √2 apart, about 1.5 times its value at 2), and an order under [`MIN_ORDER`] sends the ladder on.
 //!
 //! Oberkampf, W. L. and Roy, C. J. (2010), *Verification and Validation in Scientific Computing*, Cambridge
 //! University Press, §8.6 (the GCI's factor of safety: 1.25 where the observed order is within 10% of the formal
