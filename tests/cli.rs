@@ -597,6 +597,18 @@ fn outputs_record_camera_lights_and_settings() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--tolerance") && stderr(&o).lines().count() == 1, "{}", stderr(&o));
     assert!(!exr.exists());
+    // --tolerance holds in penumbrae unless --tolerance-outside-penumbrae: the two promises together, or either
+    // without --tolerance, are usage errors, nothing written.
+    for flags in [
+        &["--tolerance", "1e-3", "--tolerance-outside-penumbrae", "--tolerance-in-penumbrae"][..],
+        &["--tolerance-outside-penumbrae"][..],
+        &["--tolerance-in-penumbrae"][..],
+    ] {
+        let o = sunshade(&[&["render", s(&input), "-o", s(&exr)][..], flags].concat());
+        assert_eq!(o.status.code(), Some(2), "{flags:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("--tolerance"), "{flags:?}: {}", stderr(&o));
+        assert!(!exr.exists());
+    }
 }
 
 #[test]
