@@ -389,9 +389,11 @@ fn occlusion_and_arithmetic(
                 p.unbounded.push("the shadow maps".into())
             }
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
-            _ => p
-                .unbounded
-                .push("penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae estimates them)".into()),
+            _ => p.unbounded.push(
+                "penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae \
+                 estimates them)"
+                    .into(),
+            ),
         }
     }
     if let Renderer::Gpu { barycentrics } = renderer {

@@ -342,6 +342,13 @@ impl SceneArgs {
         })
     }
 
+    /// Whether `--tolerance` is asked and is to hold in penumbrae under `lights`: its default, or a sky (held in
+    /// its penumbra whatever is asked: it is nearly the whole image). `render` and `reference` take the lights by
+    /// slices there unless `--visibility` says otherwise.
+    pub fn tolerance_holds_in_penumbrae(&self, lights: &crate::scene::Lights) -> bool {
+        self.tolerance().is_some_and(|t| t.in_penumbrae || lights.sky.is_some())
+    }
+
     /// Refuses flags that mean nothing together.
     pub fn check(&self) -> Result<(), super::CliError> {
         self.daylight.check().map_err(super::CliError::Usage)?;

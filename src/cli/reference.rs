@@ -98,7 +98,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     // sky's implies: `accuracy::trial::sky_by_slices`); the GPU's grid where it is to be compared with the GPU's,
     // and where the promise leaves the penumbrae out (the slices' walks would cost more for nothing promised:
     // sunset.glb at 256², `--tolerance 1e-2`, 1.5 s against 0.15 s).
-    let in_penumbrae = a.scene.tolerance().is_some_and(|t| t.in_penumbrae || settings.lights.sky.is_some());
+    let in_penumbrae = a.scene.tolerance_holds_in_penumbrae(&settings.lights);
     settings.shading.visibility_rule = a.visibility_rule.unwrap_or(if a.converged || in_penumbrae {
         VisibilityRule::Slices
     } else {

@@ -354,7 +354,7 @@ fn default_visibility(
     scene: &crate::scene::Scene,
     technique: Shadows,
 ) -> crate::shading::VisibilityRule {
-    let in_penumbrae = a.tolerance().is_some_and(|t| t.in_penumbrae || settings.lights.sky.is_some());
+    let in_penumbrae = a.tolerance_holds_in_penumbrae(&settings.lights);
     let lights = &settings.lights;
     let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
     let rays = matches!(a.shadows, Shadows::Auto | Shadows::Ray) && technique != Shadows::None;
