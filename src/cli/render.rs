@@ -191,6 +191,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         spent.render += t.render;
         spent.readback += t.readback;
         spent.lights_in_passes |= t.lights_in_passes;
+        spent.probe = t.probe.or(spent.probe);
         Ok::<_, crate::gpu::GpuError>((image, t))
     };
     let beyond = |e: crate::gpu::GpuError, settings: &RenderSettings| match (e, tolerance) {
@@ -524,6 +525,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         }
         if let Some(lights) = crate::gpu::slice_passes::passed_lights(job.frame.lights_in_passes) {
             eprintln!("sunshade: slices in passes before the frame: {lights} (gpu::slice_passes)");
+        }
+        if let Some(probe) = job.frame.probe {
+            eprintln!("sunshade: {}", probe.describe());
         }
         eprintln!("sunshade: {}", job.prediction.line());
         print_exposure(ev);

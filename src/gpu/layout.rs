@@ -180,7 +180,8 @@ pub struct DiskGpu {
 pub struct LightsHeader {
     pub sun: SunGpu,
     pub sky: [f32; 4],
-    /// Disk count, unused, unused, samples per axis for disks and the sky.
+    /// Disk count, unused, the probe loop's iterations (`loop_budget::LOOP_PROBE_ITERATIONS`; more in a frame's
+    /// probe, `frame_probe`), samples per axis for disks and the sky.
     pub counts: [u32; 4],
     /// Samples per axis over the sun's disk, shadow samples per axis (visible fractions), the shadow maps'
     /// filter (1 PCSS, 2 nearest); the rest unused.
@@ -408,6 +409,15 @@ pub fn with_light_rows(bytes: &[u8], light_rows: [u32; 4]) -> Vec<u8> {
     let mut bytes = bytes.to_vec();
     let at = std::mem::offset_of!(LightsHeader, light_rows);
     bytes[at..at + 16].copy_from_slice(bytemuck::bytes_of(&light_rows));
+    bytes
+}
+
+/// The light buffer's bytes (`lights_bytes`) with `counts.z`, the probe loop's iterations (shaders/fragment.glsl,
+/// `coverage_alpha`), set to `iterations`.
+pub fn with_loop_probe(bytes: &[u8], iterations: u32) -> Vec<u8> {
+    let mut bytes = bytes.to_vec();
+    let at = std::mem::offset_of!(LightsHeader, counts) + 2 * std::mem::size_of::<u32>();
+    bytes[at..at + 4].copy_from_slice(&iterations.to_ne_bytes());
     bytes
 }
 

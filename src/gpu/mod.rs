@@ -11,6 +11,7 @@
 //! - `accel`: acceleration structures for the shadow rays (ray queries);
 //! - `shadow_map`: the sun's shadow-map pass;
 //! - `slice_passes`: the lights' slices, taken in passes before the frame where a fragment cannot take them;
+//! - `frame_probe`: a sparse first look at a frame, to learn whether it would run out of llvmpipe's loop budget;
 //! - `renderer`: upload, draw, readback.
 
 mod accel;
@@ -18,6 +19,7 @@ mod commands;
 mod context;
 mod device_info;
 mod error;
+pub mod frame_probe;
 pub mod layout;
 pub mod loop_budget;
 mod memory;

@@ -11,6 +11,7 @@ use super::commands::Commands;
 use super::context::{ContextOptions, Device, Interpolation, ValidationLog};
 use super::device_info::DeviceInfo;
 use super::error::GpuError;
+use super::frame_probe;
 use super::layout::{
     lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_light_rows,
     MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, BRDF_LAMBERT, DISKS_EXACT, LIGHT_ABSENT,
@@ -55,6 +56,8 @@ pub struct FrameTimings {
     /// The lights whose visible fractions the frame read from their passes of slices (`slice_passes::read_bits`:
     /// `READ_SKY`, `READ_SUN`, `READ_DISKS`), 0 where it took every light itself.
     pub lights_in_passes: u32,
+    /// The frame's probe (`frame_probe`), where one was drawn first.
+    pub probe: Option<frame_probe::Probe>,
 }
 
 /// What a frame draws besides the lights' passes: the shadow maps' transforms (world → map) where the technique
@@ -637,6 +640,15 @@ impl Renderer {
             draw_pipelines: &draw_pipelines,
         };
         let mut passed = slice_passes::PassedFractions::new((width * height) as usize);
+        // A first frame at these rows that slices the sun or disk lights itself is probed first (`frame_probe`), on
+        // devices with the loop limiter.
+        let mut probing = match passable.first() {
+            Some(slot) if !slots.contains(slot) && frame_probe::probes(&self.dev.info) => {
+                frame_probe::probe_blocks(width, height)
+            }
+            _ => None,
+        };
+        let mut probe = None;
         let (image, lights, light_fractions, readback) = loop {
             passes_pipelines += self.light_fractions(scene, settings, &light_bytes, &variants, &slots, &mut passed)?;
             let light_fractions = match passed.layered() {
@@ -644,8 +656,22 @@ impl Renderer {
                 None => None,
             };
             let read = slice_passes::read_bits(&slots);
-            let lights = Buffer::storage(&self.dev, &with_light_rows(&light_bytes, [0, 0, 0, read]), "lights")?;
-            self.draw_frame(scene, settings, &lights, light_fractions.as_ref(), &draws)?;
+            let frame_bytes = with_light_rows(&light_bytes, [0, 0, 0, read]);
+            if let Some(blocks) = probing.take() {
+                let t_probe = Instant::now();
+                let bytes = frame_probe::probe_light_bytes(&frame_bytes);
+                let probe_lights = Buffer::storage(&self.dev, &bytes, "the probe's lights")?;
+                self.draw_frame(scene, settings, (&probe_lights, light_fractions.as_ref()), &draws, &blocks)?;
+                let ran_out = super::loop_budget::check(&self.read_back(width, height)?, "").is_err();
+                probe = Some(frame_probe::Probe { blocks: blocks.len(), ran_out, time: t_probe.elapsed() });
+                if ran_out {
+                    scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
+                    slots.extend(&passable);
+                    continue;
+                }
+            }
+            let lights = Buffer::storage(&self.dev, &frame_bytes, "lights")?;
+            self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
             let t_readback = Instant::now();
             let image = self.read_back(width, height)?;
             match super::loop_budget::check(&image, &self.dev.info.name) {
@@ -664,19 +690,20 @@ impl Renderer {
         self.light_fractions = light_fractions;
         self.check_validation()?;
         let lights_in_passes = slice_passes::read_bits(&slots);
-        Ok((image, FrameTimings { pipelines, render, readback, lights_in_passes }))
+        Ok((image, FrameTimings { pipelines, render, readback, lights_in_passes, probe }))
     }
 
     /// One frame's draws, with the light buffer `lights` and the passes' fractions (binding 13; the unused one
     /// where `None`): the shadow maps' depth passes (`draws`' maps, where the technique is `map`), then the scene
-    /// pass; submitted and waited for.
+    /// pass, over the whole image or only a probe's `blocks` (`(x, y, side)`, `frame_probe::probe_blocks`);
+    /// submitted and waited for.
     fn draw_frame(
         &mut self,
         scene: &GpuScene,
         settings: &RenderSettings,
-        lights: &Buffer,
-        fractions: Option<&Buffer>,
+        (lights, fractions): (&Buffer, Option<&Buffer>),
         draws: &FrameDraws,
+        blocks: &[(u32, u32, u32)],
     ) -> Result<(), GpuError> {
         // SAFETY: all handles are valid and owned by this renderer; the GPU is idle (every submission is waited
         // for), so the descriptor set may be updated and the command buffer re-recorded.
@@ -689,7 +716,7 @@ impl Renderer {
             for (map, to_map) in self.disk_maps.iter().zip(&draws.disk_maps).filter_map(|(m, f)| Some((m, (*f)?))) {
                 self.record_depth_pass(cb, scene, settings, map, to_map, draws.map_pipelines);
             }
-            self.record_scene_pass(cb, scene, settings, draws.draw_pipelines);
+            self.record_scene_pass(cb, scene, settings, draws.draw_pipelines, blocks);
             self.commands.submit_and_wait(&self.dev, cb)?;
         }
         Ok(())
@@ -741,7 +768,7 @@ impl Renderer {
                 unsafe {
                     self.write_descriptors(scene, &pass_lights, &self.no_light_fractions);
                     let cb = self.commands.begin(&self.dev)?;
-                    self.record_scene_pass(cb, scene, settings, &pass_pipelines);
+                    self.record_scene_pass(cb, scene, settings, &pass_pipelines, &[]);
                     self.commands.submit_and_wait(&self.dev, cb)?;
                 }
                 let image = self.read_back(settings.width, settings.height)?;
@@ -924,6 +951,7 @@ impl Renderer {
         scene: &GpuScene,
         settings: &RenderSettings,
         draw_pipelines: &[vk::Pipeline],
+        blocks: &[(u32, u32, u32)],
     ) {
         let d = &self.dev.device;
         let target = self.target.as_ref().expect("made by ensure_target");
@@ -983,13 +1011,25 @@ impl Renderer {
                 max_depth: 1.0,
             };
             d.cmd_set_viewport(cb, 0, &[viewport]);
-            d.cmd_set_scissor(cb, 0, &[area]);
-            if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                let cull =
-                    |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
-                self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), |draw| {
-                    push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
-                });
+            // The whole image, or the scene drawn once for each of the probe's blocks (`frame_probe`).
+            let scissors: Vec<vk::Rect2D> = match blocks {
+                [] => vec![area],
+                _ => blocks
+                    .iter()
+                    .map(|&(x, y, side)| vk::Rect2D {
+                        offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                        extent: vk::Extent2D { width: side, height: side },
+                    })
+                    .collect(),
+            };
+            let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
+            for scissor in scissors {
+                d.cmd_set_scissor(cb, 0, &[scissor]);
+                if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
+                    self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), |draw| {
+                        push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
+                    });
+                }
             }
             d.cmd_end_rendering(cb);
         }
