@@ -5,6 +5,8 @@
 //!   that does not hold are reported);
 //! - [`error`]: an image's error against such a truth (max relative with the diff's floor, p99, RMSE, pixels over
 //!   1e-2, 1e-3, 1e-4);
+//! - [`from_reference`]: the GPU's pixels that f32 leaves further from the reference than `--tolerance` allows,
+//!   taken from the reference's image where it was rendered anyway;
 //! - [`interpolation`]: the error f32 barycentrics add, bounded per pixel from the triangle's shape and the
 //!   radiance's change over that move;
 //! - [`pareto`]: which settings of a sweep are on the front of frame time against error;
@@ -23,6 +25,7 @@
 pub mod bounds;
 pub mod converged;
 pub mod error;
+pub mod from_reference;
 pub mod interpolation;
 pub mod material_study;
 pub mod pareto;

@@ -116,6 +116,9 @@ pub struct Rendered {
     /// The reference's image at `settings`, mirroring the device, where `--tolerance` rendered it to measure the
     /// GPU's against it: `--check` compares with it rather than render it again ([`reference_of`]).
     pub reference: Option<Image>,
+    /// The GPU's own image, where `--tolerance` took some of `image`'s pixels from `reference`
+    /// (`accuracy::from_reference`): `--check` compares the device's pixels, not the reference's.
+    pub device_image: Option<Image>,
 }
 
 /// Renders one job on the session's renderer for its device: the scene loaded (unless the session has it), the
@@ -210,7 +213,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         )),
         (e, _) => CliError::from(e),
     };
-    let (image, prediction, reference_image) = match tolerance {
+    let (image, prediction, reference_image, device_image) = match tolerance {
         Some(t) if study_on_the_reference => {
             let scene_flags = (a.scene.shadows, can_occlude);
             studied_on_the_reference(scene_data, &mut settings, &reference, scene_flags, t, |s| {
@@ -223,11 +226,11 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
                 TrialError::Tolerance(why) => CliError::Usage(why),
                 TrialError::Render(e) => beyond(e, &settings),
             })?;
-            let ((image, _), mut prediction) = (done.kept, done.prediction);
-            let mut reference_image = None;
+            let ((mut image, _), mut prediction) = (done.kept, done.prediction);
+            let (mut reference_image, mut device_image) = (None, None);
             if let Some(t) = tolerance.filter(|t| t.in_penumbrae) {
-                reference_image = slices_measured_against_the_reference(
-                    &image,
+                (reference_image, device_image) = slices_measured_against_the_reference(
+                    &mut image,
                     scene_data,
                     &settings,
                     &reference,
@@ -235,7 +238,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
                     &mut prediction,
                 )?;
             }
-            (image, prediction, reference_image)
+            (image, prediction, reference_image, device_image)
         }
     };
     let frame = spent;
@@ -251,6 +254,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
         scene,
         renderer,
         reference: reference_image,
+        device_image,
     })
 }
 
@@ -259,13 +263,14 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 /// (`accuracy::trial::reference_within_tolerance`, `settings` updated to the models it keeps; the promise there holds
 /// in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
 /// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to
-/// the prediction, T refused by name where the sum exceeds it: the image is within the sum of the truth. A study's
+/// the prediction, the pixels it leaves too far taken from the reference's image (`measured_against_the_reference`):
+/// the image is within the sum of the truth. A study's
 /// rungs cost the GPU far more than the reference: the sky's passes some 40 ms a row at 64 × 48 on lavapipe
 /// (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27², its order
 /// capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame runs out of the
 /// loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the shadows asked for, and
-/// whether the scene can shadow itself. The GPU's image, its prediction, and the reference's image it was measured
-/// against.
+/// whether the scene can shadow itself. The image, its prediction, the reference's image it was measured against,
+/// and the GPU's own image where some of its pixels were taken from the reference's.
 fn studied_on_the_reference(
     scene: &crate::scene::Scene,
     settings: &mut RenderSettings,
@@ -273,7 +278,7 @@ fn studied_on_the_reference(
     (asked, can_occlude): (Shadows, bool),
     tolerance: Tolerance,
     render: impl FnOnce(&RenderSettings) -> Result<Image, CliError>,
-) -> Result<(Image, Prediction, Option<Image>), CliError> {
+) -> Result<(Image, Prediction, Option<Image>, Option<Image>), CliError> {
     let (studied, mut prediction) = crate::accuracy::trial::reference_within_tolerance(
         scene,
         settings,
@@ -283,35 +288,48 @@ fn studied_on_the_reference(
         Some(tolerance),
     )
     .map_err(CliError::Usage)?;
-    let image = render(settings)?;
-    let what = "the GPU against the reference at the kept settings (measured; studied on the reference):";
-    measured_against_the_reference(&image, &studied, what, tolerance.max_relative, &mut prediction, |apart, sum| {
-        format!(
-            "the GPU's image is {apart:.1e} from the reference's at the settings kept (its f32 shading, interpolation \
-             and slices), which with the rest ({sum:.1e}) exceeds it; `sunshade reference` with the same scene flags \
-             has no f32"
-        )
-    })?;
-    Ok((image, prediction, Some(studied)))
+    let mut image = render(settings)?;
+    let what = "the GPU against the reference at the kept settings (measured; studied on the reference)";
+    let device_image =
+        measured_against_the_reference(&mut image, &studied, what, tolerance.max_relative, &mut prediction, |sum| {
+            format!(
+                "the study's own terms come to {sum:.1e}, leaving nothing for the GPU's f32 shading, interpolation \
+                 and slices; `sunshade reference` with the same scene flags has no f32"
+            )
+        })?;
+    Ok((image, prediction, Some(studied), device_image))
 }
 
 /// The GPU's `image` against the reference's f64 image at the same settings (`f64_image`): their distance added to
-/// the prediction as the term `what`, measured where no bound is derived, and `tolerance` refused by name where the
-/// sum exceeds it (`refusal(apart, sum)` says why).
+/// the prediction as the term `what`, measured where no bound is derived. Where the sum would exceed `tolerance`,
+/// the pixels further from `f64_image` than the rest of the prediction leaves are taken from it
+/// (`accuracy::from_reference`; the term names how many), and the GPU's own image is returned; `tolerance` is
+/// refused by name only where the rest alone reaches it (`refusal(rest)` says why).
 fn measured_against_the_reference(
-    image: &Image,
+    image: &mut Image,
     f64_image: &Image,
     what: &str,
     tolerance: f64,
     prediction: &mut Prediction,
-    refusal: impl FnOnce(f64, f64) -> String,
-) -> Result<(), CliError> {
-    let apart = crate::accuracy::refinement::max_difference(image, f64_image);
-    prediction.add_term(what, apart);
-    if prediction.max_relative > tolerance {
-        return Err(CliError::Usage(format!("--tolerance {tolerance:e}: {}", refusal(apart, prediction.max_relative))));
+    refusal: impl FnOnce(f64) -> String,
+) -> Result<Option<Image>, CliError> {
+    use crate::accuracy::{from_reference::take_from_reference, refinement::max_difference};
+    let rest = prediction.max_relative;
+    if rest >= tolerance {
+        return Err(CliError::Usage(format!("--tolerance {tolerance:e}: {}", refusal(rest))));
     }
-    Ok(())
+    let apart = max_difference(image, f64_image);
+    if rest + apart <= tolerance {
+        prediction.add_term(&format!("{what}:"), apart);
+        return Ok(None);
+    }
+    // The pixels' budget, 1% short of what the rest leaves, so that the sum's rounding cannot tip it past T.
+    let budget = 0.99 * (tolerance - rest);
+    let device_image = image.clone();
+    let taken = take_from_reference(image, f64_image, budget);
+    let term = format!("{what}, {taken} pixel(s) further than {budget:.1e} taken from the reference's f64 image:");
+    prediction.add_term(&term, max_difference(image, f64_image));
+    Ok(Some(device_image))
 }
 
 /// What f32 geometry costs the GPU's slices where `--tolerance` holds in penumbrae: a point millimetres to
@@ -319,30 +337,30 @@ fn measured_against_the_reference(
 /// the scene's coordinates (1e-7 m at 1 m), about 1e-4 of the sun's chord at a centimetre (cube.glb at 64²,
 /// `--tolerance 1e-4`: 1.5e-4 against the converged reference). No bound is derived for it, so it is measured: the
 /// kept image against the reference's f64 slices at the same settings (mirroring the device), added to the
-/// prediction as a term, and T refused where the sum exceeds it.
+/// prediction as a term, the pixels too far taken from the reference's image (`measured_against_the_reference`).
+/// The reference's image, and the GPU's own where pixels were taken.
 fn slices_measured_against_the_reference(
-    image: &Image,
+    image: &mut Image,
     scene: &crate::scene::Scene,
     settings: &RenderSettings,
     reference: &ReferenceOptions,
     tolerance: f64,
     prediction: &mut Prediction,
-) -> Result<Option<Image>, CliError> {
+) -> Result<(Option<Image>, Option<Image>), CliError> {
     if settings.shading.visibility_rule != crate::shading::VisibilityRule::Slices
         || settings.shading.shadows != Shadows::Ray
     {
-        return Ok(None);
+        return Ok((None, None));
     }
     let f64_slices = cpu::render(scene, settings, reference);
-    let what = "GPU f32 slices (measured against the reference's):";
-    measured_against_the_reference(image, &f64_slices, what, tolerance, prediction, |apart, sum| {
+    let what = "GPU f32 slices (measured against the reference's)";
+    let device_image = measured_against_the_reference(image, &f64_slices, what, tolerance, prediction, |sum| {
         format!(
-            "the GPU's slices of the lights are {apart:.1e} from the reference's f64 slices (f32 geometry near the \
-             occluders), which with the rest ({sum:.1e}) exceeds it; `sunshade reference` with the same scene flags \
-             has no f32 geometry"
+            "the other terms come to {sum:.1e}, leaving nothing for the GPU's slices' f32 geometry; `sunshade \
+             reference` with the same scene flags has no f32 geometry"
         )
     })?;
-    Ok(Some(f64_slices))
+    Ok((Some(f64_slices), device_image))
 }
 
 /// `render`'s visibility rule without `--visibility`: slices where `--tolerance` holds in penumbrae (its default, not
@@ -433,7 +451,7 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     let unit = job.settings.shading.quantity.unit();
     let format = ReportFormat::new(a.json, unit, vec![("predicted_error".to_string(), job.prediction.json())]);
     let report = compare_and_report(
-        &job.image,
+        job.device_image.as_ref().unwrap_or(&job.image),
         &reference,
         ("gpu", "cpu reference"),
         &a.tolerances.options(),
