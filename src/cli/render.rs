@@ -315,13 +315,13 @@ fn measured_against_the_reference(
 ) -> Result<Option<Image>, CliError> {
     use crate::accuracy::{from_reference::take_from_reference, refinement::max_difference};
     let rest = prediction.max_relative;
-    if rest >= tolerance {
-        return Err(CliError::Usage(format!("--tolerance {tolerance:e}: {}", refusal(rest))));
-    }
     let apart = max_difference(image, f64_image);
     if rest + apart <= tolerance {
         prediction.add_term(&format!("{what}:"), apart);
         return Ok(None);
+    }
+    if rest >= tolerance {
+        return Err(CliError::Usage(format!("--tolerance {tolerance:e}: {}", refusal(rest))));
     }
     // The pixels' budget, 1% short of what the rest leaves, so that the sum's rounding cannot tip it past T.
     let budget = 0.99 * (tolerance - rest);
