@@ -37,14 +37,14 @@ use super::layout::with_loop_probe;
 use super::loop_budget::LOOP_PROBE_ITERATIONS;
 use super::DeviceInfo;
 
-/// The side of a probe's blocks [pixels]: llvmpipe shades 4 × 4 blocks, so a block aligned to 4 shades no pixel
+/// The side of a probe's blocks \[pixels\]: llvmpipe shades 4 × 4 blocks, so a block aligned to 4 shades no pixel
 /// outside it.
 pub const PROBE_BLOCK: u32 = 4;
 /// About how many cells of the probe's pattern lie along the frame's shorter side.
 pub const PROBE_CELLS: u32 = 16;
-/// The least spacing of the probe's blocks [pixels]: a probe shades at most a 16th of the frame's pixels.
+/// The least spacing of the probe's blocks \[pixels\]: a probe shades at most a 16th of the frame's pixels.
 pub const PROBE_MIN_SPACING: u32 = 4 * PROBE_BLOCK;
-/// The shorter side [pixels] from which frames are probed: smaller ones, whose wasted frame costs little, are not.
+/// The shorter side \[pixels\] from which frames are probed: smaller ones, whose wasted frame costs little, are not.
 pub const PROBED_FROM: u32 = 128;
 /// The iterations of llvmpipe's loop budget (65 535) that a probe's fragment keeps in reserve: an eighth. (A
 /// quarter sent room.gltf at 128² and k = 6, whose frame fits, to the passes.)
