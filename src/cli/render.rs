@@ -264,13 +264,13 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
 /// in penumbrae too), then the GPU renders once with them (`render`), and the distance of its image from the
 /// reference's at those settings (the GPU's f32: shading, interpolation, the slices' geometry) is measured and added to
 /// the prediction, the pixels it leaves too far taken from the reference's image (`measured_against_the_reference`):
-/// the image is within the sum of the truth. A study's
-/// rungs cost the GPU far more than the reference: the sky's passes some 40 ms a row at 64 × 48 on lavapipe
-/// (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study on the GPU took 6 min and kept 27², its order
-/// capped at 1, the reference's takes 4 s and keeps 19²); a disk light's rows in passes where the frame runs out of the
-/// loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept 39²). `(asked, can_occlude)`: the shadows asked for, and
-/// whether the scene can shadow itself. The image, its prediction, the reference's image it was measured against,
-/// and the GPU's own image where some of its pixels were taken from the reference's.
+/// the image is within the sum of the truth. A study's rungs cost the GPU far more than the reference: the sky's
+/// passes some 40 ms a row at 64 × 48 on lavapipe (`gpu::slice_passes`; on overcast.glb at 64 × 48 and 1e-3 a study
+/// on the GPU took 6 min and kept 27², its order capped at 1, the reference's takes 4 s and keeps 19²); a disk
+/// light's rows in passes where the frame runs out of the loop budget (room.gltf at 64², 1e-4: 7 min on the GPU, kept
+/// 39²). `(asked, can_occlude)`: the shadows asked for, and whether the scene can shadow itself. The image, its
+/// prediction, the reference's image it was measured against, and the GPU's own image where some of its pixels were
+/// taken from the reference's.
 fn studied_on_the_reference(
     scene: &crate::scene::Scene,
     settings: &mut RenderSettings,
