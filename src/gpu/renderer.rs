@@ -657,31 +657,33 @@ impl Renderer {
             };
             let read = slice_passes::read_bits(&slots);
             let frame_bytes = with_light_rows(&light_bytes, [0, 0, 0, read]);
-            if let Some(blocks) = probing.take() {
-                let t_probe = Instant::now();
-                let bytes = frame_probe::probe_light_bytes(&frame_bytes);
-                let probe_lights = Buffer::storage(&self.dev, &bytes, "the probe's lights")?;
-                self.draw_frame(scene, settings, (&probe_lights, light_fractions.as_ref()), &draws, &blocks)?;
-                let ran_out = super::loop_budget::check(&self.read_back(width, height)?, "").is_err();
-                probe = Some(frame_probe::Probe { blocks: blocks.len(), ran_out, time: t_probe.elapsed() });
-                if ran_out {
-                    scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
-                    slots.extend(&passable);
-                    continue;
+            let probe_ran_out = match probing.take() {
+                Some(blocks) => {
+                    let t_probe = Instant::now();
+                    let bytes = frame_probe::probe_light_bytes(&frame_bytes);
+                    let probe_lights = Buffer::storage(&self.dev, &bytes, "the probe's lights")?;
+                    self.draw_frame(scene, settings, (&probe_lights, light_fractions.as_ref()), &draws, &blocks)?;
+                    let ran_out = super::loop_budget::check(&self.read_back(width, height)?, "").is_err();
+                    probe = Some(frame_probe::Probe { blocks: blocks.len(), ran_out, time: t_probe.elapsed() });
+                    ran_out
+                }
+                None => false,
+            };
+            if !probe_ran_out {
+                let lights = Buffer::storage(&self.dev, &frame_bytes, "lights")?;
+                self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
+                let t_readback = Instant::now();
+                let image = self.read_back(width, height)?;
+                match super::loop_budget::check(&image, &self.dev.info.name) {
+                    Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {}
+                    Err(e) => return Err(GpuError::LoopBudget(e)),
+                    Ok(()) => break (image, lights, light_fractions, t_readback.elapsed()),
                 }
             }
-            let lights = Buffer::storage(&self.dev, &frame_bytes, "lights")?;
-            self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
-            let t_readback = Instant::now();
-            let image = self.read_back(width, height)?;
-            match super::loop_budget::check(&image, &self.dev.info.name) {
-                Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {
-                    scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
-                    slots.extend(&passable);
-                }
-                Err(e) => return Err(GpuError::LoopBudget(e)),
-                Ok(()) => break (image, lights, light_fractions, t_readback.elapsed()),
-            }
+            // The probe or the frame ran out with the sun and disk lights in the frame: their rows go to passes, in
+            // this frame and in the scene's later frames from these rows on.
+            scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
+            slots.extend(&passable);
         };
         let render = t_render.elapsed() - passes_pipelines - readback;
         let pipelines = pipelines + passes_pipelines;
