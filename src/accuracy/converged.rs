@@ -31,7 +31,7 @@
 //! rule defines the image rather than approximating an integral that a finer grid would resolve. Interpolation is
 //! in f64 throughout the reference.
 
-use crate::compare::{image_peak, pixel_difference, DiffOptions};
+use crate::compare::{default_floor, pixel_difference};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
 use crate::scene::Scene;
@@ -197,7 +197,7 @@ pub fn render_converged(
     let mut image = cpu::render(scene, &s, reference);
     // The floor of `sunshade diff`, from the starting image's peak (refinement moves the peak by far less than
     // the 1% the floor is of it).
-    let floor = DiffOptions::default().floor_fraction * image_peak(&image);
+    let floor = default_floor(&image);
     let threshold = options.accuracy / 10.0;
     let mut moving: Vec<bool> = image.pixels().iter().map(|p| p[3] > 0.0).collect();
     let mut result = Converged {

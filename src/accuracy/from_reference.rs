@@ -10,14 +10,14 @@
 //! truth, so those pixels are taken from it: every pixel then lies within `T − rest` of the reference, the image
 //! within T of the truth. `-v` names how many, and `--check` still compares the GPU's own image.
 
-use crate::compare::{image_peak, pixel_difference, DiffOptions};
+use crate::compare::{default_floor, pixel_difference};
 use crate::film::Image;
 
 /// Replaces each pixel of `image` whose relative difference from `reference` (the diff's floor from the
 /// reference's peak, as `refinement::max_difference` measures it) exceeds `budget` with the reference's pixel;
 /// returns how many it replaced. Both images have the same size.
 pub fn take_from_reference(image: &mut Image, reference: &Image, budget: f64) -> usize {
-    let floor = DiffOptions::default().floor_fraction * image_peak(reference);
+    let floor = default_floor(reference);
     let mut taken = 0;
     for (a, &b) in image.pixels_mut().iter_mut().zip(reference.pixels()) {
         // A NaN's difference is infinite (`pixel_difference`), so it is taken too.

@@ -80,7 +80,7 @@
 //! University Press, §8.6 (the GCI's factor of safety: 1.25 where the observed order is within 10% of the formal
 //! one, 3 otherwise).
 
-use crate::compare::{image_peak, pixel_difference, DiffOptions};
+use crate::compare::{default_floor, pixel_difference};
 use crate::film::Image;
 
 /// The finest lobe grid the ladder renders [per axis].
@@ -127,7 +127,7 @@ pub fn max_difference(coarse: &Image, fine: &Image) -> f64 {
 /// [`max_difference`] over the pixels `mask` flags only (row-major; `None`: all), the floor still the whole
 /// image's: a part of the image measured as the diff measures the whole.
 pub fn max_difference_where(coarse: &Image, fine: &Image, mask: Option<&[bool]>) -> f64 {
-    let floor = DiffOptions::default().floor_fraction * image_peak(fine);
+    let floor = default_floor(fine);
     coarse
         .pixels()
         .iter()

@@ -174,6 +174,20 @@ pub enum PixelDiff {
     Relative(f64),
 }
 
+impl DiffOptions {
+    /// The relative error's floor for images whose peak is `peak`: `floor`, or `floor_fraction` of the peak where
+    /// that is more.
+    pub fn floor_for(&self, peak: f64) -> f64 {
+        self.floor.max(self.floor_fraction * peak)
+    }
+}
+
+/// The floor `sunshade diff` takes by default against `image`: 1% of its peak ([`DiffOptions::floor_for`]), as the
+/// accuracy studies measure an image against a finer or reference one.
+pub fn default_floor(image: &Image) -> f64 {
+    DiffOptions::default().floor_for(image_peak(image))
+}
+
 /// The largest absolute radiance over RGB of an image's covered pixels, ignoring non-finite values: the peak the
 /// floor is a fraction of.
 pub fn image_peak(image: &Image) -> f64 {
@@ -247,7 +261,7 @@ pub fn diff_excusing(
         })
     };
     let peak = image_peak(a).max(image_peak(b));
-    let floor = options.floor.max(options.floor_fraction * peak);
+    let floor = options.floor_for(peak);
 
     let mut report = DiffReport {
         width: w,
