@@ -129,7 +129,12 @@ impl CheckedRenderer {
     }
 
     pub fn try_new() -> Result<Self, TestingError> {
-        let renderer = Renderer::new(&ContextOptions { validation: true, ..Default::default() })?;
+        Self::try_with(ContextOptions::default())
+    }
+
+    /// A renderer with these options, validation on whatever they say.
+    pub fn try_with(options: ContextOptions) -> Result<Self, TestingError> {
+        let renderer = Renderer::new(&ContextOptions { validation: true, ..options })?;
         let log = renderer.validation_log();
         Ok(Self { renderer: Some(renderer), log })
     }

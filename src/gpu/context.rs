@@ -63,12 +63,22 @@ pub struct ContextOptions {
     /// Where the pipeline cache is kept on disk (`None`: in memory only; the CLI passes
     /// [`super::pipeline_cache::default_dir`] unless `--no-cache`).
     pub pipeline_cache_dir: Option<std::path::PathBuf>,
+    /// Diagnostics only: hand the driver each fragment shader whole, with its specialization constants, instead of
+    /// the module specialized for the pipeline (`sunshade_glsl::specialize`): for measuring what that saves and
+    /// checking that images do not change (`SUNSHADE_WHOLE_SHADERS=1`, tests/startup.rs).
+    pub whole_shaders: bool,
 }
 
 impl ContextOptions {
-    /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`.
+    /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`; whole shaders (diagnostics) when
+    /// `SUNSHADE_WHOLE_SHADERS` is `1`.
     pub fn from_env() -> Self {
-        Self { validation: std::env::var("SUNSHADE_VALIDATION").is_ok_and(|v| v == "1"), ..Default::default() }
+        let on = |k: &str| std::env::var(k).is_ok_and(|v| v == "1");
+        Self {
+            validation: on("SUNSHADE_VALIDATION"),
+            whole_shaders: on("SUNSHADE_WHOLE_SHADERS"),
+            ..Default::default()
+        }
     }
 }
 

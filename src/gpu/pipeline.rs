@@ -1,6 +1,8 @@
 //! The scene pipeline: descriptor layout (materials, lights), push constants, and the graphics pipelines for
-//! dynamic rendering into RGBA32F colour + D32 depth, one per [`ShaderVariant`] in use, created at first use from
-//! the same SPIR-V with different specialization constants and kept.
+//! dynamic rendering into RGBA32F colour + D32 depth, one per [`ShaderVariant`] in use, created at first use and
+//! kept. Each variant's fragment stage is the shader built ahead of time specialized for the variant's constants
+//! ([`sunshade_glsl::specialize`]): the driver is handed only the code the variant can run, since lavapipe compiles
+//! everything a module calls before it folds the constants (docs/platform.md, "What the driver compiles").
 //!
 //! Fixed state: triangle lists, fill, counter-clockwise front faces, depth test LESS with writes, no blending,
 //! one sample. The fragment shader reads materials, lights, and the scene's indices and vertices (to interpolate
@@ -28,13 +30,17 @@ pub(crate) struct ScenePipeline {
     pub descriptor_pool: vk::DescriptorPool,
     pub descriptor_set: vk::DescriptorSet,
     vertex_module: vk::ShaderModule,
-    fragment_module: vk::ShaderModule,
+    /// The fragment stages' SPIR-V as built (specialized per variant when a pipeline is made).
+    fragment_spirv: Vec<u32>,
     /// The fragment shader with shadow rays: by ray queries, or by the shader's walk of the occluders' BVH on
-    /// devices without them (`ray_bvh`); null with the naive-math diagnostic.
-    ray_module: vk::ShaderModule,
+    /// devices without them (`ray_bvh`); empty with the naive-math diagnostic.
+    ray_spirv: Vec<u32>,
     /// The same with the lights' visible fractions by slices (`SUNSHADE_SLICES`): the variants with
     /// `VISIBILITY_SLICES`, so that the grid's do not compile the slices' code.
-    slices_module: vk::ShaderModule,
+    slices_spirv: Vec<u32>,
+    /// Diagnostics: hand the driver the whole module and its specialization constants
+    /// ([`super::context::ContextOptions::whole_shaders`]).
+    whole_shaders: bool,
     ray_bvh: bool,
     with_normals: bool,
     variants: HashMap<ShaderVariant, vk::Pipeline>,
@@ -42,7 +48,7 @@ pub(crate) struct ScenePipeline {
     shadow: vk::Pipeline,
     /// The masked draws' shadow-map fragment stage (alpha test, no colour), and its pipelines per
     /// `SURFACE_*` bits, created at first use.
-    shadow_mask_module: vk::ShaderModule,
+    shadow_mask_spirv: Vec<u32>,
     shadow_masked: HashMap<u32, vk::Pipeline>,
     cache: Option<DiskPipelineCache>,
     /// Variants created since the cache was last saved.
@@ -61,7 +67,9 @@ pub enum ShadowRays {
 impl ScenePipeline {
     /// `with_normals`: the vertex shader also reads the normal (for device interpolation). `cache_dir`: where the
     /// pipeline cache lives on disk (`None`: in memory only). `ray_spirv`: the fragment stage with shadow rays,
-    /// without and with the slices' code (`SUNSHADE_SLICES`), and how it casts them.
+    /// without and with the slices' code (`SUNSHADE_SLICES`), and how it casts them. `whole_shaders`: see the
+    /// field.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         dev: &Arc<Device>,
         vertex_spirv: &[u32],
@@ -70,6 +78,7 @@ impl ScenePipeline {
         ray_spirv: Option<(&[u32], &[u32], ShadowRays)>,
         with_normals: bool,
         cache_dir: Option<&Path>,
+        whole_shaders: bool,
     ) -> Result<Self, GpuError> {
         let d = &dev.device;
         let mut out = Self {
@@ -79,14 +88,15 @@ impl ScenePipeline {
             descriptor_pool: vk::DescriptorPool::null(),
             descriptor_set: vk::DescriptorSet::null(),
             vertex_module: vk::ShaderModule::null(),
-            fragment_module: vk::ShaderModule::null(),
-            ray_module: vk::ShaderModule::null(),
-            slices_module: vk::ShaderModule::null(),
+            fragment_spirv: fragment_spirv.to_vec(),
+            ray_spirv: ray_spirv.map_or(Vec::new(), |(words, _, _)| words.to_vec()),
+            slices_spirv: ray_spirv.map_or(Vec::new(), |(_, sliced, _)| sliced.to_vec()),
+            whole_shaders,
             ray_bvh: matches!(ray_spirv, Some((_, _, ShadowRays::Bvh))),
             with_normals,
             variants: HashMap::new(),
             shadow: vk::Pipeline::null(),
-            shadow_mask_module: vk::ShaderModule::null(),
+            shadow_mask_spirv: shadow_mask_spirv.to_vec(),
             shadow_masked: HashMap::new(),
             cache: None,
             unsaved: false,
@@ -175,20 +185,6 @@ impl ScenePipeline {
             out.vertex_module = d
                 .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(vertex_spirv), None)
                 .vk("vkCreateShaderModule")?;
-            out.fragment_module = d
-                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(fragment_spirv), None)
-                .vk("vkCreateShaderModule")?;
-            out.shadow_mask_module = d
-                .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(shadow_mask_spirv), None)
-                .vk("vkCreateShaderModule")?;
-            if let Some((words, sliced, _)) = ray_spirv {
-                out.ray_module = d
-                    .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)
-                    .vk("vkCreateShaderModule")?;
-                out.slices_module = d
-                    .create_shader_module(&vk::ShaderModuleCreateInfo::default().code(sliced), None)
-                    .vk("vkCreateShaderModule")?;
-            }
             let mut hashed = vec![vertex_spirv, fragment_spirv, shadow_mask_spirv];
             hashed.extend(ray_spirv.iter().flat_map(|&(words, sliced, _)| [words, sliced]));
             let name = pipeline_cache::file_name(&dev.info, pipeline_cache::shader_hash(&hashed));
@@ -221,10 +217,11 @@ impl ScenePipeline {
                     &self.dev.device,
                     cache,
                     self.layout,
-                    (self.vertex_module, vk::ShaderModule::null()),
+                    (self.vertex_module, None),
                     self.with_normals,
                     None,
                     true,
+                    false,
                 )?
             };
             self.unsaved = true;
@@ -247,10 +244,11 @@ impl ScenePipeline {
                 &self.dev.device,
                 cache,
                 self.layout,
-                (self.vertex_module, self.shadow_mask_module),
+                (self.vertex_module, Some(&self.shadow_mask_spirv)),
                 self.with_normals,
                 Some(variant),
                 true,
+                self.whole_shaders,
             )?
         };
         self.shadow_masked.insert(surface, p);
@@ -260,7 +258,7 @@ impl ScenePipeline {
 
     /// Whether pipelines with shadow rays can be made (the device has ray queries).
     pub fn has_shadow_rays(&self) -> bool {
-        self.ray_module != vk::ShaderModule::null()
+        !self.ray_spirv.is_empty()
     }
 
     /// Whether the shadow rays walk the occluders' BVH in the shader (binding 12) rather than query the device's
@@ -293,9 +291,9 @@ impl ScenePipeline {
         }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
-        let (d, layout, with_normals) = (&self.dev.device, self.layout, self.with_normals);
+        let (d, layout, with_normals, whole) = (&self.dev.device, self.layout, self.with_normals, self.whole_shaders);
         let (vertex, fragment, rays, slices) =
-            (self.vertex_module, self.fragment_module, self.ray_module, self.slices_module);
+            (self.vertex_module, &self.fragment_spirv[..], &self.ray_spirv[..], &self.slices_spirv[..]);
         let mut first_error = None;
         for chunk in missing.chunks(threads) {
             let created: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|scope| {
@@ -310,7 +308,16 @@ impl ScenePipeline {
                         // SAFETY: valid device, layout, modules and cache, owned by self and alive for the scope;
                         // vkCreateGraphicsPipelines may be called from several threads at once.
                         scope.spawn(move || unsafe {
-                            create_pipeline(d, cache, layout, (vertex, fs), with_normals, Some(variant), false)
+                            create_pipeline(
+                                d,
+                                cache,
+                                layout,
+                                (vertex, Some(fs)),
+                                with_normals,
+                                Some(variant),
+                                false,
+                                whole,
+                            )
                         })
                     })
                     .collect();
@@ -345,25 +352,62 @@ impl ScenePipeline {
     }
 }
 
+/// A pipeline with the vertex module `vs` and, where given, the fragment stage `fs`'s SPIR-V specialized for
+/// `variant`'s constants (the whole module with the constants where `whole`). `depth_only`: a shadow map's pipeline,
+/// no colour attachment; its fragment stage (`None`: none) only discards.
+#[allow(clippy::too_many_arguments)]
 unsafe fn create_pipeline(
+    d: &ash::Device,
+    cache: vk::PipelineCache,
+    layout: vk::PipelineLayout,
+    (vs, fs): (vk::ShaderModule, Option<&[u32]>),
+    with_normals: bool,
+    variant: Option<ShaderVariant>,
+    depth_only: bool,
+    whole: bool,
+) -> Result<vk::Pipeline, GpuError> {
+    let constants = variant.map_or([0; 8], |v| v.constants());
+    let module = match fs {
+        Some(words) => {
+            let specialized;
+            let code = if whole {
+                words
+            } else {
+                let pairs: Vec<(u32, u32)> = (0u32..).zip(constants).collect();
+                specialized = sunshade_glsl::specialize(words, &pairs).map_err(GpuError::ShaderCompile)?;
+                &specialized[..]
+            };
+            // SAFETY: valid device; SPIR-V built by build.rs, specialized (spirv-val checks both in tests).
+            unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None) }
+                .vk("vkCreateShaderModule")?
+        }
+        None => vk::ShaderModule::null(),
+    };
+    // SAFETY: valid device, modules and layout; the module is no longer needed once the pipeline exists (a null
+    // module is ignored by the destroy call).
+    unsafe {
+        let pipeline = create_pipeline_from(d, cache, layout, (vs, module), with_normals, &constants, depth_only);
+        d.destroy_shader_module(module, None);
+        pipeline
+    }
+}
+
+unsafe fn create_pipeline_from(
     d: &ash::Device,
     cache: vk::PipelineCache,
     layout: vk::PipelineLayout,
     (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
-    variant: Option<ShaderVariant>,
+    constants: &[u32; 8],
     depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.
     unsafe {
-        // `depth_only`: a shadow map's pipeline, no colour attachment; its fragment stage (a null `fs`: none)
-        // only discards.
-        let constants = variant.map_or([0; 8], |v| v.constants());
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();
         let specialization =
-            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(&constants));
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
         let all_stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main"),
             vk::PipelineShaderStageCreateInfo::default()
@@ -442,12 +486,8 @@ impl Drop for ScenePipeline {
             for p in self.variants.drain().map(|(_, p)| p).chain(self.shadow_masked.drain().map(|(_, p)| p)) {
                 d.destroy_pipeline(p, None);
             }
-            d.destroy_shader_module(self.shadow_mask_module, None);
             d.destroy_pipeline(self.shadow, None);
             d.destroy_shader_module(self.vertex_module, None);
-            d.destroy_shader_module(self.fragment_module, None);
-            d.destroy_shader_module(self.ray_module, None);
-            d.destroy_shader_module(self.slices_module, None);
             d.destroy_descriptor_pool(self.descriptor_pool, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

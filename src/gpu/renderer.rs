@@ -221,6 +221,7 @@ impl Renderer {
             rays.as_ref().map(|(words, sliced, kind)| (&words[..], &sliced[..], *kind)),
             interpolation == Interpolation::Device,
             options.pipeline_cache_dir.as_deref(),
+            options.whole_shaders,
         )?;
         let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
