@@ -62,6 +62,8 @@ layout(constant_id = 4) const uint VARIANT_SHADOWS = 0u; // SHADOWS_NONE, SHADOW
 layout(constant_id = 5) const uint VARIANT_SURFACE = 0u; // SURFACE_* bits: what the material needs per pixel
 layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE, QUANTITY_IRRADIANCE or QUANTITY_LIGHT_ROWS
 layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID or VISIBILITY_SLICES, with shadow rays
+layout(constant_id = 8) const uint VARIANT_OCCLUDERS_MASKED = 0u; // with shadow rays: 1 where a material of the scene
+                                                             // is alpha-masked (occluders.glsl's blocks tests it)
 
 // What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
 #define SURFACE_EVAL 1u

@@ -15,6 +15,11 @@
 // triangle that is not alpha-masked; for a masked one, where its alpha at the hit reaches the cutoff
 // (masked_hit_blocks; the texture read at the hit's coordinates, no footprint).
 bool blocks(uvec4 tri, vec2 b) {
+    // Where no material of the scene is masked, every triangle blocks: the alpha test below (a texture lookup)
+    // would be inlined into every shadow ray's traversal for nothing.
+    if (VARIANT_OCCLUDERS_MASKED == 0u) {
+        return true;
+    }
     MaterialGpu material = materials[tri.w & 0x7fffffffu];
     if (material.kind.z == 0u) {
         return true;

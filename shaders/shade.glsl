@@ -315,9 +315,12 @@ SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d
             if (c > 0.0) {
                 float weight = c * h / (dist2 * dist) * radius * radius * sb * sb * bw.y * sw.y;
                 projected += weight;
-                // A sample that contributes casts its shadow ray (|| short-circuits).
-                if (rays == RAYS_NONE || (rays == RAYS_ALONG ? visible_along(p.shadow_origin, omega)
-                                                            : visible_to(p.shadow_origin, p.position + y))) {
+                // A sample that contributes casts its shadow ray (|| short-circuits): visible_along omega, or
+                // visible_to the point p.position + y, as one call of occluded so that the driver inlines one copy
+                // of the ray's traversal (visibility.glsl's sample_visible).
+                bool along = rays == RAYS_ALONG;
+                if (rays == RAYS_NONE || !occluded(p.shadow_origin, along ? omega : (p.position + y) - p.shadow_origin,
+                                                   along ? RAY_T_INFINITE : SEGMENT_T_MAX)) {
                     sum += specular_lobe_rgb(m, p, omega) * weight;
                 }
             }

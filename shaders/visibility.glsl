@@ -186,9 +186,13 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
     return disk_sample(L.x, L.n, L.c, L.d, L.a, L.b, L.radius, xy, ray);
 }
 
-// Whether a grid sample's shadow ray reaches its light.
+// Whether a grid sample's shadow ray reaches its light: visible_to for a disk light's point, visible_along for a
+// direction, written as one call of occluded so that the driver, which inlines every call, compiles one copy of
+// the ray's traversal here instead of two (docs/platform.md, "What the driver compiles"). The arithmetic is
+// theirs: target - origin for a point, the direction itself otherwise.
 bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
-    return L.kind == GRID_LIGHT_DISK ? visible_to(origin, ray) : visible_along(origin, ray);
+    bool to_point = L.kind == GRID_LIGHT_DISK;
+    return !occluded(origin, to_point ? ray - origin : ray, to_point ? SEGMENT_T_MAX : RAY_T_INFINITE);
 }
 
 // Bisection steps that place a visibility edge between two neighbouring corners: ceil(log2 k), at least 1.

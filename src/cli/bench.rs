@@ -87,6 +87,16 @@ pub struct BenchArgs {
     /// --width/--height are given). Its --update regions are "measured-lookup" and "measured-fit".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto"])]
     pub measured: bool,
+    /// What a whole `render` process costs: each scene (default: every model in models/ at 512 × 512 unless
+    /// --width/--height are given, and models/square.gltf at 64 × 64) rendered by --repeat separate processes; the
+    /// medians of the process and of its phases, and each pipeline's SPIR-V size and creation time. Its --update
+    /// region is "startup".
+    #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto", "measured"])]
+    pub startup: bool,
+    /// With --startup: the same processes again with the whole shaders handed to the driver (diagnostics:
+    /// `SUNSHADE_WHOLE_SHADERS=1`), to show what specializing them saves.
+    #[arg(long, requires = "startup")]
+    pub whole_shaders: bool,
     /// With --pareto: draw error against frame time (log-log, the front drawn, each point labelled by its row)
     /// into this PNG, one chart per scene.
     #[arg(long, value_name = "PNG", requires = "pareto")]
@@ -158,6 +168,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         pareto_region(a.visibility_rule)
     } else if a.measured {
         "measured-fit"
+    } else if a.startup {
+        "startup"
     } else {
         ""
     };
@@ -166,6 +178,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.brdf_chart {
         return brdf_chart(a);
+    }
+    if a.startup {
+        return super::bench_startup::run(a);
     }
     if a.shadows {
         return super::bench_shadows::run(a);

@@ -11,6 +11,7 @@ mod bench;
 mod bench_measured;
 mod bench_pareto;
 mod bench_shadows;
+mod bench_startup;
 mod bench_textures;
 mod bench_tolerance;
 mod daylight;

@@ -520,6 +520,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         let lobe_line = super::metadata::lobe_model_line(&job.settings, session.scene_ref(job.scene));
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
+        let created = renderer.take_created_pipelines();
         let info = renderer.device_info();
         eprintln!(
             "sunshade: device {}: {} ({}, {} {}); interpolation {}",
@@ -549,6 +550,14 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         }
         eprintln!("sunshade: {}", job.prediction.line());
         print_exposure(ev);
+        for p in created {
+            eprintln!(
+                "sunshade: pipeline {}: {} SPIR-V instructions, created in {:.1} ms",
+                p.what,
+                p.instructions,
+                p.time.as_secs_f64() * 1e3
+            );
+        }
         match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {
             (None, _) => eprintln!("sunshade: pipeline cache: off"),
             (Some(d), 0) => eprintln!("sunshade: pipeline cache: none yet in {}", d.display()),

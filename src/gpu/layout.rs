@@ -55,7 +55,7 @@ pub const MIP_LINEAR: u32 = 2;
 pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 7). The shader keeps only the code these select; `shadows` also
+/// `shaders/bindings.glsl`, constant ids 0 to 8). The shader keeps only the code these select; `shadows` also
 /// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
@@ -76,11 +76,22 @@ pub struct ShaderVariant {
     /// `VISIBILITY_GRID` or `VISIBILITY_SLICES` with shadow rays (`VISIBILITY_GRID` without: nothing to take), so
     /// that the grid's pipelines leave the slices' code out (on Mesa 25 with ray queries it cost their creation 0.4 s).
     pub visibility: u32,
+    /// With shadow rays, 1 where a material of the scene is alpha-masked (the rays then test their hits' alpha), else
+    /// 0; always 0 without shadow rays, so that such scenes share the other variants.
+    pub occluders_masked: u32,
 }
 
 impl ShaderVariant {
-    /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights.
-    pub fn new(brdf: u32, surface: u32, lights: &Lights, shading: &ShadingOptions, shadows: u32) -> Self {
+    /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights, in a scene that has alpha-masked
+    /// materials or not.
+    pub fn new(
+        brdf: u32,
+        surface: u32,
+        lights: &Lights,
+        shading: &ShadingOptions,
+        shadows: u32,
+        scene_masked: bool,
+    ) -> Self {
         let sun = match (&lights.sun, shading.sun) {
             (None, _) => LIGHT_ABSENT,
             (Some(_), SunModel::Disk) => SUN_DISK,
@@ -100,12 +111,48 @@ impl ShaderVariant {
             crate::shading::VisibilityRule::Slices if shadows == SHADOWS_RAY => VISIBILITY_SLICES,
             _ => VISIBILITY_GRID,
         };
-        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility }
+        let occluders_masked = (shadows == SHADOWS_RAY && scene_masked) as u32;
+        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked }
+    }
+
+    /// The variant in words, for `-v` and the start-up bench: "Ward · disk sun · exact disks · sky · shadow maps ·
+    /// surface 0b00101 · radiance".
+    pub fn describe(&self) -> String {
+        let pick = |v: u32, names: &[&str]| names.get(v as usize).copied().unwrap_or("?").to_string();
+        let mut parts = vec![pick(self.brdf, &["Lambert", "Phong", "Blinn-Phong", "Ward", "measured"])];
+        let lights = [
+            pick(self.sun, &["", "disk sun", "delta sun"]),
+            pick(self.disks, &["", "exact disks", "small-source disks"]),
+            pick(self.sky, &["", "sky"]),
+        ];
+        parts.extend(lights.into_iter().filter(|l| !l.is_empty()));
+        parts.push(match (self.shadows, self.visibility) {
+            (SHADOWS_RAY, VISIBILITY_SLICES) => "shadow rays by slices".into(),
+            (s, _) => pick(s, &["no shadows", "shadow rays", "shadow maps"]),
+        });
+        if self.surface != 0 {
+            parts.push(format!("surface {:#07b}", self.surface));
+        }
+        if self.occluders_masked != 0 {
+            parts.push("alpha-masked occluders".into());
+        }
+        parts.push(pick(self.quantity, &["radiance", "irradiance", "a light's rows"]));
+        parts.join(" · ")
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 8] {
-        [self.brdf, self.sun, self.disks, self.sky, self.shadows, self.surface, self.quantity, self.visibility]
+    pub fn constants(&self) -> [u32; 9] {
+        [
+            self.brdf,
+            self.sun,
+            self.disks,
+            self.sky,
+            self.shadows,
+            self.surface,
+            self.quantity,
+            self.visibility,
+            self.occluders_masked,
+        ]
     }
 }
 
@@ -520,10 +567,11 @@ mod tests {
             "VARIANT_SURFACE",
             "VARIANT_QUANTITY",
             "VARIANT_VISIBILITY",
+            "VARIANT_OCCLUDERS_MASKED",
         ];
         assert_eq!(
             variant_constants.len(),
-            ShaderVariant::new(0, 0, &Default::default(), &Default::default(), 0).constants().len()
+            ShaderVariant::new(0, 0, &Default::default(), &Default::default(), 0, false).constants().len()
         );
         for (id, name) in variant_constants.iter().enumerate() {
             assert!(

@@ -35,4 +35,5 @@ pub mod slice_passes;
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;
 pub use error::{GpuError, VULKAN_PACKAGES};
+pub use pipeline::CreatedPipeline;
 pub use renderer::{FrameTimings, GpuScene, Renderer, SetupTimings};

@@ -23,6 +23,15 @@ use super::pipeline_cache::{self, DiskPipelineCache};
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
+/// A pipeline made for a frame: what it is, the SPIR-V instructions of its fragment stage as the driver got it
+/// (0 for none), and how long the driver took to create it.
+#[derive(Clone, Debug)]
+pub struct CreatedPipeline {
+    pub what: String,
+    pub instructions: usize,
+    pub time: std::time::Duration,
+}
+
 pub(crate) struct ScenePipeline {
     dev: Arc<Device>,
     pub set_layout: vk::DescriptorSetLayout,
@@ -53,6 +62,8 @@ pub(crate) struct ScenePipeline {
     cache: Option<DiskPipelineCache>,
     /// Variants created since the cache was last saved.
     unsaved: bool,
+    /// Pipelines created since [`Self::take_created`] was last called.
+    created: Vec<CreatedPipeline>,
 }
 
 /// How the fragment shader with shadow rays casts them: by the device's ray queries (`SUNSHADE_RAY_QUERY`,
@@ -100,6 +111,7 @@ impl ScenePipeline {
             shadow_masked: HashMap::new(),
             cache: None,
             unsaved: false,
+            created: Vec::new(),
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
@@ -212,7 +224,7 @@ impl ScenePipeline {
         if self.shadow == vk::Pipeline::null() {
             let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
             // SAFETY: valid device, layout, module and cache owned by self.
-            self.shadow = unsafe {
+            let (pipeline, made) = unsafe {
                 create_pipeline(
                     &self.dev.device,
                     cache,
@@ -224,6 +236,8 @@ impl ScenePipeline {
                     false,
                 )?
             };
+            self.shadow = pipeline;
+            self.created.push(CreatedPipeline { what: "shadow-map depth pass".into(), ..made });
             self.unsaved = true;
         }
         Ok(self.shadow)
@@ -236,10 +250,19 @@ impl ScenePipeline {
             return Ok(p);
         }
         let cache = self.cache.as_ref().map_or(vk::PipelineCache::null(), |c| c.cache);
-        let variant =
-            ShaderVariant { brdf: 0, sun: 0, disks: 0, sky: 0, shadows: 0, surface, quantity: 0, visibility: 0 };
+        let variant = ShaderVariant {
+            brdf: 0,
+            sun: 0,
+            disks: 0,
+            sky: 0,
+            shadows: 0,
+            surface,
+            quantity: 0,
+            visibility: 0,
+            occluders_masked: 0,
+        };
         // SAFETY: valid device, layout, modules and cache owned by self.
-        let p = unsafe {
+        let (p, made) = unsafe {
             create_pipeline(
                 &self.dev.device,
                 cache,
@@ -251,6 +274,8 @@ impl ScenePipeline {
                 self.whole_shaders,
             )?
         };
+        self.created
+            .push(CreatedPipeline { what: format!("shadow-map alpha-masked pass · surface {surface:#07b}"), ..made });
         self.shadow_masked.insert(surface, p);
         self.unsaved = true;
         Ok(p)
@@ -296,7 +321,7 @@ impl ScenePipeline {
             (self.vertex_module, &self.fragment_spirv[..], &self.ray_spirv[..], &self.slices_spirv[..]);
         let mut first_error = None;
         for chunk in missing.chunks(threads) {
-            let created: Vec<Result<vk::Pipeline, GpuError>> = std::thread::scope(|scope| {
+            let created: Vec<Result<(vk::Pipeline, CreatedPipeline), GpuError>> = std::thread::scope(|scope| {
                 let handles: Vec<_> = chunk
                     .iter()
                     .map(|&variant| {
@@ -331,8 +356,9 @@ impl ScenePipeline {
             // Every pipeline made is kept (and destroyed with the others), whatever failed beside it.
             for (&variant, result) in chunk.iter().zip(created) {
                 match result {
-                    Ok(p) => {
+                    Ok((p, made)) => {
                         self.variants.insert(variant, p);
+                        self.created.push(CreatedPipeline { what: variant.describe(), ..made });
                         self.unsaved = true;
                     }
                     Err(e) => first_error = first_error.or(Some(e)),
@@ -340,6 +366,11 @@ impl ScenePipeline {
             }
         }
         first_error.map_or(Ok(()), Err)
+    }
+
+    /// The pipelines created since the last call, oldest first.
+    pub fn take_created(&mut self) -> Vec<CreatedPipeline> {
+        std::mem::take(&mut self.created)
     }
 
     /// The pipelines of `variants`, in their order, those that do not exist yet created together
@@ -365,8 +396,10 @@ unsafe fn create_pipeline(
     variant: Option<ShaderVariant>,
     depth_only: bool,
     whole: bool,
-) -> Result<vk::Pipeline, GpuError> {
-    let constants = variant.map_or([0; 8], |v| v.constants());
+) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
+    let started = std::time::Instant::now();
+    let constants = variant.map_or([0; 9], |v| v.constants());
+    let mut instructions = 0;
     let module = match fs {
         Some(words) => {
             let specialized;
@@ -377,6 +410,7 @@ unsafe fn create_pipeline(
                 specialized = sunshade_glsl::specialize(words, &pairs).map_err(GpuError::ShaderCompile)?;
                 &specialized[..]
             };
+            instructions = sunshade_glsl::instruction_count(code).map_err(GpuError::ShaderCompile)?;
             // SAFETY: valid device; SPIR-V built by build.rs, specialized (spirv-val checks both in tests).
             unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None) }
                 .vk("vkCreateShaderModule")?
@@ -388,7 +422,8 @@ unsafe fn create_pipeline(
     unsafe {
         let pipeline = create_pipeline_from(d, cache, layout, (vs, module), with_normals, &constants, depth_only);
         d.destroy_shader_module(module, None);
-        pipeline
+        let made = CreatedPipeline { what: String::new(), instructions, time: started.elapsed() };
+        pipeline.map(|p| (p, made))
     }
 }
 
@@ -398,7 +433,7 @@ unsafe fn create_pipeline_from(
     layout: vk::PipelineLayout,
     (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
-    constants: &[u32; 8],
+    constants: &[u32; 9],
     depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.

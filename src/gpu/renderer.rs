@@ -18,7 +18,7 @@ use super::layout::{
     MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_DISK,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
-use super::pipeline::{ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
+use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
 use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
@@ -95,6 +95,9 @@ pub struct GpuScene {
     draws: Vec<Draw>,
     /// Whether any triangle can occlude a light from a visible surface (`visibility::can_occlude`).
     can_occlude: bool,
+    /// Whether a material of the scene is alpha-masked (`Scene::has_alpha_masks`): shadow rays then test their
+    /// hits' alpha (the variants' `occluders_masked`).
+    masked: bool,
     /// The scene's bounds (the sun's shadow map is fitted to them).
     bounds: Option<crate::scene::Aabb>,
     /// The fewest rows (`sky_slices::slice_rows`) at which a frame of this scene that sliced the sun and disk lights
@@ -252,6 +255,12 @@ impl Renderer {
     /// How the fragment shader interpolates.
     pub fn interpolation(&self) -> Interpolation {
         self.interpolation
+    }
+
+    /// The pipelines created since the last call (by the frames rendered since), oldest first: what each is, its
+    /// fragment stage's size and its creation time (`render -v`, `bench --startup`).
+    pub fn take_created_pipelines(&mut self) -> Vec<CreatedPipeline> {
+        self.pipeline.take_created()
     }
 
     pub fn setup_timings(&self) -> SetupTimings {
@@ -459,6 +468,7 @@ impl Renderer {
             // Decided here, once per upload (24 ms for 20k triangles): `auto` renders no shadow pass where it is
             // false, on any device.
             can_occlude: crate::visibility::can_occlude(scene),
+            masked,
             bounds: scene.bounds(),
         })
     }
@@ -596,7 +606,7 @@ impl Renderer {
             .iter()
             .map(|draw| {
                 let shading = settings.shading_for(draw.material as usize);
-                ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &shading, shadows)
+                ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &shading, shadows, scene.masked)
             })
             .collect();
         let draw_pipelines = self.pipeline.pipelines_of(&variants)?;

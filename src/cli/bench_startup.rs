@@ -1,0 +1,179 @@
+//! `sunshade bench --startup`: what a whole `sunshade render` process costs, and where the time goes. Each scene is
+//! rendered by `--repeat` separate processes (as users run it, once per image); the table gives the medians of the
+//! process's wall time and of its phases (from `-v`), the process against the phases that make the image (render,
+//! readback, encode), and the pipelines the driver created: each variant's SPIR-V size and creation time. With
+//! `--whole-shaders` the same processes run again handing the driver the whole shaders (`SUNSHADE_WHOLE_SHADERS=1`),
+//! to show what specializing them saves. Its --update region is "startup".
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use super::bench::{build, default_scenes, median, ms, BenchArgs};
+use super::generated::{machine, print_output, today, update_region};
+use super::CliError;
+
+/// One scene's run: the scene, its size, and the flags beyond `--width`/`--height`.
+struct Case {
+    scene: PathBuf,
+    size: (u32, u32),
+}
+
+/// What one process printed and took.
+#[derive(Default)]
+struct Run {
+    wall: Duration,
+    phases: BTreeMap<String, f64>,
+    /// (what, SPIR-V instructions, creation time [ms]).
+    pipelines: Vec<(String, usize, f64)>,
+    device: String,
+}
+
+fn cases(a: &BenchArgs) -> Result<Vec<Case>, CliError> {
+    let size = (a.width.unwrap_or(512), a.height.unwrap_or(512));
+    if !a.scenes.is_empty() {
+        return Ok(a.scenes.iter().map(|s| Case { scene: s.clone(), size }).collect());
+    }
+    let mut v: Vec<Case> = default_scenes()?.into_iter().map(|scene| Case { scene, size }).collect();
+    // Two triangles, nothing to shadow: the process with the least to do.
+    v.push(Case { scene: Path::new("models").join("square.gltf"), size: (64, 64) });
+    Ok(v)
+}
+
+fn run_once(case: &Case, whole: bool) -> Result<Run, CliError> {
+    let exe = std::env::current_exe()?;
+    let out = std::env::temp_dir().join(format!("sunshade-bench-startup-{}.png", std::process::id()));
+    let mut command = Command::new(&exe);
+    command.arg("render").arg(&case.scene).arg("-o").arg(&out);
+    command.args(["--width", &case.size.0.to_string(), "--height", &case.size.1.to_string(), "-v"]);
+    if whole {
+        command.env("SUNSHADE_WHOLE_SHADERS", "1");
+    } else {
+        command.env_remove("SUNSHADE_WHOLE_SHADERS");
+    }
+    let t = Instant::now();
+    let o = command.output()?;
+    let wall = t.elapsed();
+    let _ = std::fs::remove_file(&out);
+    if !o.status.success() {
+        return Err(CliError::Failure(anyhow::anyhow!(
+            "{}: render failed: {}",
+            case.scene.display(),
+            String::from_utf8_lossy(&o.stderr).trim()
+        )));
+    }
+    let mut run = Run { wall, ..Default::default() };
+    for line in String::from_utf8_lossy(&o.stderr).lines() {
+        if let Some(rest) = line.strip_prefix("sunshade: pipeline ") {
+            // "WHAT: N SPIR-V instructions, created in X ms"
+            let parsed = rest.rsplit_once(": ").and_then(|(what, tail)| {
+                let (n, t) = tail.split_once(" SPIR-V instructions, created in ")?;
+                Some((what.to_string(), n.parse().ok()?, t.strip_suffix(" ms")?.parse().ok()?))
+            });
+            run.pipelines.extend(parsed);
+        } else if let Some(rest) = line.strip_prefix("sunshade: device ") {
+            run.device = rest.split_once(": ").map_or(rest, |(_, d)| d).to_string();
+        } else if !line.starts_with("sunshade:") {
+            let phase = line.trim().strip_suffix(" ms").and_then(|v| {
+                let (name, num) = v.rsplit_once(' ')?;
+                Some((name.trim().to_string(), num.trim().parse::<f64>().ok()?))
+            });
+            run.phases.extend(phase);
+        }
+    }
+    Ok(run)
+}
+
+fn median_f64(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// The median of a phase over runs (0 where a run did not print it).
+fn phase(runs: &[Run], name: &str) -> f64 {
+    median_f64(runs.iter().map(|r| r.phases.get(name).copied().unwrap_or(0.0)).collect())
+}
+
+pub fn run(a: &BenchArgs) -> Result<(), CliError> {
+    let cases = cases(a)?;
+    let mut rows = String::new();
+    // Variant -> (instructions, creation times, whole-shader creation times).
+    let mut variants: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let mut device = String::new();
+    for case in &cases {
+        let mut runs = Vec::new();
+        for _ in 0..a.repeat {
+            runs.push(run_once(case, false)?);
+        }
+        let mut whole_runs = Vec::new();
+        for _ in 0..if a.whole_shaders { a.repeat } else { 0 } {
+            whole_runs.push(run_once(case, true)?);
+        }
+        device = runs[0].device.clone();
+        for r in &runs {
+            for (what, n, t) in &r.pipelines {
+                let e = variants.entry(what.clone()).or_insert((*n, Vec::new(), Vec::new()));
+                e.1.push(*t);
+            }
+        }
+        for r in &whole_runs {
+            for (what, _, t) in &r.pipelines {
+                variants.entry(what.clone()).or_insert((0, Vec::new(), Vec::new())).2.push(*t);
+            }
+        }
+        let process = ms(median(runs.iter().map(|r| r.wall).collect()));
+        let image = phase(&runs, "render") + phase(&runs, "readback") + phase(&runs, "encode");
+        let slowest = runs[0]
+            .pipelines
+            .iter()
+            .map(|(what, _, _)| {
+                let t = median_f64(
+                    runs.iter().filter_map(|r| r.pipelines.iter().find(|p| &p.0 == what).map(|p| p.2)).collect(),
+                );
+                (t, what.clone())
+            })
+            .max_by(|x, y| x.0.total_cmp(&y.0));
+        let whole = if a.whole_shaders { format!(" {:.0} |", phase(&whole_runs, "pipelines")) } else { String::new() };
+        rows += &format!(
+            "| {} | {}×{} | {process:.0} | {:.1} | {:.1} |{whole} {image:.1} | {:.2} | {} |\n",
+            case.scene.display(),
+            case.size.0,
+            case.size.1,
+            phase(&runs, "instance"),
+            phase(&runs, "pipelines"),
+            if image > 0.0 { process / image } else { f64::NAN },
+            slowest.map_or("none".into(), |(t, what)| format!("{t:.1} ({what})")),
+        );
+    }
+    let mut out = format!(
+        "Measured by `sunshade bench --startup` on {}: {}; Vulkan device {device}; {} build; median of {} processes \
+         each.\n\n",
+        today(),
+        machine(),
+        build(),
+        a.repeat
+    );
+    let whole_title = if a.whole_shaders { " pipelines, whole shaders [ms] |" } else { "" };
+    let whole_rule = if a.whole_shaders { "---:|" } else { "" };
+    out += &format!(
+        "| scene | pixels | process [ms] | instance [ms] | pipelines [ms] |{whole_title} render + readback + encode [ms] \
+         | process ÷ image phases | slowest pipeline [ms] |\n|---|---|---:|---:|---:|{whole_rule}---:|---:|---|\n"
+    );
+    out += &rows;
+    out += &format!(
+        "\n| pipeline | SPIR-V instructions | created in [ms] |{}\n|---|---:|---:|{}\n",
+        if a.whole_shaders { " whole shader [ms] |" } else { "" },
+        if a.whole_shaders { "---:|" } else { "" }
+    );
+    for (what, (n, times, whole)) in variants {
+        let w = if a.whole_shaders { format!(" {:.1} |", median_f64(whole)) } else { String::new() };
+        out += &format!("| {what} | {n} | {:.1} |{w}\n", median_f64(times));
+    }
+    print_output(&out, a.json);
+    for doc in &a.update {
+        update_region(doc, "startup", &out)?;
+        eprintln!("sunshade bench: updated {}", doc.display());
+    }
+    Ok(())
+}
