@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models bench bench-batch bench-daylight docs images clean
+.PHONY: setup build render test lint models bench bench-batch bench-startup bench-daylight docs images clean
 
 setup:
 	@./scripts/setup.sh
@@ -21,7 +21,7 @@ test: setup
 	$(CARGO) test --release --workspace
 	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
 		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
-		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli --test measured -- gpu_ ray_quer; \
+		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli --test measured --test startup -- gpu_ ray_quer; \
 	else \
 		echo "make test: SKIPPED the ray-query tests: scripts/lavapipe-rt.sh could not install Mesa 25's lavapipe (above)"; \
 	fi
@@ -34,12 +34,18 @@ lint:
 # Regenerates the measured figures in README.md and docs/accuracy.md (on this machine; the tables name it).
 bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
+	$(SUNSHADE) bench --startup --repeat 5 --update README.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
 	$(SUNSHADE) bench --textures --repeat 5 --update docs/textures.md
 	$(SUNSHADE) bench --measured --repeat 5 --update docs/measured.md
 	$(SUNSHADE) bench --pareto --repeat 5 --update docs/accuracy.md --plot docs/images/pareto.png
 	eval "$$(scripts/lavapipe-rt.sh)" && $(SUNSHADE) bench --pareto models/brdfs.glb --repeat 5 --plot docs/images/pareto-brdfs.png
+
+# Start-up: every model's whole render process, 5 processes each, with each pipeline's size and creation time
+# (README "Start-up").
+bench-startup: build
+	$(SUNSHADE) bench --startup --repeat 5 --update README.md
 
 # Throughput: 30 renders as processes against one batch, and a whole render process against its frame phases.
 bench-batch: build
