@@ -156,19 +156,23 @@ pub fn level_count(width: u32, height: u32) -> usize {
 /// it spreads over three texels, so no texel is dropped and every level keeps the image's mean. Computed
 /// separably in f64 (rows, then columns) from linear texels, rounded once to f32.
 pub fn mip_chain(level0: Level) -> Vec<Level> {
+    use rayon::prelude::*;
     let count = level_count(level0.width, level0.height);
     let mut levels = vec![level0];
     while levels.len() < count {
         let prev = levels.last().expect("level 0 is there");
         let (w, h) = ((prev.width / 2).max(1), (prev.height / 2).max(1));
+        // Rows in parallel: each texel is computed alone, so the result does not depend on the order.
         let across: Vec<[f64; 4]> = (0..prev.height)
-            .flat_map(|y| {
+            .into_par_iter()
+            .flat_map_iter(|y| {
                 let row = &prev.texels[(y * prev.width) as usize..((y + 1) * prev.width) as usize];
                 (0..w).map(move |i| box_filter(prev.width, w, i, |s| row[s].map(f64::from)))
             })
             .collect();
         let texels = (0..h)
-            .flat_map(|j| {
+            .into_par_iter()
+            .flat_map_iter(|j| {
                 let across = &across;
                 (0..w).map(move |i| {
                     box_filter(prev.height, h, j, |s| across[s * w as usize + i as usize]).map(|v| v as f32)
