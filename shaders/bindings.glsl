@@ -51,9 +51,10 @@ bool slices_overflowed = false;
 #define READ_DISKS 4u
 
 // The pipeline variant (specialization constants, from gpu::layout::ShaderVariant): the BRDF of the draw's
-// material, and which lights the frame has with which model. Code for anything else is removed when the pipeline
-// is created. That matters: on lavapipe, code present in the shader costs time even where no pixel runs it
-// (docs/accuracy.md, "Pipeline variants").
+// material, and which lights the frame has with which model. Code for anything else is removed before the driver
+// sees the module (sunshade_glsl::specialize), since lavapipe compiles every function a shader calls before it
+// folds these constants (docs/platform.md, "What the driver compiles"), and code present in the shader also costs
+// time where no pixel runs it (docs/accuracy.md, "Pipeline variants").
 layout(constant_id = 0) const uint VARIANT_BRDF = 0u;  // BRDF_*
 layout(constant_id = 1) const uint VARIANT_SUN = 0u;   // LIGHT_ABSENT, SUN_DISK or SUN_DELTA
 layout(constant_id = 2) const uint VARIANT_DISKS = 0u; // LIGHT_ABSENT, DISKS_EXACT or DISKS_SMALL_SOURCE
