@@ -1,6 +1,6 @@
 //! GLSL → SPIR-V with shaderc, for sunshade's build script (shaders compiled ahead of time) and for its run-time
 //! compilation (`SUNSHADE_SHADER_DIR`, development): one function, so both produce the same words. And
-//! [`specialize`]: a module cut down to what one set of specialization constants can run, for the driver.
+//! [`specialize()`]: a module cut down to what one set of specialization constants can run, for the driver.
 //!
 //! `#include "name.glsl"` resolves against the given sources, so no file system is needed.
 //! A compile error reports the file and line (shaderc's `file:line: error: ...`).
