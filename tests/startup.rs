@@ -289,22 +289,8 @@ fn specialized(stage: &str, defines: &[&str], constants: [u32; 9]) -> Vec<u32> {
     sunshade_glsl::specialize(&words, &constants_of(constants)).unwrap_or_else(|e| panic!("{stage} {defines:?}: {e}"))
 }
 
-/// `spirv-val` (Debian's spirv-tools, installed by scripts/setup.sh) on a module, with Vulkan 1.3's rules.
 fn spirv_val(words: &[u32], what: &str) {
-    let dir = common::TempDir::new("spirv-val");
-    let path = dir.path("module.spv");
-    std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
-    let out = std::process::Command::new("spirv-val")
-        .args(["--target-env", "vulkan1.3"])
-        .arg(&path)
-        .output()
-        .expect("spirv-val not found: install spirv-tools (make setup)");
-    assert!(
-        out.status.success(),
-        "{what}: spirv-val: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    sunshade_glsl::spirv_val(words).unwrap_or_else(|e| panic!("{what}: {e}"));
 }
 
 #[test]

@@ -43,3 +43,22 @@ pub fn compile(name: &str, sources: &[(&str, &str)], defines: &[&str]) -> Result
 
 pub mod specialize;
 pub use specialize::{instruction_count, specialize};
+
+/// Runs Debian's `spirv-val` (package spirv-tools, installed by sunshade's `make setup`) on a module with Vulkan
+/// 1.3's rules: `Err` holds its message, or says that the tool is missing. For tests.
+pub fn spirv_val(words: &[u32]) -> Result<(), String> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let path = std::env::temp_dir().join(format!("sunshade-spirv-val-{}-{n}.spv", std::process::id()));
+    std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let out = std::process::Command::new("spirv-val").args(["--target-env", "vulkan1.3"]).arg(&path).output();
+    let _ = std::fs::remove_file(&path);
+    let out = out.map_err(|e| format!("spirv-val: {e} (install spirv-tools: make setup)"))?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(format!("spirv-val: {}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)))
+    }
+}

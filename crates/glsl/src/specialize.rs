@@ -551,25 +551,8 @@ void main() {
             .collect()
     }
 
-    /// `spirv-val` (Debian's spirv-tools, installed by scripts/setup.sh) on a module: Vulkan 1.3 rules.
-    pub(crate) fn spirv_val(words: &[u32]) {
-        let dir = std::env::temp_dir().join(format!("sunshade-specialize-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path =
-            dir.join(format!("{:x}.spv", words.len() as u64 * 31 + words.iter().map(|&w| w as u64).sum::<u64>()));
-        std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
-        let out = std::process::Command::new("spirv-val")
-            .args(["--target-env", "vulkan1.3"])
-            .arg(&path)
-            .output()
-            .expect("spirv-val not found: install spirv-tools (scripts/setup.sh)");
-        let _ = std::fs::remove_file(&path);
-        assert!(
-            out.status.success(),
-            "spirv-val: {}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
+    fn spirv_val(words: &[u32]) {
+        crate::spirv_val(words).unwrap_or_else(|e| panic!("{e}"));
     }
 
     #[test]
