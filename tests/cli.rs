@@ -388,6 +388,24 @@ fn batch_renders_like_render_goes_on_after_a_failure_and_shards() {
 }
 
 #[test]
+fn test_suites_update_creates_the_goldens_folders() {
+    let dir = TempDir::new("suite-folders");
+    dir.write("scene.glb", &scene());
+    let suite = dir.path("suite.json");
+    let cases = json!({ "cases": [
+        { "name": "a", "scene": "scene.glb", "width": 16, "height": 12, "golden": "goldens/new/a.exr" },
+        { "name": "b", "scene": "scene.glb", "width": 16, "height": 12, "golden": "b.exr" }
+    ]});
+    std::fs::write(&suite, cases.to_string()).unwrap();
+    let o = sunshade(&["test", s(&suite), "--update"]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(out.contains("UPDATED a") && out.contains("UPDATED b"), "{out}{}", stderr(&o));
+    assert!(dir.path("goldens/new/a.exr").exists() && dir.path("b.exr").exists());
+    let o = sunshade(&["test", s(&suite)]);
+    assert!(o.status.success(), "{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
+}
+
+#[test]
 fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     let dir = TempDir::new("suite");
     dir.write("scene.glb", &scene());

@@ -240,10 +240,16 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             image
         }
         Expected::Golden(path) if a.update => {
-            outcome.status = match write_image(&job.image, path, Exposure::Auto) {
-                Ok(_) => Status::Updated,
-                Err(e) => Status::Error(e.to_string()),
-            };
+            // The golden's folder is made where it does not exist yet (a suite's first --update).
+            let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
+            let made = folder.map_or(Ok(()), |f| {
+                std::fs::create_dir_all(f).map_err(|e| format!("{}: cannot create the folder: {e}", f.display()))
+            });
+            outcome.status =
+                match made.and_then(|_| write_image(&job.image, path, Exposure::Auto).map_err(|e| e.to_string())) {
+                    Ok(_) => Status::Updated,
+                    Err(e) => Status::Error(e),
+                };
             return outcome;
         }
         Expected::Golden(path) if !path.exists() => {
