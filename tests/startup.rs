@@ -17,8 +17,8 @@ const ALL_SURFACE: u32 = SURFACE_EVAL | SURFACE_NORMAL_MAP | SURFACE_EMISSION | 
 const F64: &str = "SUNSHADE_F64_BARYCENTRICS";
 
 /// A variant: a name for messages, the stage and `#define`s of its module, its constants (`ShaderVariant`'s order:
-/// brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked) and its budget in SPIR-V instructions after
-/// specialization. The budgets are the sizes measured when they were recorded plus about 10%.
+/// brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked) and its budget in SPIR-V
+/// instructions after specialization: the size recorded with it plus about 10%.
 struct Pinned {
     name: &'static str,
     stage: &'static str,
