@@ -258,6 +258,30 @@ fn bench_reports_and_updates_a_marked_region() {
 }
 
 #[test]
+fn bench_times_whole_processes_and_names_their_pipelines() {
+    let dir = TempDir::new("cli-bench-process");
+    let input = dir.write("scene.glb", &scene());
+    let size = ["--width", "16", "--height", "16", "--repeat", "1"];
+    let mut args = vec!["bench", s(&input), "--process-runs", "1"];
+    args.extend_from_slice(&size);
+    let o = sunshade(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    // The phases only: each pipeline's own line of `-v` is not one.
+    assert!(out.contains("Phases (median, from `-v`):") && out.contains(" pipelines "), "{out}");
+    assert!(!out.contains("sunshade:") && !out.contains("SPIR-V"), "{out}");
+    let mut args = vec!["bench", "--startup", s(&input)];
+    args.extend_from_slice(&size);
+    let o = sunshade(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        out.contains("| pipeline | SPIR-V instructions | created in [ms] |") && out.contains("| Lambert · "),
+        "{out}"
+    );
+}
+
+#[test]
 fn disk_light_and_sky_flags_light_a_floor_as_the_formulas_say() {
     let dir = TempDir::new("cli-lights");
     let mut b = GltfBuilder::new();

@@ -437,44 +437,56 @@ pub(super) fn default_scenes() -> Result<Vec<PathBuf>, CliError> {
 }
 
 /// Times the whole `sunshade render` process and its `-v` phases.
-fn process_timing(scene: &Path, width: u32, height: u32, runs: u32) -> Result<String, CliError> {
-    let exe = std::env::current_exe()?;
+/// One whole `sunshade render SCENE -o TMP --width W --height H -v` process, as users run it: its wall time and
+/// what it printed on stderr. `whole_shaders`: with `SUNSHADE_WHOLE_SHADERS=1` (diagnostics), else without it.
+pub(super) fn render_process(
+    scene: &Path,
+    (width, height): (u32, u32),
+    whole_shaders: bool,
+) -> Result<(Duration, String), CliError> {
     let out = std::env::temp_dir().join(format!("sunshade-bench-{}.png", std::process::id()));
-    let (w, h) = (width.to_string(), height.to_string());
+    let mut command = Command::new(std::env::current_exe()?);
+    command.arg("render").arg(scene).arg("-o").arg(&out);
+    command.args(["--width", &width.to_string(), "--height", &height.to_string(), "-v"]);
+    if whole_shaders {
+        command.env("SUNSHADE_WHOLE_SHADERS", "1");
+    } else {
+        command.env_remove("SUNSHADE_WHOLE_SHADERS");
+    }
+    let t = Instant::now();
+    let o = command.output()?;
+    let wall = t.elapsed();
+    let _ = std::fs::remove_file(&out);
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    if !o.status.success() {
+        return Err(CliError::Failure(anyhow::anyhow!("{}: render failed: {}", scene.display(), stderr.trim())));
+    }
+    Ok((wall, stderr))
+}
+
+/// A phase line of `render -v` ("  pipelines   24.08 ms"): its name and milliseconds. `None` for other lines,
+/// among them the `sunshade: ...` lines that end in milliseconds too (each pipeline's creation time).
+pub(super) fn phase_line(line: &str) -> Option<(String, f64)> {
+    if line.starts_with("sunshade:") {
+        return None;
+    }
+    let (name, num) = line.trim().strip_suffix(" ms")?.rsplit_once(' ')?;
+    Some((name.trim().to_string(), num.trim().parse().ok()?))
+}
+
+pub(super) fn median_f64(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+fn process_timing(scene: &Path, width: u32, height: u32, runs: u32) -> Result<String, CliError> {
     let mut wall = Vec::new();
     let mut phases: Vec<Vec<(String, f64)>> = Vec::new();
     for _ in 0..runs {
-        let t = Instant::now();
-        let o = Command::new(&exe)
-            .args([
-                "render",
-                &scene.display().to_string(),
-                "-o",
-                &out.display().to_string(),
-                "--width",
-                &w,
-                "--height",
-                &h,
-                "-v",
-            ])
-            .output()?;
-        wall.push(t.elapsed());
-        if !o.status.success() {
-            return Err(CliError::Failure(anyhow::anyhow!("render failed: {}", String::from_utf8_lossy(&o.stderr))));
-        }
-        phases.push(
-            String::from_utf8_lossy(&o.stderr)
-                .lines()
-                .filter_map(|l| {
-                    let l = l.trim();
-                    let v = l.strip_suffix(" ms")?;
-                    let (name, num) = v.rsplit_once(' ')?;
-                    Some((name.trim().to_string(), num.trim().parse().ok()?))
-                })
-                .collect(),
-        );
+        let (t, stderr) = render_process(scene, (width, height), false)?;
+        wall.push(t);
+        phases.push(stderr.lines().filter_map(phase_line).collect());
     }
-    let _ = std::fs::remove_file(&out);
     let mut s = format!(
         "Whole process, `sunshade render {} -o t.png --width {width} --height {height}`: median **{:.0} ms** of {runs} runs. \
          Phases (median, from `-v`):",
@@ -483,10 +495,8 @@ fn process_timing(scene: &Path, width: u32, height: u32, runs: u32) -> Result<St
     );
     if let Some(first) = phases.first() {
         for (name, _) in first {
-            let mut v: Vec<f64> =
-                phases.iter().filter_map(|p| p.iter().find(|(n, _)| n == name).map(|(_, t)| *t)).collect();
-            v.sort_by(f64::total_cmp);
-            s += &format!(" {name} {:.1} ms;", v[v.len() / 2]);
+            let v = phases.iter().filter_map(|p| p.iter().find(|(n, _)| n == name).map(|(_, t)| *t)).collect();
+            s += &format!(" {name} {:.1} ms;", median_f64(v));
         }
     }
     s.pop();

@@ -7,10 +7,9 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use super::bench::{build, default_scenes, median, ms, BenchArgs};
+use super::bench::{build, default_scenes, median, median_f64, ms, phase_line, render_process, BenchArgs};
 use super::generated::{machine, print_output, today, update_region};
 use super::CliError;
 
@@ -42,29 +41,9 @@ fn cases(a: &BenchArgs) -> Result<Vec<Case>, CliError> {
 }
 
 fn run_once(case: &Case, whole: bool) -> Result<Run, CliError> {
-    let exe = std::env::current_exe()?;
-    let out = std::env::temp_dir().join(format!("sunshade-bench-startup-{}.png", std::process::id()));
-    let mut command = Command::new(&exe);
-    command.arg("render").arg(&case.scene).arg("-o").arg(&out);
-    command.args(["--width", &case.size.0.to_string(), "--height", &case.size.1.to_string(), "-v"]);
-    if whole {
-        command.env("SUNSHADE_WHOLE_SHADERS", "1");
-    } else {
-        command.env_remove("SUNSHADE_WHOLE_SHADERS");
-    }
-    let t = Instant::now();
-    let o = command.output()?;
-    let wall = t.elapsed();
-    let _ = std::fs::remove_file(&out);
-    if !o.status.success() {
-        return Err(CliError::Failure(anyhow::anyhow!(
-            "{}: render failed: {}",
-            case.scene.display(),
-            String::from_utf8_lossy(&o.stderr).trim()
-        )));
-    }
+    let (wall, stderr) = render_process(&case.scene, case.size, whole)?;
     let mut run = Run { wall, ..Default::default() };
-    for line in String::from_utf8_lossy(&o.stderr).lines() {
+    for line in stderr.lines() {
         if let Some(rest) = line.strip_prefix("sunshade: pipeline ") {
             // "WHAT: N SPIR-V instructions, created in X ms"
             let parsed = rest.rsplit_once(": ").and_then(|(what, tail)| {
@@ -74,20 +53,11 @@ fn run_once(case: &Case, whole: bool) -> Result<Run, CliError> {
             run.pipelines.extend(parsed);
         } else if let Some(rest) = line.strip_prefix("sunshade: device ") {
             run.device = rest.split_once(": ").map_or(rest, |(_, d)| d).to_string();
-        } else if !line.starts_with("sunshade:") {
-            let phase = line.trim().strip_suffix(" ms").and_then(|v| {
-                let (name, num) = v.rsplit_once(' ')?;
-                Some((name.trim().to_string(), num.trim().parse::<f64>().ok()?))
-            });
-            run.phases.extend(phase);
+        } else {
+            run.phases.extend(phase_line(line));
         }
     }
     Ok(run)
-}
-
-fn median_f64(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// The median of a phase over runs (0 where a run did not print it).
