@@ -209,7 +209,7 @@ fn successors(term: Inst<'_>, known: &HashMap<u32, u32>) -> Vec<u32> {
 fn analyse(
     insts: &[Inst<'_>],
     functions: &[Function],
-    known: &mut HashMap<u32, u32>,
+    mut known: HashMap<u32, u32>,
     tracked: &HashSet<u32>,
 ) -> Analysis {
     let by_id: HashMap<u32, &Function> = functions.iter().map(|f| (f.id, f)).collect();
@@ -232,7 +232,7 @@ fn analyse(
             reachable.insert(first.label);
             while let Some(label) = stack.pop() {
                 let Some(block) = index.get(&label) else { continue };
-                for next in successors(insts[block.end - 1], known) {
+                for next in successors(insts[block.end - 1], &known) {
                     edges.insert((label, next));
                     if reachable.insert(next) {
                         stack.push(next);
@@ -269,7 +269,7 @@ fn analyse(
             }
         }
         if known.len() == before {
-            return Analysis { known: known.clone(), edges, reachable, live_functions: live };
+            return Analysis { known, edges, reachable, live_functions: live };
         }
     }
 }
@@ -361,7 +361,7 @@ pub fn specialize(words: &[u32], constants: &[(u32, u32)]) -> Result<Vec<u32>, S
         n += 1;
         functions.push(Function { id, start, end: n, blocks });
     }
-    let a = analyse(&insts, &functions, &mut known, &tracked);
+    let a = analyse(&insts, &functions, known, &tracked);
 
     // Loops whose header is live: their continue targets, branching back, stay even where unreached.
     let mut continue_of: HashMap<u32, u32> = HashMap::new();
@@ -406,8 +406,7 @@ pub fn specialize(words: &[u32], constants: &[(u32, u32)]) -> Result<Vec<u32>, S
             let block = &insts[b.start..b.end];
             let term = block[block.len() - 1];
             let taken = successors(term, &a.known);
-            let folded =
-                term.op == OP_BRANCH_CONDITIONAL && taken.len() == 1 || term.op == OP_SWITCH && taken.len() == 1;
+            let folded = matches!(term.op, OP_BRANCH_CONDITIONAL | OP_SWITCH) && taken.len() == 1;
             for (k, i) in block.iter().enumerate() {
                 let w = i.words;
                 if i.op == OP_PHI {
