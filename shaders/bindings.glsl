@@ -65,6 +65,14 @@ layout(constant_id = 6) const uint VARIANT_QUANTITY = 0u; // QUANTITY_RADIANCE, 
 layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID or VISIBILITY_SLICES, with shadow rays
 layout(constant_id = 8) const uint VARIANT_OCCLUDERS_MASKED = 0u; // with shadow rays: 1 where a material of the scene
                                                              // is alpha-masked (occluders.glsl's blocks tests it)
+layout(constant_id = 9) const uint VARIANT_SUN_CELLS = 0u; // with shadow rays and a sun: SUN_CELLS_*
+
+// What the sun's cells answer this frame (VARIANT_SUN_CELLS; gpu::layout's SUN_CELLS_*): nothing (the sun's rays
+// take occluded), every point's rays (no cell holds more than MAX_SUN_CELL_TRIANGLES: occluded is never needed for
+// the sun), or the rays of the points under at most that many (the others take occluded).
+#define SUN_CELLS_NONE 0u
+#define SUN_CELLS_COMPLETE 1u
+#define SUN_CELLS_PARTIAL 2u
 
 // What a draw's material needs per pixel (VARIANT_SURFACE); values match shading::surface::SURFACE_*.
 #define SURFACE_EVAL 1u
@@ -194,6 +202,26 @@ layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
 layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
+
+// The modules that cast shadow rays: by ray queries or by the shader's walk of the occluders' tree.
+#if defined(SUNSHADE_RAY_BVH) || defined(SUNSHADE_RAY_QUERY)
+#define SUNSHADE_SHADOW_RAYS
+#endif
+
+#ifdef SUNSHADE_SHADOW_RAYS
+// The sun's cells (gpu::sun_cells lays out visibility::sun_cells::SunCells): the axes across the sun (u, v) with
+// the projection of cell (0, 0)'s corner in w [m]; l the sun's direction, w cells per metre; dims the cells along
+// u and v, z where the entries start in data, w unused (VARIANT_SUN_CELLS says what the cells answer).
+// data: each cell's first entry and one past the last cell's last (dims.x dims.y + 1 of them), then an occluder
+// record (OccluderTriangles') an entry, four words each.
+layout(std430, set = 0, binding = 15) readonly buffer SunCellsBuffer {
+    vec4 u;
+    vec4 v;
+    vec4 l;
+    uvec4 dims;
+    uint data[];
+} sun_cells;
+#endif
 
 // The modules that walk the occluders' tree: for the shadow rays themselves without ray queries
 // (SUNSHADE_RAY_BVH), and for the lights' slices (SUNSHADE_SLICES, slices.glsl) with ray queries or without.

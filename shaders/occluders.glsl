@@ -48,15 +48,17 @@ bool blocks(uvec4 tri, vec2 b) {
     return masked_hit_blocks(material, s);
 }
 
-#ifdef SUNSHADE_WALK
-// What the shadow rays' walk (devices without ray queries) and the slices' walks (shaders/slices.glsl, on every
-// device with shadow rays) share: the tree, its leaves' corners, the walk.
+#ifdef SUNSHADE_SHADOW_RAYS
 // A corner of an occluder triangle: the world position [m] of global vertex i (the vertex buffer's f32, which the
-// reference's rays meet as f64).
+// reference's rays meet as f64). Read by the walks and by the sun's cells (sun_cells.glsl).
 #define OCCLUDER_CORNER(i) vec3(vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION], \
     vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 1u], \
     vertex_data[(i) * FLOATS_PER_VERTEX + VERTEX_POSITION + 2u])
+#endif
 
+#ifdef SUNSHADE_WALK
+// What the shadow rays' walk (devices without ray queries) and the slices' walks (shaders/slices.glsl, on every
+// device with shadow rays) share: the tree, the walk.
 // The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
 #define BVH_LEAF_SIZE 1u
 // The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
@@ -79,7 +81,7 @@ bool blocks(uvec4 tri, vec2 b) {
     }
 #endif
 
-#ifdef SUNSHADE_RAY_BVH
+#ifdef SUNSHADE_SHADOW_RAYS
 
 // A ray prepared for the watertight test (WatertightRay in the Rust): the direction's dominant axis kz, the other
 // two kx, ky (swapped where the direction along kz is negative, keeping the winding), and the shear
@@ -140,6 +142,9 @@ bool intersect(WatertightRay r, vec3 a, vec3 b, vec3 c, float t_max, out vec2 ba
     bary = vec2(v, w) / det;
     return t > 0.0 && t < t_max;
 }
+#endif
+
+#ifdef SUNSHADE_RAY_BVH
 
 // One axis of the slab test (slab): the interval [lo, hi] of t narrowed to the box's slab [box_lo, box_hi] along
 // it, or, where the ray does not move along it (d = 0), `outside` set when the origin lies outside the slab.

@@ -63,6 +63,8 @@ bool visible_to(vec3 origin, vec3 target) {
     return !occluded(origin, target - origin, SEGMENT_T_MAX);
 }
 
+#include "sun_cells.glsl"
+
 // The point of the unit disk for (u, v) of the unit square (Shirley & Chiu's concentric map; equal-area).
 vec2 concentric_disk(float u, float v) {
     float a = 2.0 * u - 1.0;
@@ -125,6 +127,8 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
 #define GRID_LIGHT_SUN 0u
 #define GRID_LIGHT_DISK 1u
 #define GRID_LIGHT_SKY 2u
+// The sun, its rays tested against its cell's triangles (sun_cells.glsl) instead of taking occluded.
+#define GRID_LIGHT_SUN_CELLS 3u
 // grid_fraction's stages at a corner: its own ray, the bisection along v to the corner below, along u to the one
 // before.
 #define GRID_CORNER 0u
@@ -180,7 +184,7 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
         return sky_sample(L.a, L.b, L.tilt, L.radius, uv, ray);
     }
     vec2 xy = concentric_disk(uv.x, uv.y);
-    if (L.kind == GRID_LIGHT_SUN) {
+    if (L.kind == GRID_LIGHT_SUN || L.kind == GRID_LIGHT_SUN_CELLS) {
         return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
     }
     return disk_sample(L.x, L.n, L.c, L.d, L.a, L.b, L.radius, xy, ray);
@@ -191,6 +195,11 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
 // the ray's traversal here instead of two (docs/platform.md, "What the driver compiles"). The arithmetic is
 // theirs: target - origin for a point, the direction itself otherwise.
 bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
+#ifdef SUNSHADE_SHADOW_RAYS
+    if (ONLY_SUN_CELL_RAYS || L.kind == GRID_LIGHT_SUN_CELLS) {
+        return !sun_cells_occluded(origin, ray);
+    }
+#endif
     bool to_point = L.kind == GRID_LIGHT_DISK;
     return !occluded(origin, to_point ? ray - origin : ray, to_point ? SEGMENT_T_MAX : RAY_T_INFINITE);
 }
@@ -395,10 +404,26 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     return fraction(visible, total);
 }
 
-// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]).
+// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]). Where the frame
+// has the sun's cells, their classification first: a cone that misses every triangle of its cell sees the whole
+// sun (1, what every ray of the grid would find), one within an opaque triangle none of it (0, where the whole disk
+// is above the surface's horizon so that the grid's weights are all positive); only a penumbra casts the grid's
+// rays, against the cell's triangles.
 float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
+    uint kind = GRID_LIGHT_SUN;
+#ifdef SUNSHADE_SHADOW_RAYS
+    float sin_sigma = sin(0.5 * angular_diameter);
+    uint cone = sun_cone_class(origin, n, l, sin_sigma);
+    if (cone == SUN_CONE_MISSES) {
+        return 1.0;
+    }
+    if (cone == SUN_CONE_COVERED && dot(n, l) > sin_sigma + SUN_CONE_MARGIN) {
+        return 0.0;
+    }
+    kind = cone == SUN_CONE_UNKNOWN ? GRID_LIGHT_SUN : GRID_LIGHT_SUN_CELLS;
+#endif
     vec3 t = orthonormal_to(l);
-    VisibilityLight L = VisibilityLight(GRID_LIGHT_SUN, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
+    VisibilityLight L = VisibilityLight(kind, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
                                         tan(0.5 * angular_diameter), 0.0);
     return grid_fraction(origin, k, L);
 }

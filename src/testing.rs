@@ -94,10 +94,10 @@ pub fn reference(job: &Job, options: &ReferenceOptions) -> Result<Image, Testing
     Ok(cpu::render(&scene, &settings, options))
 }
 
-/// Renders the job's CPU reference and compares `image`, the job's GPU render, with it as `render --check` does:
-/// where the render used shadow maps (`--shadows map`, or `auto` on a device without ray queries, as `options`
-/// says: [`CheckedRenderer::reference_options`]) the pixels whose map lookups reach an occluder's edge are
-/// counted apart ([`DiffReport::excused`]), not failed. `Err` holds the report of a failed comparison.
+/// Renders the job's CPU reference and compares `image`, the job's GPU render, with it as `render --check` does,
+/// the pixels of `cpu::checked`'s class counted apart ([`DiffReport::excused`]): a shadow map's edges, or the
+/// fragile pixels of shadow rays, textures and alpha masks (at most `cpu::FRAGILE_ALLOWED_FRACTION` of the
+/// compared pixels over tolerance). `Err` holds the report of a failed comparison.
 pub fn check_against_reference(
     job: &Job,
     image: &Image,
@@ -105,9 +105,9 @@ pub fn check_against_reference(
     diff: &DiffOptions,
 ) -> Result<DiffReport, TestingError> {
     let (scene, settings) = job.prepare()?;
-    let (reference, edges) = cpu::render_with_map_edges(&scene, &settings, options);
-    let (report, _) = compare::diff_excusing(image, &reference, diff, Some((&edges, cpu::map_edges::CLASS)))
-        .map_err(TestingError::Compare)?;
+    let (reference, apart) = cpu::checked::checked_reference(&scene, &settings, options);
+    let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
+    let (report, _) = compare::diff_apart(image, &reference, diff, apart).map_err(TestingError::Compare)?;
     if report.pass {
         Ok(report)
     } else {
@@ -167,15 +167,9 @@ impl CheckedRenderer {
         self.renderer.as_ref().expect("alive").device_info().sub_pixel_precision_bits
     }
 
-    /// The reference options that mirror this device (its sub-pixel bits and whether it has ray queries; FMA
-    /// as the host has it).
+    /// The reference options that mirror this device (its sub-pixel bits; FMA as the host has it).
     pub fn reference_options(&self) -> ReferenceOptions {
-        let info = self.renderer.as_ref().expect("alive").device_info();
-        ReferenceOptions {
-            sub_pixel_bits: self.sub_pixel_bits(),
-            device_ray_queries: info.ray_query,
-            ..Default::default()
-        }
+        ReferenceOptions { sub_pixel_bits: self.sub_pixel_bits(), ..Default::default() }
     }
 }
 

@@ -354,11 +354,8 @@ fn tolerance_meets_itself_on_the_reference() {
     for (name, scene, sun) in &cases {
         let lights = LightOptions { sun: SunOptions { direction: *sun, ..Default::default() }, ..Default::default() };
         let mut s = settings::resolve_with(scene, 48, 48, &CameraOptions::default(), &lights).unwrap();
-        s.shading.shadows = if name.ends_with("unshadowed") {
-            Shadows::None
-        } else {
-            cpu::shadow_choice(scene, &s, &reference).technique
-        };
+        s.shading.shadows =
+            if name.ends_with("unshadowed") { Shadows::None } else { cpu::shadow_choice(scene, &s).technique };
         let can_occlude = sunshade::visibility::can_occlude(scene);
         let mut costs = Vec::new();
         for tolerance in [1e-2, 1e-3, 1e-4] {

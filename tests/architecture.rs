@@ -165,6 +165,8 @@ fn every_shader_file_is_mirrored_or_declared_gpu_only() {
         ("occluders.glsl", &["src/visibility", "src/cpu"]),
         // The sun's and disk lights' slices: the rule (src/shading) and the walk's reach (src/visibility/bvh.rs).
         ("slices.glsl", &["src/shading", "src/visibility"]),
+        // The sun's cells: their layout and classification (src/visibility/sun_cells.rs).
+        ("sun_cells.glsl", &["src/visibility"]),
     ];
     // GPU-only: the byte layout (mirrored by src/gpu/layout.rs, checked by its glsl_constants_match test); f32
     // replacements for lavapipe's inaccurate built-ins (Rust uses f64's); the shadow map (the reference casts rays,

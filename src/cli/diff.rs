@@ -147,9 +147,9 @@ pub fn compare_and_report(
     options: &DiffOptions,
     heatmap: Option<&std::path::Path>,
     format: ReportFormat,
-    excused: Option<(&[bool], &str)>,
+    excused: Option<(&[bool], &str, Option<f64>)>,
 ) -> Result<DiffReport, CliError> {
-    let (report, per_pixel): (DiffReport, Vec<PixelDiff>) = compare::diff_excusing(a, b, options, excused)
+    let (report, per_pixel): (DiffReport, Vec<PixelDiff>) = compare::diff_apart(a, b, options, excused)
         .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
     if let Some(path) = heatmap {
         compare::write_heatmap(path, a.width(), a.height(), &per_pixel)

@@ -29,8 +29,6 @@ impl ReferenceArgs {
         ReferenceOptions {
             sub_pixel_bits: self.sub_pixel_bits,
             fused_viewport: self.fused_viewport.unwrap_or_else(cpu::host_has_fma),
-            // The reference is the truth: `--shadows auto` casts rays wherever something can occlude.
-            device_ray_queries: true,
         }
     }
 }
@@ -92,7 +90,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let options = a.reference.options();
     // Tested once: the shadow choice and the error bound both need it.
     let scene_can_occlude = crate::visibility::can_occlude(&scene);
-    let choice = cpu::shadow_choice_where(scene_can_occlude, &settings, &options);
+    let choice = cpu::shadow_choice_where(scene_can_occlude, &settings);
     settings.shading.shadows = choice.technique;
     // Slices where the image is to be near the truth in penumbrae (converged; a tolerance held in them, which the
     // sky's implies: `accuracy::trial::sky_by_slices`); the GPU's grid where it is to be compared with the GPU's,
@@ -188,7 +186,7 @@ fn run_accumulation(a: &ReferenceCommand, started: Instant) -> Result<(), CliErr
     let scene_can_occlude = crate::visibility::can_occlude(&scene);
     let done = super::accumulate::accumulate(&scene, &a.scene, |settings| {
         let mut settings = settings.clone();
-        settings.shading.shadows = cpu::shadow_choice_where(scene_can_occlude, &settings, &options).technique;
+        settings.shading.shadows = cpu::shadow_choice_where(scene_can_occlude, &settings).technique;
         settings.shading.visibility_rule = a.visibility_rule.unwrap_or_default();
         Ok(cpu::render(&scene, &settings, &options))
     })?;

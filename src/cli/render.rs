@@ -141,20 +141,6 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let rule =
         a.visibility_rule.unwrap_or_else(|| default_visibility(&a.scene, &settings, scene_data, choice.technique));
     let slices = rule == crate::shading::VisibilityRule::Slices;
-    if (a.scene.tolerance.is_some() || slices) && a.scene.shadows == Shadows::Auto && choice.technique == Shadows::Map {
-        // Shadow maps have no error bound, and slices take the place of shadow rays: `auto` casts rays on any
-        // device (without ray queries, by the fragment shader's walk of the occluders' BVH).
-        let why = if a.scene.tolerance.is_some() {
-            "auto with --tolerance: shadow rays, whose error outside penumbrae is known"
-        } else {
-            "auto with --visibility slices: the lights' visible fractions by slices"
-        };
-        choice = crate::visibility::ShadowChoice {
-            technique: Shadows::Ray,
-            reason: format!("{why} (the device has no ray queries: the fragment shader walks the occluders' BVH)"),
-            warning: false,
-        };
-    }
     if slices {
         choice.reason += if settings.lights.sky.is_some() {
             "; the lights' visible fractions by slices (--visibility slices; the sky's in passes before the frame)"
@@ -396,25 +382,6 @@ pub(super) fn beyond_this_device(settings: &RenderSettings, why: &str) -> String
     )
 }
 
-/// The CPU reference of a rendered job, mirroring the device that rendered it: its sub-pixel bits, and the
-/// viewport's fused multiply-add as `--fused-viewport` says (else as the host CPU has it, as lavapipe does).
-/// For a shadow-map render, also the pixels where the maps may answer otherwise than its rays
-/// (`cpu::render_with_map_edges`), which a check counts apart. The one `--tolerance` rendered, where it did
-/// ([`Rendered::reference`]).
-pub fn reference_of(session: &mut Session, a: &RenderArgs, job: &Rendered) -> (Image, Option<Vec<bool>>) {
-    if let (Some(image), false) = (&job.reference, job.settings.shading.shadows == Shadows::Map) {
-        return (image.clone(), None);
-    }
-    let options = reference_options(session, a, job);
-    let scene = session.scene_ref(job.scene);
-    if job.settings.shading.shadows == Shadows::Map {
-        let (image, edges) = cpu::render_with_map_edges(scene, &job.settings, &options);
-        (image, Some(edges))
-    } else {
-        (cpu::render(scene, &job.settings, &options), None)
-    }
-}
-
 /// How the prediction names the device's interpolation.
 pub fn predicted_barycentrics(interpolation: Interpolation) -> predicted::Barycentrics {
     match interpolation {
@@ -429,20 +396,40 @@ fn reference_options(session: &mut Session, a: &RenderArgs, job: &Rendered) -> R
     device_reference_options(session.renderer_mut(job.renderer).device_info(), a)
 }
 
-/// The reference options that mirror a device: its sub-pixel bits and ray queries, and the viewport's FMA as
-/// `--fused-viewport` says (else as the host has it).
+/// The reference options that mirror a device: its sub-pixel bits, and the viewport's FMA as `--fused-viewport`
+/// says (else as the host has it).
 fn device_reference_options(info: &crate::gpu::DeviceInfo, a: &RenderArgs) -> ReferenceOptions {
     ReferenceOptions {
         sub_pixel_bits: info.sub_pixel_precision_bits,
         fused_viewport: a.fused_viewport.unwrap_or_else(cpu::host_has_fma),
-        device_ray_queries: info.ray_query,
     }
 }
 
-/// `--check`: the CPU reference with the device's sub-pixel bits, compared; `Err(Quiet(1))` outside tolerance.
+/// The CPU reference of a rendered job, mirroring the device that rendered it (its sub-pixel bits, and the
+/// viewport's fused multiply-add as `--fused-viewport` says, else as the host CPU has it, as lavapipe does), and
+/// the class of pixels a comparison with it counts apart (`cpu::checked`). The reference `--tolerance` rendered is
+/// reused where no class is needed ([`Rendered::reference`]).
+pub fn checked_reference_of(
+    session: &mut Session,
+    a: &RenderArgs,
+    job: &Rendered,
+) -> (Image, Option<cpu::checked::ApartClass>) {
+    let options = reference_options(session, a, job);
+    let scene = session.scene_ref(job.scene);
+    let plain = !cpu::checked::may_be_fragile(scene, &job.settings) && job.settings.shading.shadows != Shadows::Map;
+    match &job.reference {
+        Some(image) if plain => (image.clone(), None),
+        _ => cpu::checked::checked_reference(scene, &job.settings, &options),
+    }
+}
+
+/// `--check`: the CPU reference with the device's sub-pixel bits ([`checked_reference_of`]), compared;
+/// `Err(Quiet(1))` outside tolerance. The class of pixels counted apart is `cpu::checked`'s: a shadow map's edges,
+/// or the fragile pixels of shadow rays, textures and alpha masks, at most `cpu::FRAGILE_ALLOWED_FRACTION` of the
+/// compared pixels over tolerance.
 pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose: bool) -> Result<(), CliError> {
     let t = Instant::now();
-    let (reference, map_edges) = reference_of(session, a, job);
+    let (reference, apart) = checked_reference_of(session, a, job);
     if verbose {
         eprintln!("sunshade: CPU reference {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     }
@@ -457,26 +444,10 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
         &a.tolerances.options(),
         a.heatmap.as_deref(),
         format,
-        map_edges.as_deref().map(|m| (m, cpu::map_edges::CLASS)),
+        apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction)),
     )?;
     if report.pass {
         return Ok(());
-    }
-    let may_be_fragile = {
-        let scene = session.scene_ref(job.scene);
-        job.settings.shading.shadows == Shadows::Ray || !scene.textures.is_empty() || scene.has_alpha_masks()
-    };
-    if may_be_fragile && !report.over_tolerance_pixels.is_empty() && !a.json {
-        // Which of the differences lie where the GPU's f32 geometry or texture coordinates may decide the other way.
-        let options = reference_options(session, a, job);
-        let (_, fragile) = cpu::render_with_fragile_pixels(session.scene_ref(job.scene), &job.settings, &options);
-        let at = report.over_tolerance_at(&fragile, job.image.width());
-        println!(
-            "of the {} pixels over tolerance, {at} are fragile: a shadow ray within 2^-18 of the scene's size from \
-             an occluder's edge, or a texture lookup or alpha cutoff within 2^-16 of a discontinuity, where f32 \
-             geometry or texture coordinates may decide the other way",
-            report.over_tolerance_pixels.len()
-        );
     }
     Err(CliError::Quiet(1))
 }

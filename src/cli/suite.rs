@@ -18,7 +18,7 @@ use serde_json::{Map, Value};
 
 use super::batch::{job_arguments, RunArgs};
 use super::diff::ToleranceArgs;
-use super::render::{cache_dir, reference_of, render_job, RenderArgs};
+use super::render::{cache_dir, checked_reference_of, render_job, RenderArgs};
 use super::session::Session;
 use super::{clap_error_line, CliError};
 use crate::compare::{self, DiffReport};
@@ -232,11 +232,11 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             return outcome;
         }
     };
-    let mut map_edges = None;
+    let mut apart = None;
     let expected = match &case.expected {
         Expected::Reference => {
-            let (image, edges) = reference_of(session, &case.args, &job);
-            map_edges = edges;
+            let (image, class) = checked_reference_of(session, &case.args, &job);
+            apart = class;
             image
         }
         Expected::Golden(path) if a.update => {
@@ -266,8 +266,8 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             }
         },
     };
-    let excused = map_edges.as_deref().map(|m| (m, crate::cpu::map_edges::CLASS));
-    let (report, per_pixel) = match compare::diff_excusing(&job.image, &expected, &case.tolerances.options(), excused) {
+    let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
+    let (report, per_pixel) = match compare::diff_apart(&job.image, &expected, &case.tolerances.options(), apart) {
         Ok(r) => r,
         Err(e) => {
             outcome.status = Status::Failed(e);

@@ -161,6 +161,8 @@ pub struct Excused {
     pub over_tolerance: usize,
     /// The largest relative error among them.
     pub max_rel: f64,
+    /// How many of them may be over tolerance for the comparison to pass (`None`: any; [`DiffReport::cap_excused`]).
+    pub allowed: Option<usize>,
 }
 
 /// Per-pixel results, for the heatmap.
@@ -237,6 +239,21 @@ pub fn diff(a: &Image, b: &Image, options: &DiffOptions) -> Result<(DiffReport, 
     diff_excusing(a, b, options, None)
 }
 
+/// [`diff_excusing`], the class's pixels over tolerance capped at `allowed_fraction` of the compared pixels
+/// where it is given ([`DiffReport::cap_excused`]).
+pub fn diff_apart(
+    a: &Image,
+    b: &Image,
+    options: &DiffOptions,
+    apart: Option<(&[bool], &str, Option<f64>)>,
+) -> Result<(DiffReport, Vec<PixelDiff>), String> {
+    let (mut report, per_pixel) = diff_excusing(a, b, options, apart.map(|(mask, class, _)| (mask, class)))?;
+    if let Some((_, _, Some(fraction))) = apart {
+        report.cap_excused(fraction);
+    }
+    Ok((report, per_pixel))
+}
+
 /// [`diff`], with the pixels flagged in `excused` (row-major mask, and the class's name) counted apart: their
 /// differences enter the metrics (max, RMSE, worst pixel) but not the tolerance counts, the hard failures or the
 /// warn level; [`DiffReport::excused`] reports them.
@@ -291,6 +308,7 @@ pub fn diff_excusing(
             compared: 0,
             over_tolerance: 0,
             max_rel: 0.0,
+            allowed: None,
         }),
     };
     let mut per_pixel = Vec::with_capacity((w * h) as usize);
@@ -369,6 +387,19 @@ pub fn diff_excusing(
 }
 
 impl DiffReport {
+    /// Fails the comparison where more of the pixels counted apart are over tolerance than `fraction` of the
+    /// compared pixels (rounded down): a class that excuses a few rays grazing an edge, not a region.
+    pub fn cap_excused(&mut self, fraction: f64) {
+        if let Some(e) = self.excused.as_mut() {
+            let allowed = (fraction * self.compared as f64).floor() as usize;
+            e.allowed = Some(allowed);
+            if e.over_tolerance > allowed {
+                self.pass = false;
+                self.warn = false;
+            }
+        }
+    }
+
     /// How many of the pixels over tolerance are flagged in `mask` (row-major, `width` pixels a row): the class
     /// of differences at places where the reference's result is *fragile*, a shadow ray grazing an occluder's
     /// edge or a texture lookup at a discontinuity (`cpu::render_with_fragile_pixels`), counted apart as coverage
@@ -427,8 +458,10 @@ impl DiffReport {
             s += &format!("over hard fail (rel > {h:e}): {}\n", self.hard_failures);
         }
         if let Some(e) = &self.excused {
+            let allowed = e.allowed.map_or(String::new(), |n| format!(" (allowed {n})"));
+            let failed = if e.allowed.is_some() { "" } else { ", not failed" };
             s += &format!(
-                "counted apart, not failed: {} pixels at {}; {} of them over tolerance, max rel error {:.3e}\n",
+                "counted apart{failed}: {} pixels at {}; {} of them over tolerance{allowed}, max rel error {:.3e}\n",
                 e.compared, e.class, e.over_tolerance, e.max_rel
             );
         }
@@ -470,7 +503,7 @@ impl DiffReport {
             },
             "pass": self.pass,
             "warn": self.warn,
-            "excused": self.excused.as_ref().map(|e| json!({ "class": e.class, "compared": e.compared, "over_tolerance": e.over_tolerance, "max_rel": finite(e.max_rel) })),
+            "excused": self.excused.as_ref().map(|e| json!({ "class": e.class, "compared": e.compared, "over_tolerance": e.over_tolerance, "allowed": e.allowed, "max_rel": finite(e.max_rel) })),
         })
     }
 }
@@ -579,6 +612,13 @@ mod tests {
         let both: Vec<bool> = (0..100).map(|k| k == 0 || k / 10 == 1).collect();
         let (r, _) = diff_excusing(&a, &b, &o, Some((&both, "both"))).unwrap();
         assert!(r.pass && r.json("a", "b")["excused"]["over_tolerance"] == 11, "{r:?}");
+        // Capped at 11% of the 100 compared pixels it passes, at 10% it fails, and the report says so.
+        let mut capped = r.clone();
+        capped.cap_excused(0.11);
+        assert!(capped.pass && capped.text("a", "b").contains("11 of them over tolerance (allowed 11)"));
+        let mut capped = r.clone();
+        capped.cap_excused(0.10);
+        assert!(!capped.pass && capped.json("a", "b")["excused"]["allowed"] == 10, "{capped:?}");
         // Without a class the report has none.
         assert!(diff(&a, &b, &o).unwrap().0.excused.is_none());
     }

@@ -5,8 +5,8 @@ mod metrics;
 
 pub use heatmap::{colour_scale, heatmap};
 pub use metrics::{
-    default_floor, diff, diff_excusing, image_peak, pixel_difference, DiffOptions, DiffReport, Excused, PixelDiff,
-    PixelDifference, Split, WorstPixel, F32_SHADING_PEAK_FRACTION,
+    default_floor, diff, diff_apart, diff_excusing, image_peak, pixel_difference, DiffOptions, DiffReport, Excused,
+    PixelDiff, PixelDifference, Split, WorstPixel, F32_SHADING_PEAK_FRACTION,
 };
 
 /// Writes a heatmap PNG atomically.

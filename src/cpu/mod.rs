@@ -18,6 +18,7 @@
 //! depth ties resolve as on the device (the first drawn wins). Nothing here calls into `gpu`.
 
 pub mod barycentric;
+pub mod checked;
 pub mod clip;
 mod fragment;
 pub mod interpolate;
@@ -55,15 +56,11 @@ pub struct ReferenceOptions {
     /// JIT does where the host CPU has FMA: measured on a dense lattice of isolated triangles at 1000×1000, the
     /// fused mirror matched lavapipe's coverage exactly and the unfused one did not.
     pub fused_viewport: bool,
-    /// Whether the device has ray queries, for `--shadows auto`: a device without them renders every light
-    /// unoccluded under `auto` (shadow maps are asked for with `map`); the reference then does the same, so that
-    /// it mirrors what the device computed. (An explicit `ray` or `map` always gets rays.)
-    pub device_ray_queries: bool,
 }
 
 impl Default for ReferenceOptions {
     fn default() -> Self {
-        Self { sub_pixel_bits: 8, fused_viewport: host_has_fma(), device_ray_queries: true }
+        Self { sub_pixel_bits: 8, fused_viewport: host_has_fma() }
     }
 }
 
@@ -126,22 +123,18 @@ struct Prepared {
 
 /// The reference's shadow technique for this scene and these settings, and why (see
 /// [`crate::visibility::choose_reference`]).
-pub fn shadow_choice(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> ShadowChoice {
+pub fn shadow_choice(scene: &Scene, settings: &RenderSettings) -> ShadowChoice {
     // The scene's test runs only where `auto` needs it.
     let can_occlude = settings.shading.shadows != Shadows::Auto || crate::visibility::can_occlude(scene);
-    shadow_choice_where(can_occlude, settings, options)
+    shadow_choice_where(can_occlude, settings)
 }
 
 /// [`shadow_choice`] for a caller that has already tested whether the scene can occlude a light
 /// (`crate::visibility::can_occlude`).
-pub fn shadow_choice_where(
-    scene_can_occlude: bool,
-    settings: &RenderSettings,
-    options: &ReferenceOptions,
-) -> ShadowChoice {
+pub fn shadow_choice_where(scene_can_occlude: bool, settings: &RenderSettings) -> ShadowChoice {
     let requested = settings.shading.shadows;
     let can_occlude = requested != Shadows::Auto || scene_can_occlude;
-    crate::visibility::choose_reference(requested, &settings.lights, can_occlude, options.device_ray_queries)
+    crate::visibility::choose_reference(requested, &settings.lights, can_occlude)
 }
 
 /// The reference's shadow rays for a render: the occluders they test and the lights they shadow, both from
@@ -153,12 +146,8 @@ struct ShadowRays<'a> {
 }
 
 /// The render's [`ShadowRays`], or `None` where every light is unoccluded.
-fn occluders_for<'a>(
-    scene: &'a Scene,
-    settings: &RenderSettings,
-    options: &ReferenceOptions,
-) -> Option<ShadowRays<'a>> {
-    match shadow_choice(scene, settings, options).technique {
+fn occluders_for<'a>(scene: &'a Scene, settings: &RenderSettings) -> Option<ShadowRays<'a>> {
+    match shadow_choice(scene, settings).technique {
         Shadows::None => None,
         technique => Some(ShadowRays { occluders: Occluders::new(scene), lights: ShadowedLights::of(technique) }),
     }
@@ -166,7 +155,7 @@ fn occluders_for<'a>(
 
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
-    let occluders = occluders_for(scene, settings, options);
+    let occluders = occluders_for(scene, settings);
     let shader = plain_shader(scene, settings, occluders.as_ref());
     render_inner(scene, settings, options, None, &shader).0
 }
@@ -194,7 +183,7 @@ pub fn render_selected(
     selected: &[bool],
 ) -> Image {
     assert_eq!(selected.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
-    let occluders = occluders_for(scene, settings, options);
+    let occluders = occluders_for(scene, settings);
     let shader = plain_shader(scene, settings, occluders.as_ref());
     render_inner(scene, settings, options, Some(selected), &shader).0
 }
@@ -222,7 +211,7 @@ pub fn barycentric_sensitivity(
     radius: &(dyn Fn([glam::Vec4; 3], glam::Vec2) -> f64 + Sync),
 ) -> (Image, Image) {
     use std::sync::atomic::{AtomicU32, Ordering};
-    let occluders = occluders_for(scene, settings, options);
+    let occluders = occluders_for(scene, settings);
     let rays = occluders.as_ref();
     let viewer = settings.viewer();
     let (width, height) = (settings.width, settings.height);
@@ -268,6 +257,15 @@ pub fn barycentric_sensitivity(
 /// coordinates' magnitude, several times the f32 rounding of the GPU's positions and directions (2⁻²³).
 pub const FRAGILE_RAY_RELATIVE: f64 = 1.0 / 262144.0;
 
+/// The fragile pixels' class, as a comparison names it ([`render_with_fragile_pixels`]).
+pub const FRAGILE_CLASS: &str = "fragile pixels (a shadow ray within 2^-18 of the scene's size from an occluder's \
+    edge, or a texture lookup or alpha cutoff within 2^-16 of a discontinuity: f32 geometry or texture coordinates \
+    may decide the other way)";
+
+/// The most fragile pixels over tolerance a check passes: 0.05% of the compared pixels (a few rays that graze an
+/// edge, not a region).
+pub const FRAGILE_ALLOWED_FRACTION: f64 = 5e-4;
+
 /// How near a texture lookup or an alpha cutoff may be to a jump of its result before the pixel counts as
 /// fragile: `2⁻¹⁶` of the decision's scale (docs/textures.md, "Discontinuities"), above the rounding of f32 texture
 /// coordinates from f32 barycentrics (up to ~1e-5 of a thin triangle's weights).
@@ -285,7 +283,7 @@ pub fn render_with_fragile_pixels(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let occluders = occluders_for(scene, settings, options);
+    let occluders = occluders_for(scene, settings);
     let viewer = settings.viewer();
     let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
     render_inner(scene, settings, options, None, &|t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
@@ -320,7 +318,7 @@ pub fn render_with_map_edges(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let rays = occluders_for(scene, settings, options);
+    let rays = occluders_for(scene, settings);
     let reach = map_edges::MapReach::new(scene, settings);
     let viewer = settings.viewer();
     render_inner(scene, settings, options, None, &|t: &Prepared, xy: (u32, u32), w: [f64; 3]| {

@@ -26,6 +26,12 @@ pub const SHADOWS_MAP: u32 = 2;
 /// (shaders/slices.glsl, a fragment module of their own).
 pub const VISIBILITY_GRID: u32 = 0;
 pub const VISIBILITY_SLICES: u32 = 1;
+/// What the sun's cells answer in a frame with shadow rays and a sun (`VARIANT_SUN_CELLS`; `gpu::sun_cells`):
+/// nothing (no cells), every point's sun rays, or those of the points under at most
+/// `visibility::sun_cells::MAX_SUN_CELL_TRIANGLES` of their cell's triangles.
+pub const SUN_CELLS_NONE: u32 = 0;
+pub const SUN_CELLS_COMPLETE: u32 = 1;
+pub const SUN_CELLS_PARTIAL: u32 = 2;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
@@ -55,7 +61,7 @@ pub const MIP_LINEAR: u32 = 2;
 pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 8). The shader keeps only the code these select; `shadows` also
+/// `shaders/bindings.glsl`, constant ids 0 to 9). The shader keeps only the code these select; `shadows` also
 /// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
@@ -79,18 +85,19 @@ pub struct ShaderVariant {
     /// With shadow rays, 1 where a material of the scene is alpha-masked (the rays then test their hits' alpha), else
     /// 0; always 0 without shadow rays, so that such scenes share the other variants.
     pub occluders_masked: u32,
+    /// With shadow rays and a sun, what the frame's sun cells answer (`SUN_CELLS_*`); `SUN_CELLS_NONE` otherwise.
+    pub sun_cells: u32,
 }
 
 impl ShaderVariant {
     /// The variant for a material (its `MaterialGpu::kind[0]`) under these lights, in a scene that has alpha-masked
-    /// materials or not.
+    /// materials or not, in a frame whose sun cells answer `sun_cells` (`SUN_CELLS_*`).
     pub fn new(
         brdf: u32,
         surface: u32,
         lights: &Lights,
         shading: &ShadingOptions,
-        shadows: u32,
-        scene_masked: bool,
+        (shadows, scene_masked, sun_cells): (u32, bool, u32),
     ) -> Self {
         let sun = match (&lights.sun, shading.sun) {
             (None, _) => LIGHT_ABSENT,
@@ -112,7 +119,8 @@ impl ShaderVariant {
             _ => VISIBILITY_GRID,
         };
         let occluders_masked = (shadows == SHADOWS_RAY && scene_masked) as u32;
-        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked }
+        let sun_cells = if shadows == SHADOWS_RAY && sun != LIGHT_ABSENT { sun_cells } else { SUN_CELLS_NONE };
+        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells }
     }
 
     /// The variant in words, for `-v` and the start-up bench: "Ward · disk sun · exact disks · sky · shadow maps ·
@@ -136,12 +144,17 @@ impl ShaderVariant {
         if self.occluders_masked != 0 {
             parts.push("alpha-masked occluders".into());
         }
+        match self.sun_cells {
+            SUN_CELLS_COMPLETE => parts.push("sun cells".into()),
+            SUN_CELLS_PARTIAL => parts.push("sun cells, partly".into()),
+            _ => {}
+        }
         parts.push(pick(self.quantity, &["radiance", "irradiance", "a light's rows"]));
         parts.join(" · ")
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 9] {
+    pub fn constants(&self) -> [u32; 10] {
         [
             self.brdf,
             self.sun,
@@ -152,6 +165,7 @@ impl ShaderVariant {
             self.quantity,
             self.visibility,
             self.occluders_masked,
+            self.sun_cells,
         ]
     }
 }
@@ -508,6 +522,9 @@ mod tests {
             ("SHADOWS_MAP", SHADOWS_MAP),
             ("VISIBILITY_GRID", VISIBILITY_GRID),
             ("VISIBILITY_SLICES", VISIBILITY_SLICES),
+            ("SUN_CELLS_NONE", SUN_CELLS_NONE),
+            ("SUN_CELLS_COMPLETE", SUN_CELLS_COMPLETE),
+            ("SUN_CELLS_PARTIAL", SUN_CELLS_PARTIAL),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
             ("QUANTITY_LIGHT_ROWS", QUANTITY_LIGHT_ROWS),
@@ -568,10 +585,11 @@ mod tests {
             "VARIANT_QUANTITY",
             "VARIANT_VISIBILITY",
             "VARIANT_OCCLUDERS_MASKED",
+            "VARIANT_SUN_CELLS",
         ];
         assert_eq!(
             variant_constants.len(),
-            ShaderVariant::new(0, 0, &Default::default(), &Default::default(), 0, false).constants().len()
+            ShaderVariant::new(0, 0, &Default::default(), &Default::default(), (0, false, 0)).constants().len()
         );
         for (id, name) in variant_constants.iter().enumerate() {
             assert!(

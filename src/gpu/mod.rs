@@ -31,6 +31,7 @@ pub mod shadow_bvh;
 mod shadow_map;
 pub mod slice_gather;
 pub mod slice_passes;
+pub mod sun_cells;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;

@@ -122,8 +122,8 @@ impl ScenePipeline {
             // until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices with ray queries,
             // and 12 the occluders' BVH nodes and 13 the sky's fractions from its passes of slices (storage buffers) on
             // every device with shadow rays (the slices walk the tree), 14 the walk's records in the tree's leaf order
-            // with ray queries (binding 10 holds them without). All read by the fragment shader. The descriptor pool is
-            // sized from the same table.
+            // with ray queries (binding 10 holds them without), 15 the sun's cells on every device with shadow rays.
+            // All read by the fragment shader. The descriptor pool is sized from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),
@@ -143,10 +143,12 @@ impl ScenePipeline {
                     table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((14, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((15, vk::DescriptorType::STORAGE_BUFFER, 1));
                 }
                 Some((_, _, ShadowRays::Bvh)) => {
                     table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((15, vk::DescriptorType::STORAGE_BUFFER, 1));
                 }
                 None => {}
             }
@@ -260,6 +262,7 @@ impl ScenePipeline {
             quantity: 0,
             visibility: 0,
             occluders_masked: 0,
+            sun_cells: 0,
         };
         // SAFETY: valid device, layout, modules and cache owned by self.
         let (p, made) = unsafe {
@@ -398,7 +401,7 @@ unsafe fn create_pipeline(
     whole: bool,
 ) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
     let started = std::time::Instant::now();
-    let constants = variant.map_or([0; 9], |v| v.constants());
+    let constants = variant.map_or([0; 10], |v| v.constants());
     let mut instructions = 0;
     let module = match fs {
         Some(words) => {
@@ -433,7 +436,7 @@ unsafe fn create_pipeline_from(
     layout: vk::PipelineLayout,
     (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
-    constants: &[u32; 9],
+    constants: &[u32; 10],
     depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.

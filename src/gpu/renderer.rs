@@ -15,7 +15,8 @@ use super::frame_probe;
 use super::layout::{
     lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_light_rows,
     MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, BRDF_LAMBERT, DISKS_EXACT, LIGHT_ABSENT,
-    MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_DISK,
+    MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_CELLS_COMPLETE,
+    SUN_CELLS_NONE, SUN_CELLS_PARTIAL, SUN_DISK,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
@@ -30,6 +31,7 @@ use crate::shading::surface::{surface_flags, SURFACE_ALPHA_MASK};
 use crate::shading::visibility::MAX_LOCATED_GRID;
 use crate::shading::{Shadows, VisibilityRule};
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame};
+use crate::visibility::sun_cells::{SunCells, MAX_SUN_CELL_TRIANGLES};
 use crate::visibility::ShadowChoice;
 use bytemuck::Zeroable;
 
@@ -140,6 +142,10 @@ pub struct Renderer {
     /// one unused value bound at 13 where a frame takes none.
     light_fractions: Option<Buffer>,
     no_light_fractions: Buffer,
+    /// The sun's cells of the last frame with shadow rays and a sun (`sun_cells`), and the header bound at 15 where
+    /// a frame has none.
+    sun_cells: Option<Buffer>,
+    no_sun_cells: Buffer,
     sun_map: DepthMap,
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
@@ -231,11 +237,14 @@ impl Renderer {
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
         let no_light_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "light fractions (unused)")?;
+        let no_sun_cells = Buffer::storage(&dev, &super::sun_cells::absent(), "sun cells (none)")?;
         let renderer = Self {
             target: None,
             lights: None,
             light_fractions: None,
             no_light_fractions,
+            sun_cells: None,
+            no_sun_cells,
             sun_map,
             disk_maps,
             pipeline,
@@ -485,15 +494,14 @@ impl Renderer {
         ))
     }
 
-    /// The shadow technique for this scene and these settings on this device, and why: `auto` casts rays where
-    /// the device has ray queries and reads shadow maps where it has none. `map` shadows the sun and the first
-    /// `MAX_DISK_MAPS` disk lights from their maps and leaves the sky (and further disks) unoccluded, with a
-    /// warning where the scene has them. `ray` casts rays on any device: by ray queries, or, without them, by the
-    /// fragment shader's walk of the occluders' BVH (`shadow_bvh`; slower on the same device, the same rays).
+    /// The shadow technique for this scene and these settings on this device, and why: `auto` and `ray` cast rays
+    /// on any device: the sun's against its cells (`sun_cells`), the other lights' by ray queries or, without them,
+    /// by the fragment shader's walk of the occluders' BVH (`shadow_bvh`; slower on the same device, the same
+    /// rays). `map` shadows the sun and the first `MAX_DISK_MAPS` disk lights from their maps and leaves the sky
+    /// (and further disks) unoccluded, with a warning where the scene has them.
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
-        let rq = self.pipeline.has_ray_queries();
         let requested = settings.shading.shadows;
-        let mut choice = crate::visibility::choose(requested, &settings.lights, scene.can_occlude, rq);
+        let mut choice = crate::visibility::choose(requested, &settings.lights, scene.can_occlude);
         if choice.technique == Shadows::Ray && !self.pipeline.has_shadow_rays() {
             return Err(GpuError::Unsupported(format!(
                 "{}: no shadow rays with the naive-math diagnostic: --shadows map or none",
@@ -508,8 +516,23 @@ impl Renderer {
                 MAX_LOCATED_GRID * MAX_LOCATED_GRID
             )));
         }
-        if choice.technique == Shadows::Ray && self.pipeline.rays_walk_bvh() {
-            choice.reason += " (the device has no ray queries: the fragment shader walks the occluders' BVH)";
+        if choice.technique == Shadows::Ray {
+            let lights = &settings.lights;
+            let mut how = Vec::new();
+            if lights.sun.is_some() {
+                how.push("the sun's against its cells".to_string());
+            }
+            if !lights.disks.is_empty() || lights.sky.is_some() {
+                let by = if self.pipeline.rays_walk_bvh() {
+                    "the fragment shader's walk of the occluders' BVH (no ray queries)"
+                } else {
+                    "ray queries"
+                };
+                how.push(format!("the other lights' by {by}"));
+            }
+            if !how.is_empty() {
+                choice.reason += &format!(" ({})", how.join("; "));
+            }
         }
         if settings.shading.visibility_rule == VisibilityRule::Slices {
             self.check_slices(choice.technique)?;
@@ -598,6 +621,20 @@ impl Renderer {
             Shadows::Map if any_map => SHADOWS_MAP,
             _ => SHADOWS_NONE,
         };
+        // The sun's cells, for the sun's rays (`visibility::sun_cells`): none where a cell would hold too many
+        // triangles (the rays then take the BVH's walk or the ray queries).
+        self.sun_cells = None;
+        let mut sun_cells = SUN_CELLS_NONE;
+        if let (SHADOWS_RAY, Some(sun), Some(source)) = (shadows, &settings.lights.sun, &scene.walk_source) {
+            let (triangles, records) = source.triangles_and_records();
+            let half_angle = 0.5 * sun.angular_diameter as f64;
+            if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle) {
+                let bytes = super::sun_cells::bytes(&cells, triangles, records);
+                self.sun_cells = Some(Buffer::storage(&self.dev, &bytes, "sun cells")?);
+                sun_cells =
+                    if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
+            }
+        }
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
         // if this is its first frame.
         let t_pipelines = Instant::now();
@@ -606,7 +643,13 @@ impl Renderer {
             .iter()
             .map(|draw| {
                 let shading = settings.shading_for(draw.material as usize);
-                ShaderVariant::new(draw.brdf, draw.surface, &settings.lights, &shading, shadows, scene.masked)
+                ShaderVariant::new(
+                    draw.brdf,
+                    draw.surface,
+                    &settings.lights,
+                    &shading,
+                    (shadows, scene.masked, sun_cells),
+                )
             })
             .collect();
         let draw_pipelines = self.pipeline.pipelines_of(&variants)?;
@@ -866,7 +909,8 @@ impl Renderer {
                 let walks = self.pipeline.rays_walk_bvh();
                 buffers.push((10, if walks { walk_records } else { scene.occluder_triangles.buffer }));
                 if self.pipeline.has_shadow_rays() {
-                    buffers.extend([(12, nodes), (13, light_fractions.buffer)]);
+                    let sun_cells = self.sun_cells.as_ref().unwrap_or(&self.no_sun_cells);
+                    buffers.extend([(12, nodes), (13, light_fractions.buffer), (15, sun_cells.buffer)]);
                 }
                 if self.pipeline.has_ray_queries() {
                     buffers.push((14, walk_records));

@@ -15,6 +15,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("visibility.glsl", include_str!("../../shaders/visibility.glsl")),
     ("occluders.glsl", include_str!("../../shaders/occluders.glsl")),
+    ("sun_cells.glsl", include_str!("../../shaders/sun_cells.glsl")),
     ("slices.glsl", include_str!("../../shaders/slices.glsl")),
     ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),

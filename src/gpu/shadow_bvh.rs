@@ -50,6 +50,11 @@ impl WalkSource {
         }
     }
 
+    /// Every triangle of the scene in world space \[m\] and its occluder record, in the same order.
+    pub fn triangles_and_records(&self) -> (&[[DVec3; 3]], &[[u32; 4]]) {
+        (&self.triangles, &self.records)
+    }
+
     /// The nodes of the occluders' tree (`visibility::Bvh` over the same triangles) and the records in its leaf
     /// order. A scene without triangles gets a leaf of one record whose three corners are the same vertex, a
     /// degenerate triangle no ray meets (the watertight test's det is 0; a count of 0 would read as an inner node).

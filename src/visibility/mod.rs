@@ -9,6 +9,7 @@ pub mod bvh;
 pub mod occluders;
 pub mod ray_triangle;
 pub mod shadow_map;
+pub mod sun_cells;
 pub mod technique;
 
 pub use bvh::Bvh;

@@ -1,0 +1,184 @@
+// The sun's cells: the occluders binned across the sun's direction (gpu::sun_cells lays them out), so that a
+// point's rays towards the sun test its cell's triangles only, and a point whose whole sun cone misses them all,
+// or lies within one opaque triangle, casts none. Mirrors src/visibility/sun_cells.rs name for name; see it for
+// the derivations (which triangles a cell must hold, the classification and its margin).
+#ifndef SUNSHADE_SUN_CELLS_GLSL
+#define SUNSHADE_SUN_CELLS_GLSL
+
+#include "bindings.glsl"
+
+// What a cell's triangles do to the sun's cone from a point (visibility::sun_cells::SunCone), and "no cells this
+// frame" (the sun's rays then take occluded, the BVH's walk or the device's ray queries).
+#define SUN_CONE_MISSES 0u
+#define SUN_CONE_COVERED 1u
+#define SUN_CONE_PARTIAL 2u
+#define SUN_CONE_UNKNOWN 3u
+// The margin on the classification's sines (SUN_CONE_MARGIN in the Rust): 2^-20.
+#define SUN_CONE_MARGIN (1.0 / 1048576.0)
+// sun_cell_of's answer for a point outside every cell.
+#define NO_SUN_CELL 0xffffffffu
+// The most triangles above a point that its cell may hold for the point's rays to use it (MAX_SUN_CELL_TRIANGLES).
+#define MAX_SUN_CELL_TRIANGLES 256u
+
+#ifdef SUNSHADE_SHADOW_RAYS
+// Words an entry takes (gpu::sun_cells::ENTRY_WORDS): corners and top (c0, top), (c1, 0), (c2, 0) in f32, then its
+// occluder record.
+#define SUN_CELL_ENTRY_WORDS 16u
+// Word w of entry i, and its vec4 q (0 to 2) as floats.
+#define SUN_CELL_WORD(i, w) sun_cells.data[sun_cells.dims.z + SUN_CELL_ENTRY_WORDS * (i) + (w)]
+#define SUN_CELL_VEC4(i, q) uintBitsToFloat(uvec4(SUN_CELL_WORD(i, 4u * (q)), SUN_CELL_WORD(i, 4u * (q) + 1u), \
+    SUN_CELL_WORD(i, 4u * (q) + 2u), SUN_CELL_WORD(i, 4u * (q) + 3u)))
+#define SUN_CELL_RECORD(i) uvec4(SUN_CELL_WORD(i, 12u), SUN_CELL_WORD(i, 13u), SUN_CELL_WORD(i, 14u), \
+    SUN_CELL_WORD(i, 15u))
+
+// The cell whose triangles the sun rays from `origin` can meet, or NO_SUN_CELL outside every cell (nothing
+// blocks the sun there).
+uint sun_cell_of(vec3 origin) {
+    vec2 at = (vec2(dot(origin, sun_cells.u.xyz), dot(origin, sun_cells.v.xyz)) - vec2(sun_cells.u.w, sun_cells.v.w))
+            * sun_cells.l.w;
+    vec2 ij = floor(at);
+    if (!(ij.x >= 0.0 && ij.y >= 0.0 && ij.x < float(sun_cells.dims.x) && ij.y < float(sun_cells.dims.y))) {
+        return NO_SUN_CELL;
+    }
+    return uint(ij.x) + sun_cells.dims.x * uint(ij.y);
+}
+
+// What the triangle (c0, c1, c2) does to the cone of half-angle asin(sin_sigma) about the unit l from `origin`:
+// SUN_CONE_MISSES (no ray of it above the horizon of the surface's normal n meets it: wholly below the tangent
+// plane, or outside), SUN_CONE_COVERED (every ray of the cone meets it at t > 0) or SUN_CONE_PARTIAL. The edge
+// planes' normals from the edge vectors, not from two long corner vectors (see the Rust).
+uint sun_triangle_class(vec3 origin, vec3 n, vec3 l, float sin_sigma, vec3 c0, vec3 c1, vec3 c2) {
+    if (dot(n, c0 - origin) <= 0.0 && dot(n, c1 - origin) <= 0.0 && dot(n, c2 - origin) <= 0.0) {
+        return SUN_CONE_MISSES;
+    }
+    float limit = sin_sigma + SUN_CONE_MARGIN;
+    vec3 normal = cross(c1 - c0, c2 - c0);
+    float h = dot(normal, origin - c0);
+    float n_l = dot(normal, l);
+    if (h * n_l >= 0.0 && abs(n_l) > limit * length(normal)) {
+        return SUN_CONE_MISSES;
+    }
+    vec3 e0 = c0 - origin;
+    vec3 e1 = c1 - origin;
+    vec3 e2 = c2 - origin;
+    float triple = dot(e0, cross(e1, e2));
+    if (triple == 0.0) {
+        return SUN_CONE_PARTIAL;
+    }
+    float s = sign(triple);
+    vec3 m0 = cross(e0, c1 - c0);
+    vec3 m1 = cross(e1, c2 - c1);
+    vec3 m2 = cross(e2, c0 - c2);
+    vec3 lens = vec3(length(m0), length(m1), length(m2));
+    if (any(equal(lens, vec3(0.0)))) {
+        return SUN_CONE_PARTIAL;
+    }
+    vec3 c = s * vec3(dot(m0, l), dot(m1, l), dot(m2, l));
+    if (any(lessThan(c, -limit * lens))) {
+        return SUN_CONE_MISSES;
+    }
+    return all(greaterThan(c, limit * lens)) ? SUN_CONE_COVERED : SUN_CONE_PARTIAL;
+}
+
+// The entries of origin's cell whose tops lie above its depth along the sun (the only triangles its sun rays can
+// meet), as [x, y): by bisection, the cell's tops being sorted highest first. Empty outside every cell.
+uvec2 sun_cell_range(vec3 origin) {
+    uint c = sun_cell_of(origin);
+    if (c == NO_SUN_CELL) {
+        return uvec2(0u);
+    }
+    float depth = dot(origin, sun_cells.l.xyz);
+    uint lo = sun_cells.data[c];
+    uint hi = sun_cells.data[c + 1u];
+    uint start = lo;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (uintBitsToFloat(SUN_CELL_WORD(mid, 3u)) > depth) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return uvec2(start, lo);
+}
+
+// What the cell's triangles above `origin` do to the sun's cone (direction l, half-angle asin(sin_sigma)) from it
+// on a surface of normal n: SUN_CONE_COVERED where one opaque triangle holds it (an alpha-masked one may let light
+// through), MISSES where all miss its rays above the surface's horizon, PARTIAL otherwise; SUN_CONE_UNKNOWN where
+// the frame has no cells or more than MAX_SUN_CELL_TRIANGLES lie above the point (VARIANT_SUN_CELLS).
+uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
+    if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
+        return SUN_CONE_UNKNOWN;
+    }
+    uvec2 range = sun_cell_range(origin);
+    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES) {
+        return SUN_CONE_UNKNOWN;
+    }
+    bool partial = false;
+    for (uint i = range.x; i < range.y; ++i) {
+        uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
+                                      SUN_CELL_VEC4(i, 2u).xyz);
+        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || materials[SUN_CELL_WORD(i, 15u) & 0x7fffffffu].kind.z == 0u;
+        if (cls == SUN_CONE_COVERED && opaque) {
+            return SUN_CONE_COVERED;
+        }
+        partial = partial || cls != SUN_CONE_MISSES;
+    }
+    return partial ? SUN_CONE_PARTIAL : SUN_CONE_MISSES;
+}
+
+// Whether the frame has cells and the sun rays from `origin` can be tested against its cell: at most
+// MAX_SUN_CELL_TRIANGLES of its triangles lie above it.
+bool sun_cells_usable(vec3 origin) {
+    if (VARIANT_SUN_CELLS != SUN_CELLS_PARTIAL) {
+        return VARIANT_SUN_CELLS == SUN_CELLS_COMPLETE;
+    }
+    uvec2 range = sun_cell_range(origin);
+    return range.y - range.x <= MAX_SUN_CELL_TRIANGLES;
+}
+
+// Whether the ray from `origin` along `direction` (within the sun's cone) meets a triangle of its cell that
+// blocks it (occluders.glsl's blocks): the cell's triangles above the origin are every one such a ray can meet.
+// Only where sun_cells_usable.
+bool sun_cells_occluded(vec3 origin, vec3 direction) {
+    if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
+        return false;
+    }
+    uvec2 range = sun_cell_range(origin);
+    WatertightRay r = watertight_ray(origin, direction);
+    for (uint i = range.x; i < range.y; ++i) {
+        vec2 bary;
+        if (intersect(r, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz, SUN_CELL_VEC4(i, 2u).xyz, RAY_T_INFINITE,
+                      bary)
+            && blocks(SUN_CELL_RECORD(i), bary)) {
+            return true;
+        }
+    }
+    return false;
+}
+#endif
+
+// sun_cells_usable and sun_cells_occluded where the module has shadow rays.
+#ifdef SUNSHADE_SHADOW_RAYS
+#define SUN_CELLS_USABLE(origin) sun_cells_usable(origin)
+#define SUN_CELLS_OCCLUDED(origin, direction) sun_cells_occluded(origin, direction)
+#else
+#define SUN_CELLS_USABLE(origin) false
+#define SUN_CELLS_OCCLUDED(origin, direction) false
+#endif
+
+// Whether every shadow ray of this pipeline goes to the sun through its cells (complete cells, no disk light, no
+// sky): the callers of occluded then test it first, so that the specialized shader holds no traversal at all.
+const bool ONLY_SUN_CELL_RAYS = VARIANT_SUN_CELLS == SUN_CELLS_COMPLETE && VARIANT_DISKS == LIGHT_ABSENT
+                                && VARIANT_SKY == LIGHT_ABSENT;
+
+// Whether the sun's ray from `origin` along `direction` (within its cone: a delta sun's, a lobe sample's) gets
+// through: by the cells where the frame has them and the point's is not full, else by occluded.
+bool sun_visible_along(vec3 origin, vec3 direction) {
+    if (SUN_CELLS_USABLE(origin)) {
+        return !SUN_CELLS_OCCLUDED(origin, direction);
+    }
+    return visible_along(origin, direction);
+}
+
+#endif

@@ -1,0 +1,102 @@
+//! The sun's cells on the device (binding 15, `SunCellsBuffer` in shaders/bindings.glsl): the header, each cell's
+//! first entry, then every entry's corners, top and occluder record (`layout::occluder_records`), so that the
+//! shader reads a cell's triangles in one place, without an indirection. Built by `visibility::sun_cells` for each
+//! frame's sun.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::visibility::sun_cells::SunCells;
+
+/// The buffer's header (std430, 64 bytes): see `SunCellsBuffer`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct SunCellsHeader {
+    pub u: [f32; 4],
+    pub v: [f32; 4],
+    pub l: [f32; 4],
+    pub dims: [u32; 4],
+}
+
+/// The bytes of a frame without cells: the header alone with `dims.w = 0` and one word of data (the sun's rays
+/// then take `occluded`).
+pub fn absent() -> Vec<u8> {
+    let mut bytes = bytemuck::bytes_of(&SunCellsHeader::zeroed()).to_vec();
+    bytes.extend_from_slice(&[0; 4]);
+    bytes
+}
+
+/// Words an entry takes: its corners and top as `(c0, top), (c1, 0), (c2, 0)` in f32, then its occluder record.
+pub const ENTRY_WORDS: usize = 16;
+
+/// The buffer of `cells`, whose triangle indices point into `triangles` (world corners \[m\], the vertex buffer's
+/// f32 positions) and `records` (their occluder records). The entries start at a multiple of four words.
+pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
+    let f = |a: glam::DVec3, w: f64| [a.x as f32, a.y as f32, a.z as f32, w as f32];
+    let offset = cells.starts.len().next_multiple_of(4);
+    let header = SunCellsHeader {
+        u: f(cells.u, cells.origin[0]),
+        v: f(cells.v, cells.origin[1]),
+        l: f(cells.l, cells.per_metre),
+        dims: [cells.dims[0], cells.dims[1], offset as u32, 1],
+    };
+    let mut words: Vec<u32> = Vec::with_capacity(offset + ENTRY_WORDS * cells.triangles.len());
+    words.extend_from_slice(&cells.starts);
+    words.resize(offset, 0);
+    for &t in &cells.triangles {
+        let [c0, c1, c2] = triangles[t as usize];
+        // The top rounded up to f32, so that the shader's cut-off never passes over a triangle the f64 keeps.
+        let top = cells.tops[t as usize];
+        let top32 = if (top as f32 as f64) < top { (top as f32).next_up() } else { top as f32 };
+        for (c, w) in [(c0, top32), (c1, 0.0), (c2, 0.0)] {
+            words.extend([c.x as f32, c.y as f32, c.z as f32, w].map(f32::to_bits));
+        }
+        words.extend_from_slice(&records[t as usize]);
+    }
+    let mut bytes = bytemuck::bytes_of(&header).to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(&words));
+    bytes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// The header's offsets are the shader's (vec4, vec4, vec4, uvec4, then the data), the records follow the
+    /// starts, and a cell's entries are its triangles' records.
+    #[test]
+    fn the_buffer_holds_the_starts_then_each_entrys_record() {
+        assert_eq!(std::mem::size_of::<SunCellsHeader>(), 64);
+        let glsl = include_str!("../../shaders/bindings.glsl");
+        assert!(glsl.contains("    vec4 u;\n    vec4 v;\n    vec4 l;\n    uvec4 dims;\n    uint data[];\n} sun_cells;"));
+        let triangles = vec![
+            [DVec3::ZERO, DVec3::X, DVec3::Z],
+            [DVec3::new(5.0, 1.0, 0.0), DVec3::new(6.0, 1.0, 0.0), DVec3::new(5.0, 1.0, 1.0)],
+        ];
+        let records = [[1, 2, 3, 7], [4, 5, 6, 8]];
+        let cells = SunCells::build(&triangles, DVec3::Y, 0.0).unwrap();
+        let b = bytes(&cells, &triangles, &records);
+        let words: &[u32] = bytemuck::cast_slice(&b[64..]);
+        let header: SunCellsHeader = bytemuck::pod_read_unaligned(&b[..64]);
+        assert_eq!(header.dims[3], 1);
+        let offset = header.dims[2] as usize;
+        assert_eq!(offset % 4, 0);
+        assert_eq!(&words[..cells.starts.len()], &cells.starts[..]);
+        for c in 0..(cells.dims[0] * cells.dims[1]) as usize {
+            for (k, &t) in cells.cell(c).iter().enumerate() {
+                let e = &words[offset + ENTRY_WORDS * (cells.starts[c] as usize + k)..][..ENTRY_WORDS];
+                let corner = |i: usize| {
+                    DVec3::new(
+                        f32::from_bits(e[4 * i]) as f64,
+                        f32::from_bits(e[4 * i + 1]) as f64,
+                        f32::from_bits(e[4 * i + 2]) as f64,
+                    )
+                };
+                assert_eq!([corner(0), corner(1), corner(2)], triangles[t as usize]);
+                assert!(f32::from_bits(e[3]) as f64 >= cells.tops[t as usize]);
+                assert_eq!(&e[12..16], &records[t as usize]);
+            }
+        }
+        assert_eq!(bytemuck::pod_read_unaligned::<SunCellsHeader>(&absent()[..64]).dims[3], 0);
+    }
+}
