@@ -17,8 +17,10 @@
 #define SUN_CONE_MARGIN (1.0 / 1048576.0)
 // sun_cell_of's answer for a point outside every cell.
 #define NO_SUN_CELL 0xffffffffu
-// The most triangles above a point that its cell may hold for the point's rays to use it (MAX_SUN_CELL_TRIANGLES).
+// The most triangles above a point that its cell may hold for the point's rays to use it (MAX_SUN_CELL_TRIANGLES),
+// and for its classification (MAX_SUN_CELL_CLASSIFIED).
 #define MAX_SUN_CELL_TRIANGLES 256u
+#define MAX_SUN_CELL_CLASSIFIED 8192u
 
 #ifdef SUNSHADE_SHADOW_RAYS
 // Words an entry takes (gpu::sun_cells::ENTRY_WORDS): corners and top (c0, top), (c1, 0), (c2, 0) in f32, then its
@@ -105,15 +107,17 @@ uvec2 sun_cell_range(vec3 origin) {
 // What the cell's triangles above `origin` do to the sun's cone (direction l, half-angle asin(sin_sigma)) from it
 // on a surface of normal n: SUN_CONE_COVERED where one opaque triangle holds it (an alpha-masked one may let light
 // through), MISSES where all miss its rays above the surface's horizon, PARTIAL otherwise; SUN_CONE_UNKNOWN where
-// the frame has no cells or more than MAX_SUN_CELL_TRIANGLES lie above the point (VARIANT_SUN_CELLS).
+// the frame has no cells, or where more than MAX_SUN_CELL_TRIANGLES lie above the point and its cone is neither
+// proven clear nor covered (more than MAX_SUN_CELL_CLASSIFIED: not classified at all; VARIANT_SUN_CELLS).
 uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
         return SUN_CONE_UNKNOWN;
     }
     uvec2 range = sun_cell_range(origin);
-    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES) {
+    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_CLASSIFIED) {
         return SUN_CONE_UNKNOWN;
     }
+    bool past_rays = VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES;
     bool partial = false;
     for (uint i = range.x; i < range.y; ++i) {
         uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
@@ -124,7 +128,7 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
         }
         partial = partial || cls != SUN_CONE_MISSES;
     }
-    return partial ? SUN_CONE_PARTIAL : SUN_CONE_MISSES;
+    return partial ? (past_rays ? SUN_CONE_UNKNOWN : SUN_CONE_PARTIAL) : SUN_CONE_MISSES;
 }
 
 // Whether the frame has cells and the sun rays from `origin` can be tested against its cell: at most

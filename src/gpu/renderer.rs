@@ -628,7 +628,8 @@ impl Renderer {
         if let (SHADOWS_RAY, Some(sun), Some(source)) = (shadows, &settings.lights.sun, &scene.walk_source) {
             let (triangles, records) = source.triangles_and_records();
             let half_angle = 0.5 * sun.angular_diameter as f64;
-            if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle) {
+            let max_entries = super::sun_cells::max_entries(self.dev.info.max_storage_buffer_range);
+            if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle, max_entries) {
                 let bytes = super::sun_cells::bytes(&cells, triangles, records);
                 self.sun_cells = Some(Buffer::storage(&self.dev, &bytes, "sun cells")?);
                 sun_cells =

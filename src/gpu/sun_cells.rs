@@ -28,6 +28,12 @@ pub fn absent() -> Vec<u8> {
 /// Words an entry takes: its corners and top as `(c0, top), (c1, 0), (c2, 0)` in f32, then its occluder record.
 pub const ENTRY_WORDS: usize = 16;
 
+/// The most entries a storage buffer of `max_storage_buffer_range` bytes holds beside the header and the cells'
+/// starts: seven eighths of it (at most 1024² cells, 4 MiB of starts: an eighth of lavapipe's 128 MiB).
+pub fn max_entries(max_storage_buffer_range: u32) -> usize {
+    max_storage_buffer_range as usize / 8 * 7 / (ENTRY_WORDS * 4)
+}
+
 /// The buffer of `cells`, whose triangle indices point into `triangles` (world corners \[m\], the vertex buffer's
 /// f32 positions) and `records` (their occluder records). The entries start at a multiple of four words.
 pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
@@ -74,7 +80,7 @@ mod tests {
             [DVec3::new(5.0, 1.0, 0.0), DVec3::new(6.0, 1.0, 0.0), DVec3::new(5.0, 1.0, 1.0)],
         ];
         let records = [[1, 2, 3, 7], [4, 5, 6, 8]];
-        let cells = SunCells::build(&triangles, DVec3::Y, 0.0).unwrap();
+        let cells = SunCells::build(&triangles, DVec3::Y, 0.0, 100).unwrap();
         let b = bytes(&cells, &triangles, &records);
         let words: &[u32] = bytemuck::cast_slice(&b[64..]);
         let header: SunCellsHeader = bytemuck::pod_read_unaligned(&b[..64]);
@@ -98,5 +104,13 @@ mod tests {
             }
         }
         assert_eq!(bytemuck::pod_read_unaligned::<SunCellsHeader>(&absent()[..64]).dims[3], 0);
+        // The shader's constants are the Rust's.
+        use crate::visibility::sun_cells::{MAX_SUN_CELL_CLASSIFIED, MAX_SUN_CELL_TRIANGLES, SUN_CONE_MARGIN};
+        let glsl = include_str!("../../shaders/sun_cells.glsl");
+        assert!(glsl.contains(&format!("#define SUN_CELL_ENTRY_WORDS {ENTRY_WORDS}u\n")));
+        assert!(glsl.contains(&format!("#define MAX_SUN_CELL_TRIANGLES {MAX_SUN_CELL_TRIANGLES}u\n")));
+        assert!(glsl.contains(&format!("#define MAX_SUN_CELL_CLASSIFIED {MAX_SUN_CELL_CLASSIFIED}u\n")));
+        assert_eq!(SUN_CONE_MARGIN, 1.0 / 1_048_576.0);
+        assert!(glsl.contains("#define SUN_CONE_MARGIN (1.0 / 1048576.0)\n"));
     }
 }

@@ -57,8 +57,14 @@ use super::ray_triangle::WatertightRay;
 /// holds more, where they can.
 pub const MAX_SUN_CELL_TRIANGLES: usize = 256;
 
-/// The most entries (a triangle in a cell) the cells keep: 1 Mi, 64 MiB on the device (`gpu::sun_cells`).
-pub const MAX_SUN_CELL_ENTRIES: usize = 1 << 20;
+/// The most triangles above a point that its classification tests where its cell holds more than
+/// [`MAX_SUN_CELL_TRIANGLES`] above it: a cone proven clear or covered still casts no ray (one loop iteration a
+/// triangle, well within llvmpipe's budget); only a penumbra there takes the traversal.
+pub const MAX_SUN_CELL_CLASSIFIED: usize = 8192;
+
+/// The most entries (a triangle in a cell) the cells keep where the caller has no bound of its own: 2 Mi, 128 MiB
+/// on the device (`gpu::sun_cells`: 64 bytes an entry), lavapipe's largest storage buffer.
+pub const MAX_SUN_CELL_ENTRIES: usize = 1 << 21;
 
 /// The margin on the sines of the classification: directions within it of an edge's plane are left to the rays.
 pub const SUN_CONE_MARGIN: f64 = 1.0 / 1_048_576.0;
@@ -100,8 +106,9 @@ pub struct SunCells {
 
 impl SunCells {
     /// Bins `triangles` (world corners \[m\]) for a sun in direction `l` (need not be unit) of angular radius
-    /// `half_angle` \[rad\]. `None` where `l` is not a direction.
-    pub fn build(triangles: &[[DVec3; 3]], l: DVec3, half_angle: f64) -> Option<Self> {
+    /// `half_angle` \[rad\], in at most `max_entries` entries (a triangle in a cell). `None` where `l` is not a
+    /// direction, or where even one cell would hold more (more triangles than that).
+    pub fn build(triangles: &[[DVec3; 3]], l: DVec3, half_angle: f64, max_entries: usize) -> Option<Self> {
         let l = l.try_normalize()?;
         let u = crate::shading::orthonormal_to(l);
         let v = l.cross(u);
@@ -146,63 +153,48 @@ impl SunCells {
                 tops,
             });
         }
-        // About two cells a triangle over the projected area, at most 1024 a side and coarser while the entries
-        // would pass MAX_SUN_CELL_ENTRIES; then halved while a cell holds more than MAX_SUN_CELL_TRIANGLES, the
-        // cells can still shrink and the entries stay within bounds (a cell smaller than the triangles' growth
-        // gains little: every point there sees the same grown boxes).
+        // About two cells a triangle over the projected area, at most 1024 a side, coarser while the entries would
+        // pass `max_entries`; then halved while a cell holds more than MAX_SUN_CELL_TRIANGLES, the cells can still
+        // shrink, the entries stay within bounds and halving still empties the fullest cell by a tenth (a cell
+        // smaller than the triangles' growth gains little: every point there sees the same grown boxes).
         let area = ((u1 - u0) * (v1 - v0)).max(f64::MIN_POSITIVE);
         let longest_side = (u1 - u0).max(v1 - v0);
-        let bin = |side: f64| Self::bin(&boxes, &tops, [u0, v0, u1, v1], side, [l, u, v]);
+        let count = |side: f64| Grid::count(&boxes, [u0, v0, u1, v1], side);
         let mut side = (area / (2.0 * triangles.len() as f64)).sqrt().max(longest_side / 1024.0);
-        let mut cells = bin(side);
-        while cells.triangles.len() > MAX_SUN_CELL_ENTRIES {
-            if cells.dims == [1, 1] {
+        let mut grid = count(side);
+        while grid.entries() > max_entries {
+            if grid.dims == [1, 1] {
                 return None;
             }
-            side *= 2.0;
-            cells = bin(side);
+            side *= 1.5;
+            grid = count(side);
         }
         for _ in 0..8 {
-            if cells.fullest() <= MAX_SUN_CELL_TRIANGLES || longest_side / (side / 2.0) > 1024.0 {
+            let fullest = grid.fullest();
+            if fullest <= MAX_SUN_CELL_TRIANGLES || longest_side / (side / 2.0) > 1024.0 {
                 break;
             }
-            let finer = bin(side / 2.0);
-            if finer.triangles.len() > MAX_SUN_CELL_ENTRIES {
+            let finer = count(side / 2.0);
+            if finer.entries() > max_entries || finer.fullest() * 10 > fullest * 9 {
                 break;
             }
-            (cells, side) = (finer, side / 2.0);
+            (grid, side) = (finer, side / 2.0);
         }
+        let cells = Self::fill(&boxes, &tops, &grid, [l, u, v]);
         Some(cells)
     }
 
-    /// The boxes binned into cells of this side over `[u0, v0, u1, v1]`: counted, then filled (counting sort), each
-    /// cell's triangles sorted by their tops, highest first.
-    fn bin(boxes: &[[f64; 4]], tops: &[f64], [u0, v0, u1, v1]: [f64; 4], side: f64, [l, u, v]: [DVec3; 3]) -> Self {
-        let per_metre = 1.0 / side;
-        let dims = [((u1 - u0) * per_metre).ceil().max(1.0) as u32, ((v1 - v0) * per_metre).ceil().max(1.0) as u32];
-        let span = |b: &[f64; 4]| {
-            let cell = |x: f64, n: u32| ((x * per_metre).floor().max(0.0) as u32).min(n - 1);
-            (cell(b[0] - u0, dims[0])..=cell(b[2] - u0, dims[0]), cell(b[1] - v0, dims[1])..=cell(b[3] - v0, dims[1]))
-        };
-        let mut starts = vec![0u32; (dims[0] * dims[1]) as usize + 1];
-        for b in boxes {
-            let (us, vs) = span(b);
-            for j in vs {
-                for i in us.clone() {
-                    starts[(i + dims[0] * j) as usize + 1] += 1;
-                }
-            }
-        }
-        for c in 1..starts.len() {
-            starts[c] += starts[c - 1];
-        }
+    /// The boxes binned into `grid`'s cells (counting sort), each cell's triangles sorted by their tops, highest
+    /// first.
+    fn fill(boxes: &[[f64; 4]], tops: &[f64], grid: &Grid, [l, u, v]: [DVec3; 3]) -> Self {
+        let starts = grid.starts.clone();
         let mut fill = starts.clone();
         let mut triangles = vec![0u32; *starts.last().unwrap() as usize];
         for (t, b) in boxes.iter().enumerate() {
-            let (us, vs) = span(b);
+            let (us, vs) = grid.span(b);
             for j in vs {
                 for i in us.clone() {
-                    let c = (i + dims[0] * j) as usize;
+                    let c = (i + grid.dims[0] * j) as usize;
                     triangles[fill[c] as usize] = t as u32;
                     fill[c] += 1;
                 }
@@ -210,9 +202,10 @@ impl SunCells {
         }
         for c in 0..starts.len() - 1 {
             let cell = &mut triangles[starts[c] as usize..starts[c + 1] as usize];
-            cell.sort_by(|a, b| tops[*b as usize].total_cmp(&tops[*a as usize]));
+            cell.sort_unstable_by(|a, b| tops[*b as usize].total_cmp(&tops[*a as usize]));
         }
-        Self { l, u, v, origin: [u0, v0], per_metre, dims, starts, triangles, tops: tops.to_vec() }
+        let origin = [grid.origin[0], grid.origin[1]];
+        Self { l, u, v, origin, per_metre: grid.per_metre, dims: grid.dims, starts, triangles, tops: tops.to_vec() }
     }
 
     /// The triangles of cell `c` (indices into the list built from), highest top first.
@@ -222,6 +215,54 @@ impl SunCells {
 
     /// The most triangles a cell holds.
     pub fn fullest(&self) -> usize {
+        self.starts.windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0)
+    }
+}
+
+/// The cells of one side over the grown boxes' extent, and how many boxes each holds (as `SunCells::starts`):
+/// counted before any is filled, so that choosing the side costs one pass over the boxes a try.
+struct Grid {
+    origin: [f64; 2],
+    per_metre: f64,
+    dims: [u32; 2],
+    starts: Vec<u32>,
+}
+
+impl Grid {
+    /// Cells of `side` \[m\] over `[u0, v0, u1, v1]`, and the boxes counted into them.
+    fn count(boxes: &[[f64; 4]], [u0, v0, u1, v1]: [f64; 4], side: f64) -> Self {
+        let per_metre = 1.0 / side;
+        let dims = [((u1 - u0) * per_metre).ceil().max(1.0) as u32, ((v1 - v0) * per_metre).ceil().max(1.0) as u32];
+        let mut grid = Grid { origin: [u0, v0], per_metre, dims, starts: vec![0; (dims[0] * dims[1]) as usize + 1] };
+        for b in boxes {
+            let (us, vs) = grid.span(b);
+            for j in vs {
+                for i in us.clone() {
+                    grid.starts[(i + dims[0] * j) as usize + 1] += 1;
+                }
+            }
+        }
+        for c in 1..grid.starts.len() {
+            grid.starts[c] += grid.starts[c - 1];
+        }
+        grid
+    }
+
+    /// The cells a box covers, along u and along v.
+    fn span(&self, b: &[f64; 4]) -> (std::ops::RangeInclusive<u32>, std::ops::RangeInclusive<u32>) {
+        let cell = |x: f64, n: u32| ((x * self.per_metre).floor().max(0.0) as u32).min(n - 1);
+        let [u0, v0] = self.origin;
+        (
+            cell(b[0] - u0, self.dims[0])..=cell(b[2] - u0, self.dims[0]),
+            cell(b[1] - v0, self.dims[1])..=cell(b[3] - v0, self.dims[1]),
+        )
+    }
+
+    fn entries(&self) -> usize {
+        *self.starts.last().unwrap() as usize
+    }
+
+    fn fullest(&self) -> usize {
         self.starts.windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0)
     }
 }
@@ -292,8 +333,8 @@ pub fn sun_triangle_class(origin: DVec3, n: DVec3, l: DVec3, sin_sigma: f64, cor
 
 /// What the cell's triangles do to the sun's cone from `origin` on a surface of normal `n`: [`SunCone::Covered`]
 /// where one of them that is `opaque` holds it, [`SunCone::Misses`] where all miss its rays above the surface's
-/// horizon, [`SunCone::Unknown`] where more than [`MAX_SUN_CELL_TRIANGLES`] lie above it, else
-/// [`SunCone::Partial`].
+/// horizon, else [`SunCone::Partial`], or [`SunCone::Unknown`] where more than [`MAX_SUN_CELL_TRIANGLES`] lie above
+/// it (its rays then take the traversal; more than [`MAX_SUN_CELL_CLASSIFIED`]: not classified at all).
 pub fn sun_cone_class(
     cells: &SunCells,
     triangles: &[[DVec3; 3]],
@@ -303,9 +344,10 @@ pub fn sun_cone_class(
     sin_sigma: f64,
 ) -> SunCone {
     let range = sun_cell_range(cells, origin);
-    if range.len() > MAX_SUN_CELL_TRIANGLES {
+    if range.len() > MAX_SUN_CELL_CLASSIFIED {
         return SunCone::Unknown;
     }
+    let past_rays = range.len() > MAX_SUN_CELL_TRIANGLES;
     let mut partial = false;
     for &t in &cells.triangles[range] {
         match sun_triangle_class(origin, n, cells.l, sin_sigma, triangles[t as usize]) {
@@ -314,10 +356,10 @@ pub fn sun_cone_class(
             _ => partial = true,
         }
     }
-    if partial {
-        SunCone::Partial
-    } else {
-        SunCone::Misses
+    match (partial, past_rays) {
+        (false, _) => SunCone::Misses,
+        (true, false) => SunCone::Partial,
+        (true, true) => SunCone::Unknown,
     }
 }
 
@@ -417,7 +459,7 @@ mod tests {
                     [c + rng.point(size), c + rng.point(size), c + rng.point(size)]
                 })
                 .collect();
-            let cells = SunCells::build(&triangles, l, sigma).expect("60 triangles fit");
+            let cells = SunCells::build(&triangles, l, sigma, MAX_SUN_CELL_ENTRIES).expect("60 triangles fit");
             for _ in 0..400 {
                 // Origins on the triangles (where shading points lie), pushed off them along the face normal as
                 // the renderers push shadow rays' origins (2^-16 of the largest corner coordinate), on either side.
@@ -480,7 +522,7 @@ mod tests {
         let block = [DVec3::new(-0.5, 1.0, -0.5), DVec3::new(0.5, 1.0, -0.5), DVec3::new(0.0, 1.0, 0.5)];
         let triangles = vec![floor[0], floor[1], block];
         let sigma = 0.53f64.to_radians() / 2.0;
-        let cells = SunCells::build(&triangles, DVec3::Y, sigma).unwrap();
+        let cells = SunCells::build(&triangles, DVec3::Y, sigma, MAX_SUN_CELL_ENTRIES).unwrap();
         assert!(cells.fullest() <= MAX_SUN_CELL_TRIANGLES);
         let above = |x: f64, z: f64| DVec3::new(x, 1e-4, z);
         let class = |p| sun_cone_class(&cells, &triangles, |_| true, p, DVec3::Y, sigma.sin());
@@ -490,6 +532,22 @@ mod tests {
         // A masked (not opaque) cover leaves the decision to the rays.
         let masked = sun_cone_class(&cells, &triangles, |t| t != 2, above(0.0, 0.0), DVec3::Y, sigma.sin());
         assert_eq!(masked, SunCone::Partial);
+    }
+
+    /// The entries stay within the caller's bound: coarser cells where the fine ones would pass it, none where
+    /// even one cell would.
+    #[test]
+    fn the_cells_keep_within_their_entries() {
+        let triangles: Vec<[DVec3; 3]> = (0..900)
+            .map(|i| {
+                let (x, z) = ((i % 30) as f64 * 0.1, (i / 30) as f64 * 0.1);
+                [DVec3::new(x, 0.0, z), DVec3::new(x + 0.3, 0.0, z), DVec3::new(x, 0.0, z + 0.3)]
+            })
+            .collect();
+        let free = SunCells::build(&triangles, DVec3::Y, 0.0046, MAX_SUN_CELL_ENTRIES).unwrap();
+        let bounded = SunCells::build(&triangles, DVec3::Y, 0.0046, 2000).unwrap();
+        assert!(free.triangles.len() > 2000 && bounded.triangles.len() <= 2000, "{}", free.triangles.len());
+        assert!(SunCells::build(&triangles, DVec3::Y, 0.0046, 899).is_none());
     }
 
     /// Too many triangles over one spot (a stack of 400 coincident squares) cannot be split into cells: a point
@@ -504,11 +562,14 @@ mod tests {
             })
             .collect();
         triangles.push([DVec3::new(5.0, 0.0, 5.0), DVec3::new(6.0, 0.0, 5.0), DVec3::new(5.0, 0.0, 6.0)]);
-        let cells = SunCells::build(&triangles, DVec3::Y, 0.0046).unwrap();
+        let cells = SunCells::build(&triangles, DVec3::Y, 0.0046, MAX_SUN_CELL_ENTRIES).unwrap();
         assert!(cells.fullest() > MAX_SUN_CELL_TRIANGLES);
         let class = |p| sun_cone_class(&cells, &triangles, |_| true, p, DVec3::Y, 0.0046);
+        // Under all 400: too many for its rays, but the classification still proves it covered; at the stack's
+        // edge a penumbra, left to the traversal.
         let under = DVec3::new(0.2, -0.1, 0.2);
-        assert_eq!(class(under), SunCone::Unknown);
+        assert_eq!(class(under), SunCone::Covered);
+        assert_eq!(class(DVec3::new(0.5, -0.1, 0.0)), SunCone::Unknown);
         assert!(!sun_cells_usable(&cells, under));
         assert_eq!(sun_cells_occluded(&cells, &triangles, |_, _| true, under, DVec3::Y), None);
         assert!(!sun_visible_along(Some(&cells), &triangles, |_, _| true, under, DVec3::Y, || true));
