@@ -2,7 +2,7 @@
 CARGO ?= cargo
 SUNSHADE := target/release/sunshade
 
-.PHONY: setup build render test lint models bench bench-batch bench-startup bench-daylight docs images clean
+.PHONY: setup build render test lint models bench bench-batch bench-startup bench-shadow-cost bench-daylight docs images clean
 
 setup:
 	@./scripts/setup.sh
@@ -35,6 +35,7 @@ lint:
 bench: build
 	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
 	$(SUNSHADE) bench --startup --repeat 5 --update README.md
+	$(SUNSHADE) bench --shadow-cost --repeat 5 --update docs/accuracy.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
 	$(SUNSHADE) bench --textures --repeat 5 --update docs/textures.md
@@ -46,6 +47,10 @@ bench: build
 # (README "Start-up").
 bench-startup: build
 	$(SUNSHADE) bench --startup --repeat 5 --update README.md
+
+# What the default shadows cost against an unshadowed frame (docs/accuracy.md, "What the shadows cost").
+bench-shadow-cost: build
+	$(SUNSHADE) bench --shadow-cost --repeat 5 --update docs/accuracy.md
 
 # Throughput: 30 renders as processes against one batch, and a whole render process against its frame phases.
 bench-batch: build

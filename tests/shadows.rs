@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 
 use common::CheckedRenderer;
 use glam::{DVec3, Vec3};
-use sunshade::authoring::shapes::{cube, icosphere, quad, MeshData};
+use sunshade::authoring::shapes::{cube, icosphere, quad, uv_sphere, MeshData};
 use sunshade::compare::{self, DiffOptions};
 use sunshade::cpu::{self, ReferenceOptions};
 use sunshade::scene::{Brdf, Camera, Lights, Material, MetallicRoughness, Projection, Scene, Sun};
@@ -19,6 +19,7 @@ use sunshade::shading::quadrature::integrate_composite;
 use sunshade::shading::visibility::shadow_ray_origin;
 use sunshade::shading::{
     irradiance_visible, Occlusion, ShadingOptions, ShadowedLights, Shadowing, Shadows, SurfacePoint, VisibilityRule,
+    DEFAULT_SHADOW_SAMPLES_PER_AXIS,
 };
 use sunshade::visibility::Bvh;
 use sunshade::Image;
@@ -605,6 +606,86 @@ fn gpu_ray_queries_agree_with_the_reference_at_every_scale_and_at_grazing_sun() 
             assert_eq!(over, flagged, "scale {scale}, sun {l}: {over} pixels over tolerance, {flagged} fragile");
         }
     }
+}
+
+/// A coarse smooth-shaded head on a floor: an 8 × 6 UV sphere with a nose, two ears and a brow of smaller coarse
+/// spheres sunk into it (creases where smooth normals meet faceted occluders), `scale` metres tall.
+fn low_poly_head(scale: f32) -> Scene {
+    let at = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * scale;
+    let parts = [
+        placed(&floor(2.0), scale, Vec3::ZERO),
+        uv_sphere(at(0.0, 0.5, 0.0), 0.35 * scale, 6, 8),
+        uv_sphere(at(0.0, 0.5, 0.33), 0.08 * scale, 4, 6),
+        uv_sphere(at(0.34, 0.5, 0.0), 0.1 * scale, 4, 6),
+        uv_sphere(at(-0.34, 0.5, 0.0), 0.1 * scale, 4, 6),
+        uv_sphere(at(0.0, 0.68, 0.22), 0.15 * scale, 4, 6),
+    ];
+    scene(&parts)
+}
+
+#[test]
+fn gpu_default_shadows_agree_with_the_reference_on_hard_meshes() {
+    // The default render (`auto`: shadow rays on every device, the sun's through its cells) against the default
+    // reference, as `render --check` compares them: no coverage mismatch, and over tolerance only fragile pixels,
+    // at most 0.05% of the compared ones. An 80-triangle icosphere and a coarse head on a floor (smooth normals
+    // over few facets), a box and a 1 mm plate touching the floor, at 1 mm, 1 m and 10 km, under a sun 45°, 1° and
+    // 0.1° above the horizon.
+    let mut gpu = common::shadow_ray_renderer();
+    let diff = DiffOptions::default();
+    let (azimuth, suns) = (20f64.to_radians(), [45.0f64, 1.0, 0.1].map(f64::to_radians));
+    let suns = suns.map(|e| DVec3::new(e.cos() * azimuth.cos(), e.sin(), e.cos() * azimuth.sin()));
+    let mut shadowed_cases = 0;
+    for (name, scale) in [("icosphere", 1.0f32), ("head", 1e-3), ("head", 1.0), ("blocks", 1e-3), ("blocks", 1e4)] {
+        let sc = match name {
+            "icosphere" => scene(&[floor(3.0), icosphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 1)]),
+            "head" => low_poly_head(scale),
+            _ => blocks_scene(scale, 5.0),
+        };
+        let centre = if name == "blocks" { DVec3::new(1.5, 0.0, 0.0) } else { DVec3::ZERO } * scale as f64;
+        let camera = camera_down(centre, 3.0 * scale as f64, 10.0 * scale as f64);
+        for l in suns {
+            let s = settings(96, 96, camera, sun_lights(l, 0.53), Shadows::Auto, DEFAULT_SHADOW_SAMPLES_PER_AXIS);
+            let what = format!("{name} at {scale} m, sun {:.1}° up", l.y.atan2(l.x.hypot(l.z)).to_degrees());
+            let g = gpu.render(&sc, &s);
+            let (c, apart) = cpu::checked::checked_reference(&sc, &s, &gpu.reference_options());
+            let apart = apart.as_ref().map(|a| (a.mask.as_slice(), a.name, a.allowed_fraction));
+            assert!(apart.is_some_and(|a| a.2.is_some()), "{what}: the fragile class, capped");
+            let (report, _) = compare::diff_apart(&g, &c, &diff, apart).unwrap();
+            assert!(report.pass && report.coverage_mismatches.total == 0, "{what}:\n{}", report.text("gpu", "cpu"));
+            let e = report.excused.as_ref().expect("the fragile class");
+            eprintln!(
+                "{what}: {} compared, {} over tolerance, {} fragile ({} over)",
+                report.compared, report.over_tolerance.total, e.compared, e.over_tolerance
+            );
+            let none = cpu::render(
+                &sc,
+                &settings(96, 96, camera, sun_lights(l, 0.53), Shadows::None, 1),
+                &gpu.reference_options(),
+            );
+            shadowed_cases += usize::from(c.pixels().iter().zip(none.pixels()).any(|(a, b)| a[0] < b[0]));
+        }
+    }
+    // Every case but none shows a shadow (the test would pass vacuously otherwise).
+    assert!(shadowed_cases >= 14, "{shadowed_cases} of 15 cases show a shadow");
+}
+
+#[test]
+fn sun_rays_are_spent_only_in_penumbrae() {
+    // What the GPU's sun visibility casts (cpu::sun_costs, the shader's classification mirrored): a lit floor no
+    // ray at all (its cells prove every cone clear); with the box and the plate on it, only the penumbrae cast
+    // the 6² grid's rays, (6 + 1)² corners and at most 2·6 crossings located by 3 bisections each, and they are a
+    // small part of the floor.
+    let camera = camera_down(DVec3::new(1.5, 0.0, 0.0), 3.0, 10.0);
+    let s = settings(96, 96, camera, sun_lights(DVec3::new(-1.0, 1.0, 0.2), 0.53), Shadows::Auto, 6);
+    let options = ReferenceOptions::default();
+    let lone = cpu::sun_costs::sun_ray_costs(&scene(&[floor(5.0)]), &s, &options).unwrap();
+    assert!(lone.covered > 9000 && lone.evaluated == lone.covered, "{lone:?}");
+    assert_eq!((lone.penumbra, lone.rays), (0, 0), "{lone:?}");
+    let blocks = cpu::sun_costs::sun_ray_costs(&blocks_scene(1.0, 5.0), &s, &options).unwrap();
+    assert!(blocks.penumbra > 0 && blocks.penumbra * 20 < blocks.evaluated, "{blocks:?}");
+    let per_penumbra = blocks.rays as f64 / blocks.penumbra as f64;
+    eprintln!("lone floor {lone:?}; with the blocks {blocks:?}");
+    assert!((49.0..=85.0).contains(&per_penumbra), "{per_penumbra} rays a penumbra pixel: {blocks:?}");
 }
 
 #[test]

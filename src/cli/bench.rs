@@ -62,8 +62,7 @@ pub struct BenchArgs {
     /// Instead of scenes, measure the shadow techniques and sample counts on shadowed scenes (the teapot on a
     /// floor under the sun, the room under its skylight; 256 × 192 unless --width/--height are given): GPU frame
     /// time, CPU reference time, and the visible-fraction error against a converged reference. Run from the
-    /// repository (it reads models/); GPU rows need ray queries (`eval "$(scripts/lavapipe-rt.sh)"`). Its
-    /// --update region is "shadows".
+    /// repository (it reads models/). Its --update region is "shadows".
     #[arg(long, conflicts_with_all = ["scenes", "interpolation", "process_runs", "brdf_chart"])]
     pub shadows: bool,
     /// Measure what textures cost: each textured scene (default: the textured samples in models/gltf-samples;
@@ -93,6 +92,12 @@ pub struct BenchArgs {
     /// region is "startup".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto", "measured"])]
     pub startup: bool,
+    /// What the default render's shadows cost: teapot, cube, sunset and room (512 × 512 unless --width/--height are
+    /// given) and the teapot on a floor under a delta sun at twice that, each GPU frame with the default shadows
+    /// against `--shadows none` and `--shadows map`, the CPU reference's render, the sun's penumbra fraction and
+    /// its rays a pixel (`cpu::sun_costs`). Its --update region is "shadow-cost".
+    #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto", "measured", "startup"])]
+    pub shadow_cost: bool,
     /// With --startup: the same processes again with the whole shaders handed to the driver (diagnostics:
     /// `SUNSHADE_WHOLE_SHADERS=1`), to show what specializing them saves.
     #[arg(long, requires = "startup")]
@@ -170,6 +175,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         "measured-fit"
     } else if a.startup {
         "startup"
+    } else if a.shadow_cost {
+        "shadow-cost"
     } else {
         ""
     };
@@ -181,6 +188,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     }
     if a.startup {
         return super::bench_startup::run(a);
+    }
+    if a.shadow_cost {
+        return super::bench_shadow_cost::run(a);
     }
     if a.shadows {
         return super::bench_shadows::run(a);

@@ -10,6 +10,7 @@ mod batch;
 mod bench;
 mod bench_measured;
 mod bench_pareto;
+mod bench_shadow_cost;
 mod bench_shadows;
 mod bench_startup;
 mod bench_textures;

@@ -1,0 +1,88 @@
+//! `sunshade bench --shadow-cost`: what the default render's shadows cost on the models of models/ and on the
+//! teapot standing on a floor: each GPU frame with the default shadows (`auto`: shadow rays, the sun's through its
+//! cells) against the same frame unshadowed and by shadow maps, the CPU reference's render of the same image, and
+//! where the sun's rays go (`cpu::sun_costs`): the fraction of the evaluated pixels left to the rays (penumbrae),
+//! and the rays a covered pixel and a penumbra pixel cast.
+
+use std::time::Instant;
+
+use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
+use super::generated::{print_output, update_region};
+use super::CliError;
+use crate::cpu;
+use crate::scene::{self, LoadOptions};
+use crate::settings::{self, CameraOptions, LightOptions, SunOptions};
+use crate::shading::{Shadows, SunModel};
+
+pub fn run(a: &BenchArgs) -> Result<(), CliError> {
+    let (width, height) = (a.width.unwrap_or(512), a.height.unwrap_or(512));
+    let (mut renderer, info, reference) = bench_renderer(a, (2 * width, 2 * height))?;
+    let mut out = measured_by(
+        "sunshade bench --shadow-cost",
+        &info,
+        (width, height),
+        a.repeat,
+        "frames are the render phase; the CPU reference renders the default image (f64 rays) on every core",
+    );
+    out += "| scene | covered px | unshadowed frame [ms] | default frame [ms] | default / unshadowed | shadow maps frame [ms] | CPU reference [ms] | sun evaluated px | penumbra (left to rays) | sun rays / covered px | rays / penumbra px |\n";
+    out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    let mut cases = Vec::new();
+    for model in ["teapot.glb", "cube.glb", "sunset.glb", "room.gltf"] {
+        let path = std::path::Path::new("models").join(model);
+        let scene = scene::load_with_options(&path, &LoadOptions::default())?;
+        let s = settings::resolve_with(&scene, width, height, &CameraOptions::default(), &LightOptions::default())
+            .map_err(|e| CliError::Usage(format!("{model}: {e}")))?;
+        cases.push((format!("models/{model}"), scene, s));
+    }
+    // The teapot standing on a floor, twice the size, under a delta sun (hard shadows).
+    let teapot = super::bench_shadows::teapot_on_floor()?;
+    let sun = SunOptions { elevation_degrees: Some(40.0), azimuth_degrees: Some(30.0), ..Default::default() };
+    let lights = LightOptions { sun, ..Default::default() };
+    let mut s = settings::resolve_with(&teapot, 2 * width, 2 * height, &CameraOptions::default(), &lights)
+        .map_err(|e| CliError::Usage(format!("teapot on a floor: {e}")))?;
+    s.shading.sun = SunModel::Delta;
+    cases.push((format!("teapot on a floor, delta sun, {}×{}", 2 * width, 2 * height), teapot, s));
+    for (name, scene, s) in cases {
+        let uploaded = renderer.upload(&scene)?;
+        let with = |shadows: Shadows| {
+            let mut s = s.clone();
+            s.shading.shadows = shadows;
+            s
+        };
+        let frame = |renderer: &mut crate::gpu::Renderer, shadows: Shadows| {
+            warm_frames(renderer, &uploaded, &with(shadows), a.repeat).map(|(image, t)| (image, median(t)))
+        };
+        let (image, none) = frame(&mut renderer, Shadows::None)?;
+        let (_, auto) = frame(&mut renderer, Shadows::Auto)?;
+        let (_, map) = frame(&mut renderer, Shadows::Map)?;
+        let t = Instant::now();
+        cpu::render(&scene, &with(Shadows::Auto), &reference);
+        let cpu_time = t.elapsed();
+        let costs = cpu::sun_costs::sun_ray_costs(&scene, &with(Shadows::Ray), &reference);
+        let (evaluated, penumbra, per_pixel, per_penumbra) = match costs {
+            Some(c) => (
+                c.evaluated.to_string(),
+                format!("{} ({:.2}%)", c.penumbra, 100.0 * c.penumbra as f64 / c.evaluated.max(1) as f64),
+                format!("{:.2}", c.rays as f64 / c.covered.max(1) as f64),
+                if c.penumbra > 0 { format!("{:.1}", c.rays as f64 / c.penumbra as f64) } else { "–".into() },
+            ),
+            None => ("no sun".into(), "–".into(), "–".into(), "–".into()),
+        };
+        out += &format!(
+            "| {name} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {evaluated} | {penumbra} | {per_pixel} | {per_penumbra} |\n",
+            image.covered_count(),
+            ms(none),
+            ms(auto),
+            auto.as_secs_f64() / none.as_secs_f64(),
+            ms(map),
+            ms(cpu_time),
+        );
+        eprintln!("sunshade bench: {name} done");
+    }
+    print_output(&out, a.json);
+    for doc in &a.update {
+        update_region(doc, "shadow-cost", &out)?;
+        eprintln!("sunshade bench: updated {}", doc.display());
+    }
+    Ok(())
+}
