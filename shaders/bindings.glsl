@@ -212,14 +212,14 @@ layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
 // The sun's cells (gpu::sun_cells lays out visibility::sun_cells::SunCells): the axes across the sun (u, v) with
 // the projection of cell (0, 0)'s corner in w [m]; l the sun's direction, w cells per metre; dims the cells along
 // u and v, z where the entries start in data, w unused (VARIANT_SUN_CELLS says what the cells answer).
-// data: each cell's first entry and one past the last cell's last (dims.x dims.y + 1 of them), then an occluder
-// record (OccluderTriangles') an entry, four words each.
+// data, four words a vec4: each cell's first entry and one past the last cell's last (dims.x dims.y + 1 of them),
+// then from word dims.z (a multiple of four) the entries, sixteen words each (sun_cells.glsl).
 layout(std430, set = 0, binding = 15) readonly buffer SunCellsBuffer {
     vec4 u;
     vec4 v;
     vec4 l;
     uvec4 dims;
-    uint data[];
+    uvec4 data[];
 } sun_cells;
 #endif
 

@@ -65,7 +65,7 @@ vec3 irradiance_visible(Frame p) {
         float v = 1.0;
         if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
             if (VARIANT_SUN == SUN_DELTA) {
-                v = sun_visible_along(p.shadow_origin, l) ? 1.0 : 0.0;
+                v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
             } else {
                 // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
                 // sky_slices::slice_rows), or as their passes took them before this one where the frame could not
@@ -321,7 +321,7 @@ SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d
                 // The sun's samples (RAYS_ALONG) take its cells where the frame has them (sun_visible_along).
                 bool along = rays == RAYS_ALONG;
                 bool cells = ONLY_SUN_CELL_RAYS || (along && SUN_CELLS_USABLE(p.shadow_origin));
-                if (rays == RAYS_NONE || (cells ? !SUN_CELLS_OCCLUDED(p.shadow_origin, omega)
+                if (rays == RAYS_NONE || (cells ? !SUN_CELLS_OCCLUDED(p.shadow_origin, n, omega)
                                                 : !occluded(p.shadow_origin, along ? omega : (p.position + y) - p.shadow_origin,
                                                             along ? RAY_T_INFINITE : SEGMENT_T_MAX))) {
                     sum += specular_lobe_rgb(m, p, omega) * weight;
@@ -586,7 +586,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         vec3 l = lights.sun.direction.xyz;
         if (VARIANT_SUN == SUN_DELTA) {
             vec3 factor = specular_lobe_rgb(material, p, l) * max(dot(p.normal, l), 0.0);
-            if (SHADOWS_ON && any(greaterThan(factor, vec3(0.0))) && !sun_visible_along(p.shadow_origin, l)) {
+            if (SHADOWS_ON && any(greaterThan(factor, vec3(0.0))) && !sun_visible_along(p.shadow_origin, p.normal, l)) {
                 factor = vec3(0.0);
             }
             if (SHADOWS_MAP_ON) {

@@ -24,14 +24,14 @@
 
 #ifdef SUNSHADE_SHADOW_RAYS
 // Words an entry takes (gpu::sun_cells::ENTRY_WORDS): corners and top (c0, top), (c1, 0), (c2, 0) in f32, then its
-// occluder record.
+// occluder record; the entries start at a multiple of four words (dims.z).
 #define SUN_CELL_ENTRY_WORDS 16u
 // Word w of entry i, and its vec4 q (0 to 2) as floats.
-#define SUN_CELL_WORD(i, w) sun_cells.data[sun_cells.dims.z + SUN_CELL_ENTRY_WORDS * (i) + (w)]
-#define SUN_CELL_VEC4(i, q) uintBitsToFloat(uvec4(SUN_CELL_WORD(i, 4u * (q)), SUN_CELL_WORD(i, 4u * (q) + 1u), \
-    SUN_CELL_WORD(i, 4u * (q) + 2u), SUN_CELL_WORD(i, 4u * (q) + 3u)))
-#define SUN_CELL_RECORD(i) uvec4(SUN_CELL_WORD(i, 12u), SUN_CELL_WORD(i, 13u), SUN_CELL_WORD(i, 14u), \
-    SUN_CELL_WORD(i, 15u))
+// Vec4 q (0 to 3) of entry i, as words (one 16-byte load) and as floats; word w of the starts.
+#define SUN_CELL_UVEC4(i, q) sun_cells.data[sun_cells.dims.z / 4u + (SUN_CELL_ENTRY_WORDS / 4u) * (i) + (q)]
+#define SUN_CELL_VEC4(i, q) uintBitsToFloat(SUN_CELL_UVEC4(i, q))
+#define SUN_CELL_RECORD(i) SUN_CELL_UVEC4(i, 3u)
+#define SUN_CELL_START(c) sun_cells.data[(c) / 4u][(c) % 4u]
 
 // The cell whose triangles the sun rays from `origin` can meet, or NO_SUN_CELL outside every cell (nothing
 // blocks the sun there).
@@ -90,12 +90,12 @@ uvec2 sun_cell_range(vec3 origin) {
         return uvec2(0u);
     }
     float depth = dot(origin, sun_cells.l.xyz);
-    uint lo = sun_cells.data[c];
-    uint hi = sun_cells.data[c + 1u];
+    uint lo = SUN_CELL_START(c);
+    uint hi = SUN_CELL_START(c + 1u);
     uint start = lo;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (uintBitsToFloat(SUN_CELL_WORD(mid, 3u)) > depth) {
+        if (SUN_CELL_VEC4(mid, 0u).w > depth) {
             lo = mid + 1u;
         } else {
             hi = mid;
@@ -122,7 +122,7 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     for (uint i = range.x; i < range.y; ++i) {
         uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
                                       SUN_CELL_VEC4(i, 2u).xyz);
-        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || materials[SUN_CELL_WORD(i, 15u) & 0x7fffffffu].kind.z == 0u;
+        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || materials[SUN_CELL_RECORD(i).w & 0x7fffffffu].kind.z == 0u;
         if (cls == SUN_CONE_COVERED && opaque) {
             return SUN_CONE_COVERED;
         }
@@ -141,20 +141,25 @@ bool sun_cells_usable(vec3 origin) {
     return range.y - range.x <= MAX_SUN_CELL_TRIANGLES;
 }
 
-// Whether the ray from `origin` along `direction` (within the sun's cone) meets a triangle of its cell that
-// blocks it (occluders.glsl's blocks): the cell's triangles above the origin are every one such a ray can meet.
-// Only where sun_cells_usable.
-bool sun_cells_occluded(vec3 origin, vec3 direction) {
+// Whether the ray from `origin` (on a surface of normal n) along `direction` (within the sun's cone) meets a
+// triangle of its cell that blocks it (occluders.glsl's blocks): the cell's triangles above the origin are every
+// one such a ray can meet; a ray leaving above the tangent plane skips those wholly below it. Only where
+// sun_cells_usable.
+bool sun_cells_occluded(vec3 origin, vec3 n, vec3 direction) {
     if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
         return false;
     }
     uvec2 range = sun_cell_range(origin);
     WatertightRay r = watertight_ray(origin, direction);
+    bool leaves_above = dot(n, direction) > 0.0;
     for (uint i = range.x; i < range.y; ++i) {
+        vec3 c0 = SUN_CELL_VEC4(i, 0u).xyz;
+        vec3 c1 = SUN_CELL_VEC4(i, 1u).xyz;
+        vec3 c2 = SUN_CELL_VEC4(i, 2u).xyz;
+        bool below = leaves_above && dot(n, c0 - origin) <= 0.0 && dot(n, c1 - origin) <= 0.0
+                     && dot(n, c2 - origin) <= 0.0;
         vec2 bary;
-        if (intersect(r, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz, SUN_CELL_VEC4(i, 2u).xyz, RAY_T_INFINITE,
-                      bary)
-            && blocks(SUN_CELL_RECORD(i), bary)) {
+        if (!below && intersect(r, c0, c1, c2, RAY_T_INFINITE, bary) && blocks(SUN_CELL_RECORD(i), bary)) {
             return true;
         }
     }
@@ -165,10 +170,10 @@ bool sun_cells_occluded(vec3 origin, vec3 direction) {
 // sun_cells_usable and sun_cells_occluded where the module has shadow rays.
 #ifdef SUNSHADE_SHADOW_RAYS
 #define SUN_CELLS_USABLE(origin) sun_cells_usable(origin)
-#define SUN_CELLS_OCCLUDED(origin, direction) sun_cells_occluded(origin, direction)
+#define SUN_CELLS_OCCLUDED(origin, n, direction) sun_cells_occluded(origin, n, direction)
 #else
 #define SUN_CELLS_USABLE(origin) false
-#define SUN_CELLS_OCCLUDED(origin, direction) false
+#define SUN_CELLS_OCCLUDED(origin, n, direction) false
 #endif
 
 // Whether every shadow ray of this pipeline goes to the sun through its cells (complete cells, no disk light, no
@@ -176,11 +181,12 @@ bool sun_cells_occluded(vec3 origin, vec3 direction) {
 const bool ONLY_SUN_CELL_RAYS = VARIANT_SUN_CELLS == SUN_CELLS_COMPLETE && VARIANT_DISKS == LIGHT_ABSENT
                                 && VARIANT_SKY == LIGHT_ABSENT;
 
-// Whether the sun's ray from `origin` along `direction` (within its cone: a delta sun's, a lobe sample's) gets
-// through: by the cells where the frame has them and the point's is not full, else by occluded.
-bool sun_visible_along(vec3 origin, vec3 direction) {
+// Whether the sun's ray from `origin` (on a surface of normal n) along `direction` (within its cone: a delta
+// sun's) gets through: by the cells where the frame has them and the point is within their bound, else by
+// occluded.
+bool sun_visible_along(vec3 origin, vec3 n, vec3 direction) {
     if (SUN_CELLS_USABLE(origin)) {
-        return !SUN_CELLS_OCCLUDED(origin, direction);
+        return !SUN_CELLS_OCCLUDED(origin, n, direction);
     }
     return visible_along(origin, direction);
 }

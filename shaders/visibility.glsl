@@ -197,7 +197,7 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
 bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
 #ifdef SUNSHADE_SHADOW_RAYS
     if (ONLY_SUN_CELL_RAYS || L.kind == GRID_LIGHT_SUN_CELLS) {
-        return !sun_cells_occluded(origin, ray);
+        return !sun_cells_occluded(origin, L.n, ray);
     }
 #endif
     bool to_point = L.kind == GRID_LIGHT_DISK;

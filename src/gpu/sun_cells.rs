@@ -17,11 +17,11 @@ pub struct SunCellsHeader {
     pub dims: [u32; 4],
 }
 
-/// The bytes of a frame without cells: the header alone with `dims.w = 0` and one word of data (the sun's rays
+/// The bytes of a frame without cells: the header alone with `dims.w = 0` and one vec4 of data (the sun's rays
 /// then take `occluded`).
 pub fn absent() -> Vec<u8> {
     let mut bytes = bytemuck::bytes_of(&SunCellsHeader::zeroed()).to_vec();
-    bytes.extend_from_slice(&[0; 4]);
+    bytes.extend_from_slice(&[0; 16]);
     bytes
 }
 
@@ -46,6 +46,7 @@ pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 
         dims: [cells.dims[0], cells.dims[1], offset as u32, 1],
     };
     let mut words: Vec<u32> = Vec::with_capacity(offset + ENTRY_WORDS * cells.triangles.len());
+    // The shader reads data in vec4s: the starts padded to four words (offset), the entries sixteen each.
     words.extend_from_slice(&cells.starts);
     words.resize(offset, 0);
     for &t in &cells.triangles {
@@ -74,7 +75,9 @@ mod tests {
     fn the_buffer_holds_the_starts_then_each_entrys_record() {
         assert_eq!(std::mem::size_of::<SunCellsHeader>(), 64);
         let glsl = include_str!("../../shaders/bindings.glsl");
-        assert!(glsl.contains("    vec4 u;\n    vec4 v;\n    vec4 l;\n    uvec4 dims;\n    uint data[];\n} sun_cells;"));
+        assert!(
+            glsl.contains("    vec4 u;\n    vec4 v;\n    vec4 l;\n    uvec4 dims;\n    uvec4 data[];\n} sun_cells;")
+        );
         let triangles = vec![
             [DVec3::ZERO, DVec3::X, DVec3::Z],
             [DVec3::new(5.0, 1.0, 0.0), DVec3::new(6.0, 1.0, 0.0), DVec3::new(5.0, 1.0, 1.0)],

@@ -371,36 +371,40 @@ pub fn sun_cells_usable(cells: &SunCells, origin: DVec3) -> bool {
 
 /// Whether the ray from `origin` along `direction` (within the sun's cone) meets a triangle of its cell that
 /// `blocks` it (given the triangle and the hit's distance): the cell's triangles above the origin are every one it
-/// can meet. `None` where they are too many ([`sun_cells_usable`]).
+/// can meet. A ray that leaves above the surface's tangent plane (normal `n`, `n·direction > 0`) cannot meet a
+/// triangle wholly below that plane, which is skipped before the ray test. `None` where the triangles above the
+/// origin are too many ([`sun_cells_usable`]).
 pub fn sun_cells_occluded(
     cells: &SunCells,
     triangles: &[[DVec3; 3]],
     mut blocks: impl FnMut(usize, f64) -> bool,
-    origin: DVec3,
+    (origin, n): (DVec3, DVec3),
     direction: DVec3,
 ) -> Option<bool> {
     if !sun_cells_usable(cells, origin) {
         return None;
     }
     let Some(ray) = WatertightRay::new(origin, direction) else { return Some(false) };
+    let leaves_above = n.dot(direction) > 0.0;
     Some(cells.triangles[sun_cell_range(cells, origin)].iter().any(|&t| {
         let t = t as usize;
-        ray.intersect(triangles[t], 0.0, f64::INFINITY).is_some_and(|hit| blocks(t, hit))
+        let below = leaves_above && triangles[t].iter().all(|c| n.dot(*c - origin) <= 0.0);
+        !below && ray.intersect(triangles[t], 0.0, f64::INFINITY).is_some_and(|hit| blocks(t, hit))
     }))
 }
 
-/// Whether the sun's ray from `origin` along `direction` (within its cone) gets through: by the cells where there
-/// are some and the point's is not full, else by the caller's `occluded` (the BVH's walk, or the device's ray
-/// queries on the GPU).
+/// Whether the sun's ray from `origin` (on a surface of normal `n`) along `direction` (within its cone) gets
+/// through: by the cells where there are some and the point is within their bound, else by the caller's
+/// `occluded` (the BVH's walk, or the device's ray queries on the GPU).
 pub fn sun_visible_along(
     cells: Option<&SunCells>,
     triangles: &[[DVec3; 3]],
     blocks: impl FnMut(usize, f64) -> bool,
-    origin: DVec3,
+    origin_and_normal: (DVec3, DVec3),
     direction: DVec3,
     occluded: impl FnOnce() -> bool,
 ) -> bool {
-    match cells.and_then(|cells| sun_cells_occluded(cells, triangles, blocks, origin, direction)) {
+    match cells.and_then(|cells| sun_cells_occluded(cells, triangles, blocks, origin_and_normal, direction)) {
         Some(blocked) => !blocked,
         None => !occluded(),
     }
@@ -498,12 +502,14 @@ mod tests {
                     SunCone::Partial => partial += 1,
                     SunCone::Unknown => panic!("case {case}: 60 triangles fill no cell"),
                 }
-                for d in &rays {
+                // Every ray that is cast (above the surface's horizon) gets the brute-force answer.
+                for d in rays.iter().filter(|d| n.dot(**d) > 0.0) {
                     let all = triangles.iter().any(|tri| {
                         WatertightRay::new(origin, *d).unwrap().intersect(*tri, 0.0, f64::INFINITY).is_some()
                     });
-                    assert_eq!(sun_cells_occluded(&cells, &triangles, |_, _| true, origin, *d), Some(all));
-                    assert_eq!(sun_visible_along(Some(&cells), &triangles, |_, _| true, origin, *d, || true), !all);
+                    assert_eq!(sun_cells_occluded(&cells, &triangles, |_, _| true, (origin, n), *d), Some(all));
+                    let visible = sun_visible_along(Some(&cells), &triangles, |_, _| true, (origin, n), *d, || true);
+                    assert_eq!(visible, !all);
                 }
             }
         }
@@ -571,8 +577,8 @@ mod tests {
         assert_eq!(class(under), SunCone::Covered);
         assert_eq!(class(DVec3::new(0.5, -0.1, 0.0)), SunCone::Unknown);
         assert!(!sun_cells_usable(&cells, under));
-        assert_eq!(sun_cells_occluded(&cells, &triangles, |_, _| true, under, DVec3::Y), None);
-        assert!(!sun_visible_along(Some(&cells), &triangles, |_, _| true, under, DVec3::Y, || true));
+        assert_eq!(sun_cells_occluded(&cells, &triangles, |_, _| true, (under, DVec3::Y), DVec3::Y), None);
+        assert!(!sun_visible_along(Some(&cells), &triangles, |_, _| true, (under, DVec3::Y), DVec3::Y, || true));
         // Between the 300th and the 301st square: 99 above it.
         let high = DVec3::new(0.2, 3.005, 0.2);
         assert_eq!(sun_cell_range(&cells, high).len(), 99);
