@@ -85,15 +85,16 @@ const LADDER: [(u32, u32, u32); 4] = [(1, 2, 1), (2, 4, 2), (4, 8, 4), (16, 32, 
 /// Shadow-map sizes swept, and the ladder's (one per rung).
 const MAP_SIZES: [u32; 4] = [512, 1024, 2048, 4096];
 
-/// The settings to sweep: the default first (`interpolation` the renderer's default, shadows as `auto` chooses
-/// on this device), then each knob alone, then the ladder; without repeats. `modes`: the interpolation modes
-/// the device offers.
+/// The settings to sweep: the base first (`interpolation` the renderer's default; shadow rays where the device has
+/// ray queries, shadow maps where it has none: there the rays of disk lights and the sky walk the BVH, seconds a
+/// frame, and every rung would wait on them), then each knob alone, then the ladder; without repeats. `modes`:
+/// the interpolation modes the device offers.
 pub fn sweep(r: &Relevance, default_mode: Interpolation, modes: &[Interpolation]) -> Vec<Setting> {
     let base = ShadingOptions {
         shadows: match (r.shadows, r.ray_queries) {
             (false, _) => Shadows::None,
             (true, true) => Shadows::Ray,
-            // `auto` without ray queries: shadow maps (docs/accuracy.md, "Shadows").
+            // Without ray queries: shadow maps (see above; docs/accuracy.md, "Shadows").
             (true, false) => Shadows::Map,
         },
         ..Default::default()
