@@ -577,14 +577,6 @@ impl Renderer {
         self.ensure_target(width, height)?;
         self.lights = None;
         let technique = self.shadow_choice(scene, settings)?.technique;
-        // The walk's buffers, laid out when a render first walks: its rays without ray queries, its slices.
-        let walks = self.pipeline.rays_walk_bvh() || settings.shading.visibility_rule == VisibilityRule::Slices;
-        if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
-            let (nodes, records) = source.layout();
-            let nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
-            let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
-            let _ = scene.walk.set((nodes, records));
-        }
         // The sun's shadow map, where `map` is the technique and there is a sun and geometry.
         let sun_map = match (technique, &settings.lights.sun, scene.bounds) {
             (Shadows::Map, Some(sun), Some(bounds)) => {
@@ -635,6 +627,18 @@ impl Renderer {
                 sun_cells =
                     if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
             }
+        }
+        // The walk's buffers, laid out when a render first walks: its rays without ray queries (unless every ray
+        // goes to the sun through complete cells), its slices.
+        let lights = &settings.lights;
+        let only_sun_cells = sun_cells == SUN_CELLS_COMPLETE && lights.disks.is_empty() && lights.sky.is_none();
+        let walks = (self.pipeline.rays_walk_bvh() && !only_sun_cells)
+            || settings.shading.visibility_rule == VisibilityRule::Slices;
+        if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
+            let (nodes, records) = source.layout();
+            let nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
+            let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
+            let _ = scene.walk.set((nodes, records));
         }
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
         // if this is its first frame.
