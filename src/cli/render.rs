@@ -176,6 +176,7 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let mut spent = FrameTimings::default();
     let mut gpu_render = |s: &RenderSettings| {
         let (image, t) = r.render(gpu_scene, s)?;
+        spent.shadow_setup += t.shadow_setup;
         spent.pipelines += t.pipelines;
         spent.render += t.render;
         spent.readback += t.readback;
@@ -541,6 +542,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
                 ("instance", setup.instance),
                 ("shader compile", setup.shader_compile), // on other threads, during "instance"
                 ("upload", job.upload),
+                ("shadow setup", job.frame.shadow_setup),
                 ("pipelines", job.frame.pipelines),
                 ("cache save", cache_save),
                 ("render", job.frame.render),

@@ -48,6 +48,9 @@ pub struct SetupTimings {
 /// Wall-clock time of the phases of one frame.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameTimings {
+    /// Laying out what the shadow rays read this frame: the sun's cells, and the occluders' BVH where a ray may walk
+    /// it (its first frame only).
+    pub shadow_setup: Duration,
     /// Creating the pipeline variants this frame needs that no earlier frame created (the device compiles the
     /// specialized shaders here; zero once they exist).
     pub pipelines: Duration,
@@ -615,6 +618,7 @@ impl Renderer {
         };
         // The sun's cells, for the sun's rays (`visibility::sun_cells`): none where a cell would hold too many
         // triangles (the rays then take the BVH's walk or the ray queries).
+        let t_shadow_setup = Instant::now();
         self.sun_cells = None;
         let mut sun_cells = SUN_CELLS_NONE;
         if let (SHADOWS_RAY, Some(sun), Some(source)) = (shadows, &settings.lights.sun, &scene.walk_source) {
@@ -640,6 +644,7 @@ impl Renderer {
             let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
             let _ = scene.walk.set((nodes, records));
         }
+        let shadow_setup = t_shadow_setup.elapsed();
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
         // if this is its first frame.
         let t_pipelines = Instant::now();
@@ -751,7 +756,7 @@ impl Renderer {
         self.light_fractions = light_fractions;
         self.check_validation()?;
         let lights_in_passes = slice_passes::read_bits(&slots);
-        Ok((image, FrameTimings { pipelines, render, readback, lights_in_passes, probe }))
+        Ok((image, FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe }))
     }
 
     /// One frame's draws, with the light buffer `lights` and the passes' fractions (binding 13; the unused one

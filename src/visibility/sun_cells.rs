@@ -62,6 +62,11 @@ pub const MAX_SUN_CELL_TRIANGLES: usize = 256;
 /// triangle, well within llvmpipe's budget); only a penumbra there takes the traversal.
 pub const MAX_SUN_CELL_CLASSIFIED: usize = 8192;
 
+/// How many cells a triangle may be entered in on average before the cells are made coarser, unless the entries
+/// are few in all (`FEW_SUN_CELL_ENTRIES`, 4 MiB on the device: quick to build and upload).
+pub const ENTRIES_PER_TRIANGLE: usize = 4;
+pub const FEW_SUN_CELL_ENTRIES: usize = 1 << 16;
+
 /// The most entries (a triangle in a cell) the cells keep where the caller has no bound of its own: 2 Mi, 128 MiB
 /// on the device (`gpu::sun_cells`: 64 bytes an entry), lavapipe's largest storage buffer.
 pub const MAX_SUN_CELL_ENTRIES: usize = 1 << 21;
@@ -154,7 +159,7 @@ impl SunCells {
             });
         }
         // About two cells a triangle over the projected area, at most 1024 a side, coarser while the entries would
-        // pass `max_entries`; then halved while a cell holds more than MAX_SUN_CELL_TRIANGLES, the cells can still
+        // pass `max_entries` or four a triangle; then halved while a cell holds more than MAX_SUN_CELL_TRIANGLES, the cells can still
         // shrink, the entries stay within bounds and halving still empties the fullest cell by a tenth (a cell
         // smaller than the triangles' growth gains little: every point there sees the same grown boxes).
         let area = ((u1 - u0) * (v1 - v0)).max(f64::MIN_POSITIVE);
@@ -162,7 +167,10 @@ impl SunCells {
         let count = |side: f64| Grid::count(&boxes, [u0, v0, u1, v1], side);
         let mut side = (area / (2.0 * triangles.len() as f64)).sqrt().max(longest_side / 1024.0);
         let mut grid = count(side);
-        while grid.entries() > max_entries {
+        // Where the triangles' growth spans many cells (a tall scene under a low sun), coarser, to at most
+        // ENTRIES_PER_TRIANGLE entries a triangle: every entry is a copy to build and to upload each frame.
+        let budget = max_entries.min((ENTRIES_PER_TRIANGLE * triangles.len()).max(FEW_SUN_CELL_ENTRIES));
+        while grid.entries() > budget {
             if grid.dims == [1, 1] {
                 return None;
             }
