@@ -389,12 +389,13 @@ pub fn sun_cells_occluded(
     (origin, n): (DVec3, DVec3),
     direction: DVec3,
 ) -> Option<bool> {
-    if !sun_cells_usable(cells, origin) {
+    let range = sun_cell_range(cells, origin);
+    if range.len() > MAX_SUN_CELL_TRIANGLES {
         return None;
     }
     let Some(ray) = WatertightRay::new(origin, direction) else { return Some(false) };
     let leaves_above = n.dot(direction) > 0.0;
-    Some(cells.triangles[sun_cell_range(cells, origin)].iter().any(|&t| {
+    Some(cells.triangles[range].iter().any(|&t| {
         let t = t as usize;
         let below = leaves_above && triangles[t].iter().all(|c| n.dot(*c - origin) <= 0.0);
         !below && ray.intersect(triangles[t], 0.0, f64::INFINITY).is_some_and(|hit| blocks(t, hit))
@@ -423,18 +424,14 @@ mod tests {
     use super::*;
     use crate::shading::visibility::concentric_disk;
 
-    /// A small deterministic generator (xorshift).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn point(&mut self, scale: f64) -> DVec3 {
-            DVec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * scale
-        }
+    /// Uniform in [0, 1) from the tests' shared generator (`crate::test_rng`, in [−1, 1)).
+    fn unit(r: &mut impl FnMut() -> f64) -> f64 {
+        0.5 * (r() + 1.0)
+    }
+
+    /// A point of the cube of side `scale` about the origin.
+    fn point(r: &mut impl FnMut() -> f64, scale: f64) -> DVec3 {
+        DVec3::new(r(), r(), r()) * (0.5 * scale)
     }
 
     /// The sun's rays from `origin` through a k × k grid of the disk of radius tan σ (and its centre).
@@ -458,32 +455,32 @@ mod tests {
     /// suns of 0.1° to 5° and low over the horizon.
     #[test]
     fn the_cells_and_the_classes_agree_with_every_ray_against_every_triangle() {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut r = crate::test_rng::uniform(0x9e37_79b9_7f4a_7c15);
         let (mut misses, mut covered, mut partial) = (0, 0, 0);
         for case in 0..24 {
             let scale = [1e-3, 1.0, 1e4][case % 3];
             let sigma = [0.1f64, 0.53, 5.0][(case / 3) % 3].to_radians() / 2.0;
-            let l = DVec3::new(rng.next() - 0.5, 0.05 + rng.next(), rng.next() - 0.5).normalize();
+            let l = DVec3::new(0.5 * r(), 0.05 + unit(&mut r), 0.5 * r()).normalize();
             let triangles: Vec<[DVec3; 3]> = (0..60)
                 .map(|_| {
-                    let c = rng.point(scale);
-                    let size = scale * (0.02 + 0.3 * rng.next());
-                    [c + rng.point(size), c + rng.point(size), c + rng.point(size)]
+                    let c = point(&mut r, scale);
+                    let size = scale * (0.02 + 0.3 * unit(&mut r));
+                    [c + point(&mut r, size), c + point(&mut r, size), c + point(&mut r, size)]
                 })
                 .collect();
             let cells = SunCells::build(&triangles, l, sigma, MAX_SUN_CELL_ENTRIES).expect("60 triangles fit");
             for _ in 0..400 {
                 // Origins on the triangles (where shading points lie), pushed off them along the face normal as
                 // the renderers push shadow rays' origins (2^-16 of the largest corner coordinate), on either side.
-                let t = triangles[(rng.next() * 60.0) as usize];
-                let (a, b) = (rng.next(), rng.next());
+                let t = triangles[(unit(&mut r) * 60.0) as usize];
+                let (a, b) = (unit(&mut r), unit(&mut r));
                 let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
                 let push = t.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max) / 65_536.0;
-                let side = if rng.next() < 0.5 { -1.0 } else { 1.0 };
+                let side = if r() < 0.0 { -1.0 } else { 1.0 };
                 let face = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
                 let origin = t[0] + a * (t[1] - t[0]) + b * (t[2] - t[0]) + side * push * face;
                 // A shading normal on that side, leaning from the face's by up to some 30 degrees.
-                let n = (side * face + rng.point(1.0)).normalize();
+                let n = (side * face + point(&mut r, 1.0)).normalize();
                 let rays = cone_rays(l, sigma, 6);
                 for (index, tri) in triangles.iter().enumerate() {
                     let meets = |d: &&DVec3| {
