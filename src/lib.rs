@@ -18,6 +18,7 @@ pub mod daylight;
 pub mod film;
 pub mod gpu;
 pub mod plot;
+pub mod render;
 pub mod scene;
 pub mod settings;
 pub mod shading;

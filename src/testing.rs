@@ -1,7 +1,8 @@
 //! Image tests for your own `cargo test`: render a scene as the command line would, compare it with the CPU
 //! reference or with a golden image, and fail with the comparison's report.
 //!
-//! - [`job`]: a scene and `sunshade render`'s flags, parsed by `render`'s own parser, so that the image is the
+//! - [`job`]: a scene and `sunshade render`'s flags that define the image, rendered by the same render layer
+//!   (`sunshade::render`) as the command line, `--tolerance` and `--visibility` included, so that the image is the
 //!   one the command line gives.
 //! - [`CheckedRenderer`]: the GPU renderer with Vulkan validation on; any validation message fails (the renderer
 //!   sunshade's own tests use).
@@ -28,12 +29,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::cli::render::RenderArgs;
-use crate::cli::{load_only, resolve_settings, CliError};
 use crate::compare::{self, DiffOptions, DiffReport};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{read_image, write_image, Exposure, Image, ImageIoError};
 use crate::gpu::{ContextOptions, FrameTimings, GpuError, Renderer, ValidationLog};
+use crate::render::{RenderError, Rendered, RequestArgs};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
@@ -55,35 +55,35 @@ pub enum TestingError {
     Compare(String),
 }
 
-impl From<CliError> for TestingError {
-    fn from(e: CliError) -> Self {
+impl From<RenderError> for TestingError {
+    fn from(e: RenderError) -> Self {
         match e {
-            CliError::Usage(m) => TestingError::Flags(m),
+            RenderError::Usage(m) => TestingError::Flags(m),
             other => TestingError::Scene(other.message()),
         }
     }
 }
 
-/// A scene and the flags of `sunshade render` (no `--output` needed).
+/// A scene and the flags of `sunshade render` that define the image (not its output: no `--output`, `--check`).
 #[derive(Debug)]
 pub struct Job {
-    args: RenderArgs,
+    request: RequestArgs,
 }
 
 /// A job from a scene and `render`'s flags, e.g. `job("teapot.glb", &["--width", "64", "--brdf", "ward"])`.
 pub fn job(scene: impl AsRef<Path>, flags: &[&str]) -> Result<Job, TestingError> {
-    let mut argv: Vec<String> = vec![scene.as_ref().display().to_string(), "--output".into(), "unused.exr".into()];
+    let mut argv: Vec<String> = vec![scene.as_ref().display().to_string()];
     argv.extend(flags.iter().map(|f| f.to_string()));
-    let args = RenderArgs::parse_list(&argv).map_err(TestingError::Flags)?;
-    args.scene.check()?;
-    Ok(Job { args })
+    let request = RequestArgs::parse_list(&argv).map_err(TestingError::Flags)?;
+    request.scene.check()?;
+    Ok(Job { request })
 }
 
 impl Job {
     /// The loaded scene and the settings of the render (the loader's warnings go to stderr).
     pub fn prepare(&self) -> Result<(Scene, RenderSettings), TestingError> {
-        let (scene, _) = load_only(&self.args.scene)?;
-        let settings = resolve_settings(&scene, &self.args.scene)?;
+        let (scene, _) = crate::render::request::load(&self.request.scene)?;
+        let settings = crate::render::request::resolve_settings(&scene, &self.request.scene)?;
         Ok((scene, settings))
     }
 }
@@ -156,11 +156,31 @@ impl CheckedRenderer {
         rendered
     }
 
-    /// Renders a job as `sunshade render` would.
+    /// Renders a job as `sunshade render` does (the same render layer: its shadow technique, visibility rule and
+    /// `--tolerance`); panics on a validation message.
     pub fn render_job(&mut self, job: &Job) -> Result<Image, TestingError> {
+        Ok(self.rendered_job(job)?.image)
+    }
+
+    /// [`render_job`](Self::render_job) with what the render layer says of the image: the settings it was
+    /// rendered with (`--tolerance`'s choice), the shadow technique and why, the predicted error.
+    pub fn rendered_job(&mut self, job: &Job) -> Result<Rendered, TestingError> {
         let (scene, settings) = job.prepare()?;
-        self.renderer().check_size(settings.width, settings.height)?;
-        Ok(self.render(&scene, &settings))
+        if job.request.device.is_some() || job.request.interpolation.is_some() {
+            return Err(TestingError::Flags(
+                "--device and --interpolation choose a renderer: create it with CheckedRenderer::try_with".into(),
+            ));
+        }
+        let reference = self.reference_options();
+        let renderer = self.renderer();
+        renderer.check_size(settings.width, settings.height)?;
+        let gpu_scene = renderer.upload(&scene)?;
+        let q = &job.request;
+        let rendered =
+            crate::render::on_gpu(renderer, (&scene, &gpu_scene), &q.scene, q.visibility_rule, settings, &reference);
+        drop(gpu_scene);
+        assert_no_validation_messages(&self.log);
+        Ok(rendered?)
     }
 
     pub fn sub_pixel_bits(&self) -> u32 {

@@ -6,6 +6,9 @@ use std::path::Path;
 fn sources(dir: &str) -> Vec<(String, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
     let mut out = Vec::new();
+    if root.is_file() {
+        return vec![(root.display().to_string(), std::fs::read_to_string(&root).unwrap())];
+    }
     let mut stack = vec![root];
     while let Some(d) = stack.pop() {
         for entry in std::fs::read_dir(&d).unwrap() {
@@ -44,6 +47,10 @@ fn modules_depend_one_way() {
     // Daylight is astronomy and a clear-sky model: numbers that the settings turn into lights.
     let renderers = ["crate::gpu", "crate::cpu", "crate::shading", "crate::compare", "crate::cli"];
     assert_free_of("src/daylight", &[&["ash::", "gltf::", "crate::scene"][..], &renderers[..]].concat());
+    // One render, whoever asks: the command line, batch, test suites and the testing API call the render layer,
+    // which knows no command line; neither does the testing API (the same flags, the same image).
+    assert_free_of("src/render", &["ash::", "gltf::", "crate::cli", "super::cli"]);
+    assert_free_of("src/testing.rs", &["crate::cli", "super::cli"]);
 }
 
 /// Names of the functions defined in a GLSL file (a return type, a name, an opening parenthesis at line start).

@@ -5,7 +5,7 @@ mod common;
 use std::path::Path;
 use std::process::{Command, Output};
 
-use common::TempDir;
+use common::{bits, CheckedRenderer, TempDir};
 use glam::Vec3;
 use serde_json::json;
 use sunshade::authoring::shapes::{cube, quad};
@@ -1128,4 +1128,41 @@ fn gpu_slices_refuse_a_light_cone_holding_too_many_triangles() {
     let e = stderr(&o);
     assert!(!o.status.success() && !out.exists(), "{e}");
     assert!(e.contains("--visibility slices") && e.contains("more than 1024 triangles"), "{e}");
+}
+
+/// One render layer: the same flags through `sunshade render` and through the `testing` API give the same image, bit
+/// for bit, also where `--tolerance` chooses the models (by bounds, by a study on the reference, by slices measured
+/// against it) and where `--visibility` names the rule.
+#[test]
+fn gpu_the_library_and_the_command_line_render_the_same_flags_to_the_same_image() {
+    let dir = TempDir::new("same-flags");
+    let teapot = concat!(env!("CARGO_MANIFEST_DIR"), "/models/teapot.glb");
+    let cube = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube.glb");
+    let size = ["--width", "48", "--height", "36"];
+    let cases: [(&str, &[&str]); 4] = [
+        // Each of the first three differs from the image without `--tolerance` (checked below).
+        (teapot, &["--brdf", "ward", "--tolerance", "1e-3"]),
+        (cube, &["--brdf", "ward", "--tolerance", "1e-3", "--tolerance-outside-penumbrae"]),
+        (cube, &["--brdf", "ward", "--tolerance", "1e-3", "--visibility", "grid"]),
+        (teapot, &["--shadows", "map", "--brdf", "ward"]),
+    ];
+    let mut gpu = CheckedRenderer::new();
+    for (i, (model, flags)) in cases.iter().enumerate() {
+        let flags: Vec<&str> = size.iter().chain(flags.iter()).copied().collect();
+        let out = dir.path(&format!("cli{i}.exr"));
+        let mut argv = vec!["render", model, "-o", s(&out), "-q"];
+        argv.extend(&flags);
+        let o = sunshade(&argv);
+        assert!(o.status.success(), "{flags:?}: {}", stderr(&o));
+        let from_cli = sunshade::film::read_image(&out).unwrap();
+        let job = sunshade::testing::job(model, &flags).unwrap();
+        let from_library = gpu.render_job(&job).unwrap();
+        assert!(from_cli.covered_count() > 100, "{flags:?}");
+        assert_eq!(bits(&from_cli), bits(&from_library), "{flags:?}: the CLI's and the library's images differ");
+        if i < 3 {
+            let untoleranced: Vec<&str> = size.iter().chain(&["--brdf", "ward"]).copied().collect();
+            let plain = gpu.render_job(&sunshade::testing::job(model, &untoleranced).unwrap()).unwrap();
+            assert_ne!(bits(&plain), bits(&from_library), "{flags:?}: --tolerance chose the default models");
+        }
+    }
 }

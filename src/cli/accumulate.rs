@@ -15,10 +15,10 @@ use std::time::{Duration, Instant as Clock};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::args::SceneArgs;
-use super::quantity::RequestedQuantity;
 use super::CliError;
 use crate::daylight::Instant;
 use crate::film::Image;
+use crate::render::flags::quantity::RequestedQuantity;
 use crate::scene::Scene;
 use crate::settings::{self, RenderSettings};
 

@@ -21,6 +21,7 @@ use super::render::{cache_dir, check_job, render_job, RenderArgs};
 use super::session::Session;
 use super::CliError;
 use crate::film::{write_image_with, Exposure, Image, Metadata};
+use crate::render::flags::parse_shard;
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
@@ -53,19 +54,6 @@ impl RunArgs {
         let (k, n) = self.shard.unwrap_or((0, 1));
         (0..count).filter(|i| i % n == k).collect()
     }
-}
-
-/// `K/N` with 0 ≤ K < N.
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
-    let (k, n) = s.split_once('/').ok_or_else(|| format!("'{s}' is not K/N"))?;
-    let (k, n): (usize, usize) = (
-        k.trim().parse().map_err(|_| format!("'{k}' is not a count"))?,
-        n.trim().parse().map_err(|_| format!("'{n}' is not a count"))?,
-    );
-    if n == 0 || k >= n {
-        return Err(format!("'{s}': needs 0 ≤ K < N"));
-    }
-    Ok((k, n))
 }
 
 /// A job object → `render`'s argument list. Errors name the key.
@@ -113,11 +101,11 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
         .iter()
         .map(|job| {
             let args = RenderArgs::parse_list(&job_arguments(job)?)?;
-            if args.scene.quantity.is_accumulated() {
+            if args.request.scene.quantity.is_accumulated() {
                 return Err(format!(
                     "quantity {}: not accumulated by batch jobs (render it with sunshade render, which runs its \
                      instants in one process)",
-                    args.scene.quantity.name()
+                    args.request.scene.quantity.name()
                 ));
             }
             if args.output.false_color.is_some() {
@@ -262,7 +250,10 @@ mod tests {
         }
         assert!(!argv.iter().any(|a| a.contains("no-cache")));
         let parsed = RenderArgs::parse_list(&argv).unwrap();
-        assert_eq!((parsed.scene.width, parsed.scene.sun_elevation, parsed.check), (256, Some(-3.5), true));
+        assert_eq!(
+            (parsed.request.scene.width, parsed.request.scene.sun_elevation, parsed.check),
+            (256, Some(-3.5), true)
+        );
         assert!(job_arguments(&json!({ "output": "a.png" })).unwrap_err().contains("scene"));
         assert!(job_arguments(&json!({ "scene": "a", "output": "b.png", "width": { "x": 1 } })).is_err());
         assert!(RenderArgs::parse_list(

@@ -105,7 +105,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let uploaded: Vec<GpuScene> = renderers.iter().map(|r| r.upload(&scene)).collect::<Result<_, _>>()?;
         bar.set_message(format!("{name}: --tolerance"));
         let predicted_default =
-            predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(default_mode) };
+            predicted::Renderer::Gpu { barycentrics: crate::render::predicted_barycentrics(default_mode) };
         // Without ray queries a scene that shadows itself gets the table at a smaller size, with its own truth.
         let size = table_size((width, height), ray_queries, can_occlude);
         let smaller = if size != (width, height) {
@@ -158,7 +158,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             let error = image_error(&image, &truth.image, Some(&excluded))
                 .map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
             let renderer =
-                predicted::Renderer::Gpu { barycentrics: super::render::predicted_barycentrics(setting.interpolation) };
+                predicted::Renderer::Gpu { barycentrics: crate::render::predicted_barycentrics(setting.interpolation) };
             // A delta sun's horizon term is taken against its own image's peak.
             let peak = (s.shading.sun == crate::shading::SunModel::Delta).then(|| crate::compare::image_peak(&image));
             let p = predicted::predict_with_peak(&scene, &s, renderer, can_occlude, peak, None);

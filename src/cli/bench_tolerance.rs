@@ -13,7 +13,6 @@ use std::time::Duration;
 
 use super::bench::{median, ms, warm_frames};
 use super::metadata::{lobe_model_line, sun_model_line};
-use super::render::beyond_this_device;
 use super::CliError;
 use crate::accuracy::converged::Converged;
 use crate::accuracy::error::image_error;
@@ -23,6 +22,7 @@ use crate::accuracy::predicted::Request;
 use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
 use crate::cpu::ReferenceOptions;
 use crate::gpu::{GpuError, GpuScene, Renderer};
+use crate::render::beyond_this_device;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;

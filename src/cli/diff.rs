@@ -207,7 +207,7 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     }
     let unit = match qa.or(qb) {
         _ if fa == ImageFormat::Png => "(8-bit sRGB codes)".to_string(),
-        Some((_, unit)) => super::quantity::pretty_unit(&unit),
+        Some((_, unit)) => crate::render::flags::quantity::pretty_unit(&unit),
         None => "W/(m²·sr)".to_string(), // a PFM records nothing: radiance, sunshade's default quantity
     };
     let read = |p: &PathBuf| read_image(p).map_err(|e| CliError::Usage(e.to_string()));

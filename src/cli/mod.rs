@@ -15,28 +15,27 @@ mod bench_shadows;
 mod bench_startup;
 mod bench_textures;
 mod bench_tolerance;
-mod daylight;
 mod diff;
 mod fit_brdf;
 mod generated;
 mod info;
 mod metadata;
-mod quantity;
 mod reference;
 pub(crate) mod render;
 mod session;
 mod suite;
 mod sum;
+mod sun;
 mod sweep;
 mod tabulate_brdf;
 
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 
-use crate::scene::{self, Scene};
-use crate::settings::{self, RenderSettings};
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -65,7 +64,7 @@ enum Command {
     /// Where the sun is at a time and place (NREL SPA): zenith, azimuth (clockwise from north), elevation, its
     /// direction in scene axes, whether it is up, and the clear sky's irradiances.
     #[command(allow_negative_numbers = true)]
-    Sun(daylight::SunCommand),
+    Sun(sun::SunCommand),
     /// List the Vulkan devices, the one chosen, and the limits that matter to sunshade.
     Info(info::InfoArgs),
     /// Render many jobs of a JSON manifest in one process, on one device: scenes loaded and uploaded once while
@@ -101,38 +100,7 @@ enum Command {
     TabulateBrdf(tabulate_brdf::TabulateBrdfArgs),
 }
 
-/// `-q`: warnings and notes are not printed (errors still are, on one line, and the exit code says the rest).
-static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-pub(crate) fn set_quiet(quiet: bool) {
-    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
-}
-
-pub(crate) fn quiet() -> bool {
-    QUIET.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Prints a warning on stderr unless `-q` was given.
-pub(crate) fn warn(message: &str) {
-    if !quiet() {
-        eprintln!("sunshade: warning: {message}");
-    }
-}
-
-/// [`warn`], once per process for each distinct message (a batch of many jobs repeats the same ones).
-pub(crate) fn warn_once(message: &str) {
-    static SEEN: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
-    let first = SEEN.lock().map_or(true, |mut seen| {
-        let new = !seen.iter().any(|m| m == message);
-        if new {
-            seen.push(message.to_string());
-        }
-        new
-    });
-    if first {
-        warn(message);
-    }
-}
+pub(crate) use crate::render::warnings::{quiet, set_quiet, warn, warn_once};
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
 #[derive(Debug)]
@@ -150,6 +118,15 @@ impl CliError {
             CliError::Usage(m) => m.clone(),
             CliError::Failure(e) => one_line(e),
             CliError::Quiet(code) => format!("failed with exit code {code} (report above)"),
+        }
+    }
+}
+
+impl From<crate::render::RenderError> for CliError {
+    fn from(e: crate::render::RenderError) -> Self {
+        match e {
+            crate::render::RenderError::Usage(m) => CliError::Usage(m),
+            crate::render::RenderError::Failure(e) => CliError::Failure(e),
         }
     }
 }
@@ -195,7 +172,7 @@ pub fn main() -> ExitCode {
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Sum(a) => sum::run(&a),
-        Command::Sun(a) => daylight::run_sun(&a),
+        Command::Sun(a) => sun::run_sun(&a),
         Command::Info(a) => info::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Albedo(a) => albedo::run(&a),
@@ -246,33 +223,12 @@ fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), 
 
 /// Loads the scene (with `--brdf` applied) and prints the loader's warnings.
 pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
-    let t = Instant::now();
-    let mut scene = scene::load_with_options(&a.scene, &a.load_options())?;
-    if let Some(kind) = a.brdf {
-        scene.map_brdfs(kind);
-    }
-    if let Some(path) = &a.merl {
-        let table = scene::measured::read_merl_file(path).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-        scene.use_measured(&std::sync::Arc::new(table), a.merl_lookup.unwrap_or_default());
-    }
-    if let Some(lookup) = a.merl_lookup {
-        scene.set_measured_lookup(lookup);
-    }
-    let load_time = t.elapsed();
-    for w in &scene.warnings {
-        warn(&format!("{}: {w}", a.scene.display()));
-    }
-    Ok((scene, load_time))
+    Ok(crate::render::request::load(a)?)
 }
 
 /// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
 pub(crate) fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
-    let daylight = a.daylight.at_time();
-    if let Some(w) = daylight.as_ref().and_then(|d| d.below_horizon_warning()) {
-        warn_once(&w);
-    }
-    settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options_at(daylight.as_ref()))
-        .map_err(|e| CliError::Usage(e.to_string()))
+    Ok(crate::render::request::resolve_settings(scene, a)?)
 }
 
 /// Refuses an output path whose extension names no supported format, or whose folder does not exist, before any

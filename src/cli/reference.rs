@@ -85,23 +85,20 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     if a.scene.quantity.is_accumulated() {
         return run_accumulation(a, started);
     }
-    let (scene, mut settings, load_time) = load_scene(&a.scene)?;
+    let (scene, settings, load_time) = load_scene(&a.scene)?;
     let t = Instant::now();
     let options = a.reference.options();
     // Tested once: the shadow choice and the error bound both need it.
     let scene_can_occlude = crate::visibility::can_occlude(&scene);
-    let choice = cpu::shadow_choice_where(scene_can_occlude, &settings);
-    settings.shading.shadows = choice.technique;
-    // Slices where the image is to be near the truth in penumbrae (converged; a tolerance held in them, which the
-    // sky's implies: `accuracy::trial::sky_by_slices`); the GPU's grid where it is to be compared with the GPU's,
-    // and where the promise leaves the penumbrae out (the slices' walks would cost more for nothing promised:
-    // sunset.glb at 256², `--tolerance 1e-2`, 1.5 s against 0.15 s).
-    let in_penumbrae = a.scene.tolerance_holds_in_penumbrae(&settings.lights);
-    settings.shading.visibility_rule = a.visibility_rule.unwrap_or(if a.converged || in_penumbrae {
-        VisibilityRule::Slices
-    } else {
-        VisibilityRule::Grid
-    });
+    let plan = crate::render::plan::for_reference(
+        &scene,
+        scene_can_occlude,
+        &a.scene,
+        a.visibility_rule,
+        a.converged,
+        settings,
+    );
+    let mut settings = plan.settings;
     // `--converged` has no bound to predict (it is the truth), and takes no `--tolerance`.
     let (image, prediction, convergence) = if a.converged {
         let (image, record) = converged_image(&scene, &mut settings, &options, a);
@@ -134,7 +131,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
-        eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), choice.reason);
+        eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), plan.shadow_reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings, &scene));
         if let Some(line) = super::metadata::lobe_model_line(&settings, &scene) {
             eprintln!("sunshade: {line}");
@@ -185,10 +182,15 @@ fn run_accumulation(a: &ReferenceCommand, started: Instant) -> Result<(), CliErr
     let options = a.reference.options();
     let scene_can_occlude = crate::visibility::can_occlude(&scene);
     let done = super::accumulate::accumulate(&scene, &a.scene, |settings| {
-        let mut settings = settings.clone();
-        settings.shading.shadows = cpu::shadow_choice_where(scene_can_occlude, &settings).technique;
-        settings.shading.visibility_rule = a.visibility_rule.unwrap_or_default();
-        Ok(cpu::render(&scene, &settings, &options))
+        let plan = crate::render::plan::for_reference(
+            &scene,
+            scene_can_occlude,
+            &a.scene,
+            a.visibility_rule,
+            false,
+            settings.clone(),
+        );
+        Ok(cpu::render(&scene, &plan.settings, &options))
     })?;
     let phases = [("load", load_time)];
     done.finish(&a.scene, &a.output, "cpu reference", a.verbose.then_some((&phases[..], started)))

@@ -1,0 +1,21 @@
+//! One render, whoever asks for it: `sunshade render`, a `batch` job, a `test` case and the `testing` API all come
+//! here, so that the same flags give the same image.
+//!
+//! ```text
+//! flags (flags::SceneArgs, request::RequestArgs) ──► request::load, request::resolve_settings ──► Scene, settings
+//!   ──► plan (shadow technique, visibility rule: for_gpu / for_reference) ──► gpu::on_gpu (or the reference)
+//!   ──► Rendered (image, final settings, prediction; tolerance's measurements against the reference)
+//! ```
+
+mod error;
+pub mod flags;
+mod gpu;
+pub mod plan;
+pub mod request;
+mod tolerance;
+pub mod warnings;
+
+pub use error::RenderError;
+pub use gpu::{on_gpu, predicted_barycentrics, Rendered};
+pub use request::RequestArgs;
+pub use tolerance::beyond_this_device;
