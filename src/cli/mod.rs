@@ -100,7 +100,7 @@ enum Command {
     TabulateBrdf(tabulate_brdf::TabulateBrdfArgs),
 }
 
-pub(crate) use crate::render::warnings::{quiet, set_quiet, warn, warn_once};
+pub(crate) use crate::render::warnings::{quiet, set_quiet, warn};
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
 #[derive(Debug)]

@@ -321,13 +321,10 @@ fn run_accumulation(session: &mut Session, a: &RenderArgs, started: Instant) -> 
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let mut pipelines = std::time::Duration::ZERO;
     let done = super::accumulate::accumulate(scene_data, &a.request.scene, |settings| {
-        let choice = r.shadow_choice(gpu_scene, settings)?;
-        if choice.warning {
-            super::warn_once(&format!("shadows: {}", choice.reason));
-        }
-        let mut settings = settings.clone();
-        settings.shading.shadows = choice.technique;
-        let (image, timings) = r.render(gpu_scene, &settings)?;
+        let q = &a.request;
+        let plan =
+            crate::render::plan::for_gpu(r, gpu_scene, scene_data, &q.scene, q.visibility_rule, settings.clone())?;
+        let (image, timings) = r.render(gpu_scene, &plan.settings)?;
         pipelines += timings.pipelines;
         Ok(image)
     })?;
