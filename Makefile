@@ -69,8 +69,10 @@ bench-daylight: build
 		--to 2027-01-01T00:00:00+01:00 --step 1h -o /tmp/sunshade-district-year.exr \
 		--false-color docs/images/district-year.png -v
 
-# Regenerates the BRDF tables in docs/brdf.md (directional albedo, convergence of the sampled light integrals).
+# Regenerates docs/cli.md (the whole flag reference, from the parser) and the BRDF tables in docs/brdf.md
+# (directional albedo, convergence of the sampled light integrals).
 docs: build
+	$(SUNSHADE) man --markdown > docs/cli.md.tmp && mv docs/cli.md.tmp docs/cli.md
 	$(SUNSHADE) albedo --update docs/brdf.md
 
 # Regenerates the pictures in README.md: one scene per kind of light, and the BRDF spheres under each light; with

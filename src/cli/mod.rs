@@ -21,8 +21,10 @@ mod generated;
 mod info;
 mod metadata;
 mod reference;
+mod reference_doc;
 pub(crate) mod render;
 mod session;
+mod short_help;
 mod suite;
 mod sum;
 mod sun;
@@ -84,8 +86,11 @@ enum Command {
     /// Print the man page (roff), e.g. `sunshade man > sunshade.1 && man ./sunshade.1`; with --dir, write a page
     /// for every subcommand too (sunshade-render.1, ...) into DIR.
     Man {
-        #[arg(long, value_name = "DIR")]
+        #[arg(long, value_name = "DIR", conflicts_with = "markdown")]
         dir: Option<std::path::PathBuf>,
+        /// Print the whole reference as Markdown instead (docs/cli.md).
+        #[arg(long)]
+        markdown: bool,
     },
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     #[command(allow_negative_numbers = true)]
@@ -137,9 +142,17 @@ impl<E: Into<anyhow::Error>> From<E> for CliError {
     }
 }
 
+/// The whole parser, for the generated references (man pages, docs/cli.md, completions).
+fn command() -> clap::Command {
+    <Cli as clap::CommandFactory>::command()
+        .mut_subcommand("render", short_help::common_flags_first)
+        .mut_subcommand("reference", short_help::common_flags_first)
+}
+
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let parsed = command().try_get_matches().and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {
             // --help and --version.
@@ -156,18 +169,17 @@ pub fn main() -> ExitCode {
         Command::Batch(a) => batch::run(&a),
         Command::Test(a) => suite::run(&a),
         Command::Completions { shell } => {
-            clap_complete::generate(
-                shell,
-                &mut <Cli as clap::CommandFactory>::command(),
-                "sunshade",
-                &mut std::io::stdout(),
-            );
+            clap_complete::generate(shell, &mut command(), "sunshade", &mut std::io::stdout());
             Ok(())
         }
-        Command::Man { dir: None } => clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
-            .render(&mut std::io::stdout())
-            .map_err(|e| CliError::Failure(e.into())),
-        Command::Man { dir: Some(dir) } => clap_mangen::generate_to(<Cli as clap::CommandFactory>::command(), &dir)
+        Command::Man { markdown: true, .. } => {
+            print!("{}", reference_doc::markdown(&command()));
+            Ok(())
+        }
+        Command::Man { dir: None, .. } => {
+            clap_mangen::Man::new(command()).render(&mut std::io::stdout()).map_err(|e| CliError::Failure(e.into()))
+        }
+        Command::Man { dir: Some(dir), .. } => clap_mangen::generate_to(command(), &dir)
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", dir.display()))),
         Command::Reference(a) => reference::run(&a),
         Command::Diff(a) => diff::run(&a),

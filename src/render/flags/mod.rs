@@ -268,7 +268,9 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub sun_samples: Option<u32>,
 
-    /// Choose for each material the cheapest sun model (delta, or the disk with the fewest samples) whose derived
+    /// The largest relative error the image may have against the truth; the cheapest models that keep it are chosen.
+    ///
+    /// For each material, the cheapest sun model (delta, or the disk with the fewest samples) whose derived
     /// error bound for its lobe, with the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of
     /// 1% of the peak); `-v` prints the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
     /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
@@ -287,8 +289,8 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
-    /// With --tolerance: hold it in penumbrae too (the default since 2026-12-05; the flag is kept for the scripts
-    /// that name it). The shadow rays' grids (overriding --shadow-samples) go on the
+    /// With --tolerance: hold it in penumbrae too (the default; the flag is kept for the scripts that name it).
+    /// The shadow rays' grids (overriding --shadow-samples) go on the
     /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
     /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
     /// penumbra, the lights' located edges at second; 2 on the reference where every light is taken by slices
@@ -308,19 +310,28 @@ pub struct SceneArgs {
     #[arg(help_heading = "Quality", long, requires = "tolerance", conflicts_with = "tolerance_in_penumbrae")]
     pub tolerance_outside_penumbrae: bool,
 
-    /// Shadows: `auto` (shadow rays where the device has ray queries, else shadow maps; none where nothing can
-    /// occlude a light), `none`, `ray`, or `map` (shadow maps for the sun and the first four disk lights, any
-    /// device; the sky unoccluded, with a warning). The reference casts rays for every technique but `none`
-    /// (for `map`, for the lights the maps shadow).
+    /// Shadows: `auto` (shadow rays; none where nothing can occlude a light), `none`, `ray`, or `map`.
+    ///
+    /// Rays on every device: the sun's against its cells, the other lights' by ray queries or, without them, by the
+    /// fragment shader's walk of the occluders' BVH. `map`: shadow maps for the sun and the first four disk lights,
+    /// the sky unoccluded, with a warning. The reference casts rays for every technique but `none` (for `map`, for
+    /// the lights the maps shadow).
     #[arg(help_heading = "Shadows", long, default_value = "auto", value_name = "auto|none|ray|map")]
     pub shadows: Shadows,
 
-    /// What the pixels hold: `radiance` towards the camera [W/(m²·sr)], or `irradiance` [W/m²], the light
+    /// What the pixels hold: radiance [W/(m²·sr)], irradiance [W/m²], irradiation [Wh/m²] or sun-hours [h].
+    ///
+    /// `radiance` towards the camera [W/(m²·sr)], or `irradiance` [W/m²], the light
     /// arriving at the surface point each pixel sees, per RGB channel, from every light's visible part (the
     /// lecture's E(x, y); the material does not enter); accumulated over --from/--to/--step: `irradiation`
     /// [Wh/m²], the sum of the irradiance of each step's midpoint times its length, or `sun-hours` [h], the
     /// hours whose direct sun on the surface reaches --sun-hours-threshold. Images record the quantity and its unit.
-    #[arg(long, default_value = "radiance", value_name = "radiance|irradiance|irradiation|sun-hours")]
+    #[arg(
+        help_heading = "Image",
+        long,
+        default_value = "radiance",
+        value_name = "radiance|irradiance|irradiation|sun-hours"
+    )]
     pub quantity: RequestedQuantity,
 
     #[command(flatten)]
