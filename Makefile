@@ -31,10 +31,10 @@ lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps
 
-# Regenerates the measured figures in README.md and docs/accuracy.md (on this machine; the tables name it).
+# Regenerates the measured figures in docs/speed.md and docs/accuracy.md (on this machine; the tables name it).
 bench: build
-	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update README.md
-	$(SUNSHADE) bench --startup --repeat 5 --update README.md
+	$(SUNSHADE) bench --repeat 5 --process-runs 5 --process-scene models/teapot.glb --update docs/speed.md
+	$(SUNSHADE) bench --startup --repeat 5 --update docs/speed.md
 	$(SUNSHADE) bench --shadow-cost --repeat 5 --update docs/accuracy.md
 	$(SUNSHADE) bench --repeat 5 --interpolation f64,f32,device --update docs/accuracy.md
 	$(SUNSHADE) bench --brdf-chart --repeat 5 --update docs/accuracy.md
@@ -44,9 +44,9 @@ bench: build
 	eval "$$(scripts/lavapipe-rt.sh)" && $(SUNSHADE) bench --pareto models/brdfs.glb --repeat 5 --plot docs/images/pareto-brdfs.png
 
 # Start-up: every model's whole render process, 5 processes each, with each pipeline's size and creation time
-# (README "Start-up").
+# (docs/speed.md, "Start-up").
 bench-startup: build
-	$(SUNSHADE) bench --startup --repeat 5 --update README.md
+	$(SUNSHADE) bench --startup --repeat 5 --update docs/speed.md
 
 # What the default shadows cost against an unshadowed frame (docs/accuracy.md, "What the shadows cost").
 bench-shadow-cost: build
@@ -57,7 +57,7 @@ bench-batch: build
 	./scripts/bench-batch.sh 5
 
 # A year of hourly daylight (4380 steps with the sun up) on a 100k-triangle city block at 512², in one process,
-# against single frames of it (README "Daylight"; about 40 minutes with lavapipe on 2 threads). Writes
+# against single frames of it (docs/daylight.md; about 40 minutes with lavapipe on 2 threads). Writes
 # docs/images/district-year.png.
 DISTRICT := /tmp/sunshade-district.glb
 DISTRICT_VIEW := --eye 90,70,110 --target 0,0,0 --width 512 --height 512 --location 47.37,8.54,408
@@ -75,7 +75,7 @@ docs: build
 	$(SUNSHADE) man --markdown > docs/cli.md.tmp && mv docs/cli.md.tmp docs/cli.md
 	$(SUNSHADE) albedo --update docs/brdf.md
 
-# Regenerates the pictures in README.md: one scene per kind of light, and the BRDF spheres under each light; with
+# Regenerates the pictures in README.md and docs/: one scene per kind of light, and the BRDF spheres under each light; with
 # shadows where Mesa 25's lavapipe (ray queries) can be installed (scripts/lavapipe-rt.sh), else without.
 images: build
 	mkdir -p docs/images

@@ -1,4 +1,4 @@
-//! Writes a city block of about 100 000 triangles for timing daylight accumulations (README "Daylight"):
+//! Writes a city block of about 100 000 triangles for timing daylight accumulations (docs/daylight.md):
 //!
 //!     cargo run --release --example make_district -- /tmp/district.glb
 //!

@@ -207,7 +207,7 @@ fn spheres() -> GltfBuilder {
 }
 
 /// One sphere per BRDF on a grey floor: Lambert, Phong, Blinn-Phong, isotropic and anisotropic Ward (material
-/// extras, README "BRDFs"). No light: the README's pictures light it with the sun, a disk skylight and the sky.
+/// extras, docs/brdf.md). No light: the README's pictures light it with the sun, a disk skylight and the sky.
 fn brdfs() -> GltfBuilder {
     let mut b = GltfBuilder::new();
     let mut roots =

@@ -250,6 +250,10 @@ pub fn check_golden_with(
     ci: bool,
 ) -> Result<GoldenOutcome, String> {
     let write = |why: &str| {
+        // A golden's folder is made where it does not exist yet (a test's first run).
+        if let Some(folder) = golden.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
+        }
         write_image(image, golden, Exposure::Auto).map_err(|e| e.to_string())?;
         eprintln!("sunshade testing: {why}: wrote {}", golden.display());
         Ok(GoldenOutcome::Written(golden.to_path_buf()))
@@ -325,18 +329,20 @@ mod tests {
     fn goldens_are_written_compared_and_never_pass_silently_in_ci() {
         let dir = std::env::temp_dir().join(format!("sunshade-golden-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let golden = dir.join("g.exr");
+        let golden = dir.join("goldens").join("g.exr");
         let opts = DiffOptions::default();
         // Missing in CI: fails, writes nothing.
         let e = check_golden_with(&image(1.0), &golden, &opts, false, true).unwrap_err();
         assert!(e.contains("missing") && !golden.exists(), "{e}");
-        // Missing outside CI: written.
+        // Missing outside CI: written, its folder made.
         assert!(matches!(check_golden_with(&image(1.0), &golden, &opts, false, false), Ok(GoldenOutcome::Written(_))));
         assert!(matches!(check_golden_with(&image(1.0), &golden, &opts, false, true), Ok(GoldenOutcome::Matched(_))));
         // A mismatch fails and leaves the actual image and the heatmap next to the golden.
         let e = check_golden_with(&image(1.1), &golden, &opts, false, true).unwrap_err();
         assert!(
-            e.contains("differs") && dir.join("g.actual.exr").exists() && dir.join("g.heatmap.png").exists(),
+            e.contains("differs")
+                && dir.join("goldens/g.actual.exr").exists()
+                && dir.join("goldens/g.heatmap.png").exists(),
             "{e}"
         );
         // UPDATE_GOLDENS=1 rewrites it.

@@ -128,7 +128,7 @@ impl Brdf {
         Ok(())
     }
 
-    /// Maps glTF metallic-roughness onto a model (for scenes without `extras`; README "BRDFs"):
+    /// Maps glTF metallic-roughness onto a model (for scenes without `extras`; docs/brdf.md):
     /// - specular reflectance at normal incidence `ks = F0 = mix(0.04, base, metallic)`;
     /// - diffuse `kd = base · (1 − metallic) · (1 − ks)`, so `kd + ks ≤ 1`;
     /// - width: `α = roughness²` (glTF's convention); Ward takes it as αx = αy (at least 1e-3); Phong and

@@ -85,7 +85,7 @@ pub fn base_color(material: &Material, textures: &[Texture], s: &SurfaceSample) 
     c
 }
 
-/// The metallic-roughness mapping onto a model (README "BRDFs"), in f32: `ks = 0.04 (1 − m) + base · m`,
+/// The metallic-roughness mapping onto a model (docs/brdf.md), in f32: `ks = 0.04 (1 − m) + base · m`,
 /// `kd = base (1 − m)(1 − ks)`, `α = max(r², 10⁻³)`, Phong/Blinn-Phong exponent `clamp(2/α² − 2, 0, 10⁷)`, Ward
 /// `αx = αy = α`; Lambert takes `base` as the albedo. `m` and `r` are clamped to [0, 1].
 pub fn brdf_from_metallic_roughness(kind: BrdfKind, base: [f32; 3], metallic: f32, roughness: f32) -> Brdf {

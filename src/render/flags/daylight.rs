@@ -62,7 +62,7 @@ pub fn parse_duration(s: &str) -> Result<f64, String> {
 pub struct DaylightArgs {
     /// The sun of this instant: ISO 8601 with its UTC offset, e.g. 2026-06-21T12:00:00+02:00 (or Z). Sets the
     /// sun's direction (needs --location) and, unless --sun-irradiance/--sun-radiance and --sky-radiance say
-    /// otherwise, its E⊥ and the sky's radiance from a clear sky (README "Daylight").
+    /// otherwise, its E⊥ and the sky's radiance from a clear sky (docs/daylight.md).
     #[arg(help_heading = "Daylight", long, value_parser = parse_instant, value_name = "ISO8601",
           conflicts_with_all = ["sun_dir", "sun_elevation", "sun_azimuth", "from"], requires = "location")]
     pub time: Option<Instant>,

@@ -245,7 +245,7 @@ pub struct SceneArgs {
     #[arg(help_heading = "Disk lights and sky", long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
     pub sky_radiance: Option<[f64; 3]>,
 
-    /// Map every material's glTF metallic-roughness onto this BRDF (README "BRDFs"); `lambert` forces Lambert.
+    /// Map every material's glTF metallic-roughness onto this BRDF (docs/brdf.md); `lambert` forces Lambert.
     #[arg(help_heading = "Materials", long, value_name = "lambert|phong|blinn-phong|ward")]
     pub brdf: Option<BrdfKind>,
 
