@@ -88,10 +88,15 @@ impl Job {
     }
 }
 
-/// The CPU reference image of a job.
+/// The CPU reference image of a job, as `sunshade reference` renders it with the same flags (its shadow technique,
+/// visibility rule and `--tolerance`), mirroring the device `options` describe.
 pub fn reference(job: &Job, options: &ReferenceOptions) -> Result<Image, TestingError> {
     let (scene, settings) = job.prepare()?;
-    Ok(cpu::render(&scene, &settings, options))
+    let can_occlude = crate::visibility::can_occlude(&scene);
+    let q = &job.request;
+    let (image, _, _) =
+        crate::render::on_reference(&scene, can_occlude, &q.scene, q.visibility_rule, settings, options)?;
+    Ok(image)
 }
 
 /// Renders the job's CPU reference and compares `image`, the job's GPU render, with it as `render --check` does,

@@ -7,7 +7,6 @@ use clap::Args;
 use super::args::{parse_positive, OutputArgs, SceneArgs};
 use super::{load_scene, print_exposure, print_phases, warn_if_nothing_covered, CliError};
 use crate::accuracy::converged::{self, ConvergenceOptions};
-use crate::accuracy::trial::reference_within_tolerance;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::write_image_with;
 use crate::shading::VisibilityRule;
@@ -90,25 +89,17 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
     let options = a.reference.options();
     // Tested once: the shadow choice and the error bound both need it.
     let scene_can_occlude = crate::visibility::can_occlude(&scene);
-    let plan = crate::render::plan::for_reference(
-        &scene,
-        scene_can_occlude,
-        &a.scene,
-        a.visibility_rule,
-        a.converged,
-        settings,
-    );
-    let mut settings = plan.settings;
     // `--converged` has no bound to predict (it is the truth), and takes no `--tolerance`.
-    let (image, prediction, convergence) = if a.converged {
+    let (image, settings, shadow_reason, prediction, convergence) = if a.converged {
+        let plan =
+            crate::render::plan::for_reference(&scene, scene_can_occlude, &a.scene, a.visibility_rule, true, settings);
+        let mut settings = plan.settings;
         let (image, record) = converged_image(&scene, &mut settings, &options, a);
-        (image, None, Some(record))
+        (image, settings, plan.shadow_reason, None, Some(record))
     } else {
-        let (asked, tolerance) = (a.scene.shadows, a.scene.tolerance());
-        let (image, prediction) =
-            reference_within_tolerance(&scene, &mut settings, &options, asked, scene_can_occlude, tolerance)
-                .map_err(CliError::Usage)?;
-        (image, Some(prediction), None)
+        let (image, prediction, plan) =
+            crate::render::on_reference(&scene, scene_can_occlude, &a.scene, a.visibility_rule, settings, &options)?;
+        (image, plan.settings, plan.shadow_reason, Some(prediction), None)
     };
     let render_time = t.elapsed();
     warn_if_nothing_covered(&image, &a.scene.scene);
@@ -131,7 +122,7 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
-        eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), plan.shadow_reason);
+        eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), shadow_reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings, &scene));
         if let Some(line) = super::metadata::lobe_model_line(&settings, &scene) {
             eprintln!("sunshade: {line}");

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! flags (flags::SceneArgs, request::RequestArgs) ──► request::load, request::resolve_settings ──► Scene, settings
-//!   ──► plan (shadow technique, visibility rule: for_gpu / for_reference) ──► gpu::on_gpu (or the reference)
+//!   ──► plan (shadow technique, visibility rule: for_gpu / for_reference) ──► on_gpu / on_reference
 //!   ──► Rendered (image, final settings, prediction; tolerance's measurements against the reference)
 //! ```
 
@@ -11,11 +11,13 @@ mod error;
 pub mod flags;
 mod gpu;
 pub mod plan;
+mod reference;
 pub mod request;
 mod tolerance;
 pub mod warnings;
 
 pub use error::RenderError;
 pub use gpu::{on_gpu, predicted_barycentrics, Rendered};
+pub use reference::on_reference;
 pub use request::RequestArgs;
 pub use tolerance::beyond_this_device;
