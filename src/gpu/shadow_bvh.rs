@@ -1,5 +1,5 @@
 //! Shadow rays on devices without ray queries: the occluders' BVH (`visibility::occluder_bvh`, the tree the
-//! reference's rays walk) laid out for the fragment shader, which walks it in software (shaders/occluders.glsl,
+//! reference's rays walk) laid out for the fragment shader, which walks it in software (shaders/bvh.glsl,
 //! defined `SUNSHADE_RAY_BVH`). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 10 the occluder records
 //! (`layout::occluder_records`) in the tree's leaf order, so that a leaf's `first..first + count` indexes them
 //! directly; the triangles' corners are read from the vertex buffer (binding 3) by the records' global indices,
@@ -107,7 +107,7 @@ mod tests {
         }
         assert!(nodes.len() > 31, "{} nodes", nodes.len());
         // The shader's walk is sized by the same constants.
-        let glsl = include_str!("../../shaders/occluders.glsl");
+        let glsl = include_str!("../../shaders/bvh.glsl");
         use crate::visibility::bvh::{LEAF_SIZE, STACK_SIZE};
         assert!(glsl.contains(&format!("#define BVH_LEAF_SIZE {LEAF_SIZE}u\n")), "BVH_LEAF_SIZE");
         assert!(glsl.contains(&format!("#define BVH_STACK_SIZE {STACK_SIZE}\n")), "BVH_STACK_SIZE");

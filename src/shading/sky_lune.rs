@@ -292,7 +292,7 @@ mod tests {
 
     #[test]
     fn the_shader_grades_tails_alike() {
-        let glsl = include_str!("../../shaders/shade.glsl");
+        let glsl = [include_str!("../../shaders/shade.glsl"), include_str!("../../shaders/sky_lune.glsl")].concat();
         assert!(glsl.contains(&format!("const float SKY_TAIL_GRADING = {SKY_TAIL_GRADING:.1};\n")));
         assert!(glsl.contains(&format!("const float GRAZING_FLOOR = {GRAZING_FLOOR:.2};\n")));
         assert!(glsl.contains(&format!("const float SKY_REACH = {SKY_REACH:e};\n")));

@@ -1,5 +1,5 @@
 //! A bounding volume hierarchy over triangles for the visibility rays (the reference's, and the GPU's on devices
-//! without ray queries: shaders/occluders.glsl walks the same tree): built once per scene by binned splits of
+//! without ray queries: shaders/bvh.glsl walks the same tree): built once per scene by binned splits of
 //! least surface-area cost (MacDonald & Booth, "Heuristics for ray tracing using space subdivision", The Visual
 //! Computer 6, 1990; binned as in Wald, "On fast construction of SAH-based bounding volume hierarchies", 2007),
 //! each side kept at least a quarter of its parent's triangles, and traversed with an explicit stack.
@@ -22,12 +22,12 @@ use super::ray_triangle::WatertightRay;
 use crate::shading::visibility::SliceReach;
 
 /// The walks' stack entries: more than the deepest tree's levels (module text). `BVH_STACK_SIZE` in
-/// shaders/occluders.glsl.
+/// shaders/bvh.glsl.
 pub const STACK_SIZE: usize = 96;
 /// Bins per axis of the split search.
 const BINS: usize = 16;
 
-/// Triangles per leaf at most (`BVH_LEAF_SIZE` in shaders/occluders.glsl, whose walk tests a child leaf's triangle
+/// Triangles per leaf at most (`BVH_LEAF_SIZE` in shaders/bvh.glsl, whose walk tests a child leaf's triangle
 /// in its parent's iteration). One: on lavapipe a SIMD group runs a leaf's tests whenever one of its lanes is at a
 /// leaf, so leaves of four cost the shader's walk 1.6 to 2 times as much (`render --shadows ray`, 256²: teapot.glb
 /// 7.6 s against 4.2–5.2 s, sunset.glb 11.3–12.5 s against 6.3–6.5 s; brdfs.glb at 96 × 72: 7.0–7.5 s against
@@ -114,7 +114,7 @@ impl Bvh {
 
     /// The nodes, root first, each as `(min, max, first, count)` \[m\]: a leaf (`count > 0`) holds
     /// `order()[first..first + count]`, an inner node (`count == 0`) has its children at `first` and `first + 1`.
-    /// The boxes are padded as the traversal here uses them. The GPU's traversal (shaders/occluders.glsl) walks
+    /// The boxes are padded as the traversal here uses them. The GPU's traversal (shaders/bvh.glsl) walks
     /// the same tree.
     pub fn nodes(&self) -> impl Iterator<Item = (DVec3, DVec3, u32, u32)> + '_ {
         self.nodes.iter().map(|n| (n.min, n.max, n.first, n.count))

@@ -136,7 +136,7 @@ impl Sheared {
     }
 }
 
-/// The GPU's watertight test (shaders/occluders.glsl's `watertight_ray` and `intersect`, without ray queries),
+/// The GPU's watertight test (shaders/ray_triangle.glsl's `watertight_ray` and `intersect`, without ray queries),
 /// in f32 as the shader computes it, unfused: whether the ray from `origin` along `direction` meets the triangle
 /// with `0 < t < t_max`, and the hit's barycentrics of its second and third corners.
 pub fn intersect_f32(origin: [f32; 3], direction: [f32; 3], [a, b, c]: [[f32; 3]; 3], t_max: f32) -> Option<[f32; 2]> {
@@ -237,7 +237,7 @@ mod tests {
         }
     }
 
-    /// The GPU's f32 test (shaders/occluders.glsl, mirrored by `intersect_f32`) is watertight too: the fan's shared
+    /// The GPU's f32 test (shaders/ray_triangle.glsl, mirrored by `intersect_f32`) is watertight too: the fan's shared
     /// edges and centre, in f32, never let a ray through.
     #[test]
     fn the_f32_test_is_watertight_on_the_fan() {
