@@ -5,6 +5,9 @@
 
 use glam::Vec3;
 
+/// The sun's mean angular diameter seen from the Earth \[degrees\].
+pub const SUN_ANGULAR_DIAMETER_DEGREES: f64 = 0.53;
+
 /// The sun: a disk of uniform radiance `L_sun` and angular diameter `δ` in the direction `direction`.
 ///
 /// It is specified by `E⊥`, the irradiance on a surface facing the sun, per channel:

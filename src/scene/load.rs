@@ -29,7 +29,7 @@ use super::load_material::{rgb, sunshade_extras, MaterialReader};
 use super::load_mesh::node_world_matrices;
 use super::material::Material;
 use super::Scene;
-use crate::shading::radiometry::{degrees_to_radians, SUN_ANGULAR_DIAMETER_DEGREES};
+use crate::scene::light::SUN_ANGULAR_DIAMETER_DEGREES;
 
 /// A glTF file that could not be loaded: `path: problem`, one line.
 #[derive(Debug, thiserror::Error)]
@@ -306,7 +306,7 @@ impl<'a> Loader<'a> {
                 self.scene.lights.sun = Some(Sun {
                     direction: direction.as_vec3(),
                     irradiance,
-                    angular_diameter: degrees_to_radians(SUN_ANGULAR_DIAMETER_DEGREES) as f32,
+                    angular_diameter: SUN_ANGULAR_DIAMETER_DEGREES.to_radians() as f32,
                 });
             }
             "point" | "spot" => self.scene.warnings.push(format!(

@@ -3,9 +3,9 @@
 //! Evaluation of the BRDFs lives in `shading::brdf`; this module holds the parameters a scene gives, checks them,
 //! and maps glTF's metallic-roughness parameters onto each model (`--brdf`).
 
+use super::measured::MeasuredLookup;
 use super::measured::SharedMeasuredBrdf;
 use super::texture::TextureRef;
-use crate::shading::measured::MeasuredLookup;
 
 /// The reflectance model of a material and its parameters (dimensionless reflectances, linear RGB).
 /// `kd + ks ≤ 1` per channel for every model ([`Brdf::validate`]).
@@ -137,7 +137,7 @@ impl Brdf {
     ///
     /// Lambert takes `base` as the albedo.
     pub fn from_metallic_roughness(kind: BrdfKind, p: MetallicRoughness) -> Brdf {
-        crate::shading::surface::brdf_from_metallic_roughness(kind, p.base_color, p.metallic, p.roughness)
+        brdf_from_metallic_roughness(kind, p.base_color, p.metallic, p.roughness)
     }
 }
 
@@ -227,6 +227,25 @@ impl Material {
             .into_iter()
             .flatten()
             .chain(self.normal_texture.as_ref().map(|(t, _)| t))
+    }
+}
+
+/// The metallic-roughness mapping onto a model (docs/brdf.md), in f32 (the surface applies it per pixel,
+/// shaders/surface.glsl alike): `ks = 0.04 (1 − m) + base · m`,
+/// `kd = base (1 − m)(1 − ks)`, `α = max(r², 10⁻³)`, Phong/Blinn-Phong exponent `clamp(2/α² − 2, 0, 10⁷)`, Ward
+/// `αx = αy = α`; Lambert takes `base` as the albedo. `m` and `r` are clamped to [0, 1].
+pub fn brdf_from_metallic_roughness(kind: BrdfKind, base: [f32; 3], metallic: f32, roughness: f32) -> Brdf {
+    let m = metallic.clamp(0.0, 1.0);
+    let ks = base.map(|b| 0.04 * (1.0 - m) + b * m);
+    let kd = [0, 1, 2].map(|c| base[c] * (1.0 - m) * (1.0 - ks[c]));
+    let r = roughness.clamp(0.0, 1.0);
+    let alpha = (r * r).max(MIN_MAPPED_ALPHA);
+    let exponent = (2.0 / (alpha * alpha) - 2.0).clamp(0.0, MAX_EXPONENT);
+    match kind {
+        BrdfKind::Lambert => Brdf::Lambert { albedo: base },
+        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent },
+        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent },
+        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: alpha, alpha_y: alpha },
     }
 }
 

@@ -13,6 +13,25 @@
 
 use std::sync::Arc;
 
+/// How the table is read between its samples (`--merl-lookup`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeasuredLookup {
+    #[default]
+    Linear,
+    Nearest,
+}
+
+impl std::str::FromStr for MeasuredLookup {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "linear" => Ok(MeasuredLookup::Linear),
+            "nearest" => Ok(MeasuredLookup::Nearest),
+            _ => Err(format!("'{s}' is not a lookup (linear, nearest)")),
+        }
+    }
+}
+
 /// Bins of θ_h, θ_d and φ_d.
 pub const THETA_H_BINS: usize = 90;
 pub const THETA_D_BINS: usize = 90;

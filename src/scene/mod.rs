@@ -102,11 +102,7 @@ impl Scene {
 
     /// Gives every material the measured BRDF `table` (`--merl`), read with `lookup`: its textures and factors
     /// no longer set the BRDF (emission, normal maps and alpha still apply).
-    pub fn use_measured(
-        &mut self,
-        table: &measured::SharedMeasuredBrdf,
-        lookup: crate::shading::measured::MeasuredLookup,
-    ) {
+    pub fn use_measured(&mut self, table: &measured::SharedMeasuredBrdf, lookup: measured::MeasuredLookup) {
         for m in &mut self.materials {
             m.brdf = Brdf::Measured { table: table.clone(), lookup };
             m.mapping = None;
@@ -114,7 +110,7 @@ impl Scene {
     }
 
     /// Reads every measured material's table with `lookup` (`--merl-lookup`).
-    pub fn set_measured_lookup(&mut self, lookup: crate::shading::measured::MeasuredLookup) {
+    pub fn set_measured_lookup(&mut self, lookup: measured::MeasuredLookup) {
         for m in &mut self.materials {
             if let Brdf::Measured { lookup: l, .. } = &mut m.brdf {
                 *l = lookup;

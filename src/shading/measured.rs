@@ -26,27 +26,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
 
+pub use crate::scene::measured::MeasuredLookup;
 use crate::scene::measured::THETA_H_BINS;
 use crate::scene::measured::{merl_bin_angles, merl_index, MeasuredBrdf, MERL_SAMPLES, PHI_D_BINS, THETA_D_BINS};
-
-/// How the table is read between its samples (`--merl-lookup`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum MeasuredLookup {
-    #[default]
-    Linear,
-    Nearest,
-}
-
-impl std::str::FromStr for MeasuredLookup {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "linear" => Ok(MeasuredLookup::Linear),
-            "nearest" => Ok(MeasuredLookup::Nearest),
-            _ => Err(format!("'{s}' is not a lookup (linear, nearest)")),
-        }
-    }
-}
 
 /// The angle between unit vectors a and b, `atan2(|a × b|, a·b)`: accurate at 0 and near π/2.
 pub fn angle_between(a: DVec3, b: DVec3) -> f64 {

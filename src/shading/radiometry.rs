@@ -11,8 +11,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-/// The sun's mean angular diameter seen from the Earth \[degrees\].
-pub const SUN_ANGULAR_DIAMETER_DEGREES: f64 = 0.53;
+pub use crate::scene::light::SUN_ANGULAR_DIAMETER_DEGREES;
 
 /// Default irradiance on a surface facing the sun, `E⊥` [W/m²].
 pub const DEFAULT_SUN_IRRADIANCE: f64 = 1000.0;

@@ -7,7 +7,7 @@
 use glam::DVec3;
 
 use super::texture_filter::texture_lookup;
-use crate::scene::material::{MAX_EXPONENT, MIN_MAPPED_ALPHA};
+use crate::scene::material::brdf_from_metallic_roughness;
 use crate::scene::{AlphaMode, Brdf, BrdfKind, Material, Texture, TextureRef};
 
 /// Bits of what a draw's material needs per pixel (the `VARIANT_SURFACE` specialization constant on the GPU; the
@@ -83,24 +83,6 @@ pub fn base_color(material: &Material, textures: &[Texture], s: &SurfaceSample) 
         c = [0, 1, 2, 3].map(|k| c[k] * v[k]);
     }
     c
-}
-
-/// The metallic-roughness mapping onto a model (docs/brdf.md), in f32: `ks = 0.04 (1 − m) + base · m`,
-/// `kd = base (1 − m)(1 − ks)`, `α = max(r², 10⁻³)`, Phong/Blinn-Phong exponent `clamp(2/α² − 2, 0, 10⁷)`, Ward
-/// `αx = αy = α`; Lambert takes `base` as the albedo. `m` and `r` are clamped to [0, 1].
-pub fn brdf_from_metallic_roughness(kind: BrdfKind, base: [f32; 3], metallic: f32, roughness: f32) -> Brdf {
-    let m = metallic.clamp(0.0, 1.0);
-    let ks = base.map(|b| 0.04 * (1.0 - m) + b * m);
-    let kd = [0, 1, 2].map(|c| base[c] * (1.0 - m) * (1.0 - ks[c]));
-    let r = roughness.clamp(0.0, 1.0);
-    let alpha = (r * r).max(MIN_MAPPED_ALPHA);
-    let exponent = (2.0 / (alpha * alpha) - 2.0).clamp(0.0, MAX_EXPONENT);
-    match kind {
-        BrdfKind::Lambert => Brdf::Lambert { albedo: base },
-        BrdfKind::Phong => Brdf::Phong { kd, ks, exponent },
-        BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent },
-        BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: alpha, alpha_y: alpha },
-    }
 }
 
 /// The BRDF at the pixel: the mapping of the base colour and the metallic-roughness texture (B metallic, G
