@@ -505,7 +505,7 @@ pub fn choose_for_tolerance_with_peak(
 /// bounded); a disk light's penumbrae are where its shadows are, as the sun's (room.gltf's disk skylight: 222 of
 /// 4096 pixels at 64²). The sky's penumbra is every point that sees an occluder above its horizon, nearly a whole
 /// image that has occluders (overcast.glb: 2193 of 2461 pixels; brdfs.glb under a sky: 2515 of 2518), so a promise
-/// outside it would be one about almost nothing: refused. (Until 2026-12-03 disk lights were refused alike.)
+/// outside it would be one about almost nothing: refused.
 pub(crate) fn techniques_within(
     settings: &RenderSettings,
     renderer: Renderer,

@@ -58,14 +58,14 @@
 //! `O(k⁻²)`, order 2 on the ladder's `k`: where every light shadowed is taken by slices and every material the
 //! meshes use is Lambertian (no lobe grid, so no lobe sample casting a ray: the ones that make penumbrae first
 //! order), the order used is at most [`MAX_ORDER`], as without penumbrae ([`Ladder::with_sliced_penumbrae`]).
-//! Measured on overcast.glb at 512² (2026-12-04): the slices' images for k = 9, 13, 18 (`4k²` rows each) differ
+//! Measured on overcast.glb at 512²: the slices' images for k = 9, 13, 18 (`4k²` rows each) differ
 //! by 3.3e-3 and 1.7e-3 at their largest, an observed order of 1.8 in `k` (first order in the rows), where the
 //! cap of 1 had taken it as 1.
 //!
 //! **Orders past the midpoint's.** An observed order above 2 is cut to 2, but the cut alone keeps Roache's 1.25
 //! for an order the study did not confirm: the rungs' maxima read past 2 where the last two rungs agree by chance
 //! at the pixel whose error is largest, and that pixel's difference then understates its error. Measured on
-//! room.gltf at 48 × 36 (2026-12-05), its skylight's penumbra by slices: the rows of k = 4, 6, 9, 13, 19 err
+//! room.gltf at 48 × 36, its skylight's penumbra by slices: the rows of k = 4, 6, 9, 13, 19 err
 //! 6.0e-3, 1.5e-3, 2.3e-3, 1.0e-3, 1.7e-4 against `reference --converged --accuracy 1e-5` (not monotone), the
 //! maxima of the rungs' differences read an order of 2.6, and the estimate at 9² with 1.25 was 1.6e-3, short of
 //! the 2.3e-3 measured. Where the order observed lies more than 10% above the one used (Oberkampf and Roy's
@@ -419,7 +419,7 @@ mod tests {
         assert_eq!(ladder.estimate().unwrap().order, MAX_ORDER);
     }
 
-    /// room.gltf's case (48 × 36, its skylight's penumbra by slices, 2026-12-05): the image's largest early
+    /// room.gltf's case (48 × 36, its skylight's penumbra by slices): the image's largest early
     /// difference sits where the rows settle fast, while at another pixel two rungs agree by chance, each still
     /// off by more than they differ. The order read from the maxima (3.1) is past the midpoint's; Roache's 1.25
     /// on the order cut to 2 falls short of that pixel's error, his unconfirmed 3 covers it.

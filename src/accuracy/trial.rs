@@ -34,7 +34,7 @@ pub struct WithinTolerance<T> {
 }
 
 /// What `--tolerance` promises: the max relative error (with the diff's floor) of the image, and whether it holds in
-/// penumbrae too (`--tolerance`'s default since 2026-12-05). Without that (`--tolerance-outside-penumbrae`), the
+/// penumbrae too (`--tolerance`'s default). Without that (`--tolerance-outside-penumbrae`), the
 /// promise holds outside the penumbrae of the sun and of disk lights (where a light is partly hidden), which the
 /// prediction names as not bounded (`super::penumbrae` finds them to measure it), and the sky through occluders is
 /// refused (its penumbra is every point that sees an occluder above its horizon: nearly the whole image); with it, the

@@ -18,7 +18,7 @@
 //! miss a frame that runs out (the frame is then drawn again, as without the probe), or pass the rows of a frame
 //! that would have fitted (pixels within the reserve of the limit, none past it).
 //!
-//! Measured (2026-12-05, AMD EPYC, 2 threads, Mesa 22.3.6; `render MODEL --shadows ray --visibility slices
+//! Measured (AMD EPYC, 2 threads, Mesa 22.3.6; `render MODEL --shadows ray --visibility slices
 //! --shadow-samples K² -v`, the "render" line, one run each, images bitwise those of the frame drawn again):
 //! room.gltf at 512², k = 13: 193 s → 64 s (the probe 2.8 s); at 128², k = 9: 27.8 s → 10.3 s (1.3 s); where
 //! the frame fits, sunset.glb at 512², k = 13: the probe 0.41 s of a 24 s frame, room.gltf at 128², k = 6: 0.59 s

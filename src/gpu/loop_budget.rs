@@ -12,9 +12,9 @@
 //! median splits); with 4² rays a pixel, none. The sky's three lobe grids at 162² (79 218 iterations) exceed it on
 //! their own.
 //!
-//! A loop of known count counts too: the walk's slab test looped over three axes, three iterations a box, until
-//! called axis by axis (`slab_axis`, 2026-12-04): overcast.glb at 96 × 72 then passed 32² shadow rays where it had been
-//! refused at 12² (docs/platform.md).
+//! A loop of known count counts too: a slab test looped over three axes spends three iterations a box; called
+//! axis by axis (`slab_axis`), overcast.glb at 96 × 72 passes 32² shadow rays where the loop was refused at 12²
+//! (docs/platform.md).
 //!
 //! What sunshade does: every fragment ends with a probe loop of [`LOOP_PROBE_ITERATIONS`] iterations, a count the
 //! compiler cannot see (a uniform), which stops after one exactly when the budget is spent; such a fragment writes

@@ -52,8 +52,8 @@ use super::shade::orthonormal_to;
 /// Default side of the visibility grids, `k = 6` (`--shadow-samples 36`): the sun and disk lights cast `(k + 1)² = 49`
 /// rays a pixel (up to 85 in a penumbra, locating its edges), the sky 30 (25 on a floor: its lune's sides of zero
 /// weight cast none; up to 66 with its edges). Chosen by measurement
-/// (2026-12-03, sunset.glb, 96 × 72, against 64²): located 6² errs 4.3e-3 (max relative), where the count of 8²
-/// midpoints, the default before the edges were located, erred 2.6e-2 and 16² 5.9e-3; at 256² on the system
+/// (sunset.glb, 96 × 72, against 64²): located 6² errs 4.3e-3 (max relative), where a count of 8²
+/// midpoints errs 2.6e-2 and 16² 5.9e-3; at 256² on the system
 /// lavapipe's BVH walk located 6² renders teapot.glb and sunset.glb in 3.1–3.3 s and 5.4 s, the old 8² in 4.0–4.9 s
 /// and 6.7–6.8 s. Shadow maps filter on the same grid (PCSS, `k²` taps).
 pub const DEFAULT_SHADOW_SAMPLES_PER_AXIS: u32 = 6;
@@ -868,7 +868,7 @@ mod tests {
         // the visible directions ω·(cos θ, −e, sin θ) ≥ 0 project onto the floor as the unit disk less a half
         // ellipse of semi-axes |e|/√(1 + e²) and 1, so the fraction is ½ (1 − e/√(1 + e²))) and over two tilted
         // surfaces (truth: the same grid at 1024², whose error is four thousand times smaller than at 16² if it is
-        // of the second order, as the floors show). Measured (2026-12-03): error × k² at most 2.5 at 16², 32², 64²
+        // of the second order, as the floors show). Measured: error × k² at most 2.5 at 16², 32², 64²
         // (the steep surface's thin lune the largest); the count of k² midpoints it replaced was first order.
         for edge in [0.3, -0.7] {
             for theta in [0.0f64, 0.4, 1.1] {
