@@ -18,6 +18,7 @@ render: build
 # on Mesa 25's lavapipe (ray queries; scripts/lavapipe-rt.sh installs it into .lavapipe-rt/ without touching the
 # system). Where it cannot be installed those tests are skipped with a message, never silently.
 test: setup
+	@./scripts/machine.sh
 	$(CARGO) test --release --workspace
 	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
 		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
