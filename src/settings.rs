@@ -93,6 +93,8 @@ impl RenderSettings {
 pub struct CameraOptions {
     /// glTF camera index to use.
     pub camera: Option<usize>,
+    /// The automatic camera (framing the scene's bounding sphere) even where the file places cameras.
+    pub automatic: bool,
     pub eye: Option<DVec3>,
     pub target: Option<DVec3>,
     pub up: Option<DVec3>,
@@ -217,6 +219,7 @@ fn resolve_camera(scene: &Scene, aspect: f64, opts: &CameraOptions) -> Result<Ca
             let placed: Vec<usize> = scene.cameras.iter().map(|(i, _)| *i).collect();
             usage(format!("--camera {n}: no node of the scene places glTF camera {n} (placed: {placed:?})"))
         })?),
+        None if opts.automatic => None,
         None => scene.cameras.first().map(|(_, c)| *c),
     };
     let yfov = degrees_to_radians(opts.fov_degrees.unwrap_or(AUTO_FOV_DEGREES));

@@ -1166,3 +1166,50 @@ fn gpu_the_library_and_the_command_line_render_the_same_flags_to_the_same_image(
         }
     }
 }
+
+/// `-v` names the camera (the file's, or the automatic one, which `--camera auto` asks for even where the file has
+/// cameras) and the sun (elevation, azimuth, where it came from); light the flags may not mean is warned about: a sun
+/// below the horizon, a sky given to a scene without light (no default sun then); an empty file says so.
+#[test]
+fn renders_say_what_they_drew_and_warn_about_light_the_flags_may_not_mean() {
+    let dir = TempDir::new("say-what");
+    let mut b = GltfBuilder::new();
+    let m = b.add_material("m", [0.5; 3], false, None);
+    let mesh = b.add_mesh("cube", &[cube(0.5).primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    let camera = b.add_perspective_camera(0.8, 0.1, Some(50.0));
+    let placed = sunshade::authoring::Transform::Trs {
+        translation: [0.0, 0.0, 4.0],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+        scale: [1.0; 3],
+    };
+    let c = b.add_node(Node { camera: Some(camera), transform: placed, ..Default::default() });
+    b.add_scene(&[n, c], None);
+    let input = dir.write("cam.glb", &b);
+    let out = dir.path("o.png");
+    let v = |extra: &[&str]| {
+        let mut argv = vec!["render", s(&input), "-o", s(&out), "--width", "32", "--height", "24", "-v"];
+        argv.extend(extra);
+        let o = sunshade(&argv);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let text = v(&["--sun-elevation", "15", "--sun-azimuth", "90"]);
+    assert!(text.contains(&format!("camera: the file's camera {camera}")), "{text}");
+    assert!(text.contains("sun position: elevation 15.000°, azimuth 90.000°") && text.contains("from the flags"), "{text}");
+    let text = v(&["--camera", "auto"]);
+    assert!(text.contains("camera: automatic (--camera auto)") && text.contains("from the default"), "{text}");
+    assert!(!text.contains("warning"), "{text}");
+    assert!(v(&["--sun-elevation", "-10"]).contains("warning: the sun is below the horizon (elevation -10.00°)"));
+    let text = v(&["--sky-radiance", "50"]);
+    assert!(text.contains("warning: no sun: --sky-radiance") && text.contains("sun: none"), "{text}");
+    assert!(!v(&["--sky-radiance", "50", "--sun-elevation", "30"]).contains("warning"));
+    let o = sunshade(&["render", s(&input), "-o", s(&out), "--camera", "front"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("'front' is neither a glTF camera index nor 'auto'"), "{}", stderr(&o));
+    let empty = dir.path("empty.glb");
+    std::fs::write(&empty, b"").unwrap();
+    let o = sunshade(&["render", s(&empty), "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("empty.glb: empty file (0 bytes)"), "{}", stderr(&o));
+}

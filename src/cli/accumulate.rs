@@ -248,10 +248,17 @@ impl Accumulated {
 
     /// `-v`: what was rendered and what it cost.
     pub fn print(&self) {
-        eprintln!(
-            "sunshade: {} of {} steps in this shard rendered (the sun up), {:.3} of {:.3} h; {} steps in all",
-            self.steps_rendered, self.steps_in_shard, self.hours_rendered, self.hours_in_shard, self.steps_total
-        );
+        if self.steps_in_shard == self.steps_total {
+            eprintln!(
+                "sunshade: {} of {} steps rendered (the sun up), {:.3} of {:.3} h",
+                self.steps_rendered, self.steps_total, self.hours_rendered, self.hours_in_shard
+            );
+        } else {
+            eprintln!(
+                "sunshade: {} of {} steps in this shard rendered (the sun up), {:.3} of {:.3} h; {} steps in all",
+                self.steps_rendered, self.steps_in_shard, self.hours_rendered, self.hours_in_shard, self.steps_total
+            );
+        }
         let per = |d: Duration| {
             if self.steps_rendered == 0 {
                 0.0

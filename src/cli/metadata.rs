@@ -8,6 +8,7 @@ use serde_json::json;
 
 use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
+use crate::render::flags::SceneArgs;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
@@ -149,4 +150,60 @@ pub fn lobe_model_line(settings: &RenderSettings, scene: &Scene) -> Option<Strin
 pub fn daylight(a: &super::args::SceneArgs) -> Option<(String, String)> {
     let d = a.daylight.at_time()?;
     Some(("sunshadeDaylight".into(), d.json(a.daylight.north, a.daylight.linke_turbidity).to_string()))
+}
+
+/// Where a render's sun is, for `-v`: its elevation above the horizontal XZ plane and azimuth from +Z towards +X
+/// (`--sun-elevation`/`--sun-azimuth`'s convention), its direction, and where it came from (the flags, `--time`
+/// with the azimuth clockwise from north, the scene's directional light, or the default).
+pub fn sun_position_line(settings: &RenderSettings, scene: &Scene, a: &SceneArgs) -> Option<String> {
+    let sun = settings.lights.sun.as_ref()?;
+    let d = sun.direction.as_dvec3();
+    // atan2 of the vertical part against the horizontal one: accurate at the zenith and at the horizon alike.
+    let elevation = d.y.atan2(d.x.hypot(d.z)).to_degrees();
+    let azimuth = d.x.atan2(d.z).to_degrees().rem_euclid(360.0);
+    let from = if let Some(at) = a.daylight.at_time() {
+        format!(
+            "--time {} at {:.4}°, {:.4}° (azimuth {:.3}° clockwise from north)",
+            at.instant, at.location.latitude_deg, at.location.longitude_deg, at.position.azimuth_deg
+        )
+    } else if a.sun_dir.is_some() || a.sun_elevation.is_some() || a.sun_azimuth.is_some() {
+        "the flags".to_string()
+    } else if scene.lights.sun.is_some() {
+        "the scene's directional light".to_string()
+    } else {
+        "the default".to_string()
+    };
+    Some(format!(
+        "sun position: elevation {elevation:.3}°, azimuth {azimuth:.3}° (0 = towards +Z, 90 = towards +X), direction \
+         ({:.4}, {:.4}, {:.4}); from {from}",
+        d.x, d.y, d.z
+    ))
+}
+
+/// Which camera a render used, for `-v`: the file's camera N (the first the nodes place, unless `--camera` named
+/// one) or the automatic one, moved by `--eye`/`--target`/`--up` where given; its eye, view direction and field of
+/// view.
+pub fn camera_line(settings: &RenderSettings, scene: &Scene, a: &SceneArgs) -> String {
+    use crate::render::flags::CameraChoice;
+    use crate::scene::camera::Projection;
+    let which = match a.camera {
+        Some(CameraChoice::Scene(n)) => format!("the file's camera {n} (--camera)"),
+        Some(CameraChoice::Automatic) => "automatic (--camera auto)".to_string(),
+        None => match scene.cameras.first() {
+            Some((n, _)) => format!("the file's camera {n} (its first placed camera; --camera auto frames the scene)"),
+            None => "automatic (the file places no camera)".to_string(),
+        },
+    };
+    let moved = if a.eye.is_some() || a.target.is_some() || a.up.is_some() { ", moved by the flags" } else { "" };
+    let c = &settings.camera;
+    let view = match c.projection {
+        Projection::Perspective { yfov, .. } => {
+            format!("perspective, {:.3}° vertical field of view", yfov.to_degrees())
+        }
+        Projection::Orthographic { ymag, .. } => format!("orthographic, {ymag} m half-height"),
+    };
+    format!(
+        "camera: {which}{moved}; eye ({:.4}, {:.4}, {:.4}) m looking along ({:.4}, {:.4}, {:.4}); {view}",
+        c.eye.x, c.eye.y, c.eye.z, c.forward.x, c.forward.y, c.forward.z
+    )
 }

@@ -122,6 +122,10 @@ pub fn run(a: &ReferenceCommand) -> Result<(), CliError> {
             settings.height,
             image.covered_count()
         );
+        eprintln!("sunshade: {}", super::metadata::camera_line(&settings, &scene, &a.scene));
+        if let Some(line) = super::metadata::sun_position_line(&settings, &scene, &a.scene) {
+            eprintln!("sunshade: {line}");
+        }
         eprintln!("sunshade: shadows: {} ({})", settings.shading.shadows.name(), shadow_reason);
         eprintln!("sunshade: {}", super::metadata::sun_model_line(&settings, &scene));
         if let Some(line) = super::metadata::lobe_model_line(&settings, &scene) {

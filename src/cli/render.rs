@@ -236,6 +236,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();
         let sun_line = super::metadata::sun_model_line(&job.settings, session.scene_ref(job.scene));
+        let scene_flags = &a.request.scene;
+        let sun_position = super::metadata::sun_position_line(&job.settings, session.scene_ref(job.scene), scene_flags);
+        let camera_line = super::metadata::camera_line(&job.settings, session.scene_ref(job.scene), scene_flags);
         let lobe_line = super::metadata::lobe_model_line(&job.settings, session.scene_ref(job.scene));
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
@@ -256,6 +259,10 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             job.settings.height,
             job.image.covered_count()
         );
+        eprintln!("sunshade: {camera_line}");
+        if let Some(line) = sun_position {
+            eprintln!("sunshade: {line}");
+        }
         eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
         eprintln!("sunshade: {sun_line}");
         if let Some(line) = lobe_line {

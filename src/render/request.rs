@@ -77,12 +77,34 @@ pub fn load(a: &SceneArgs) -> Result<(Scene, Duration), RenderError> {
     Ok((scene, load_time))
 }
 
-/// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
+/// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take). Warns
+/// where the light is not what the flags may seem to say: a sun below the horizon (lighting the scene from below;
+/// `--time` at night warns on its own and puts the sun out), and a sky or disk light given to a scene without light,
+/// which leaves it without the default sun.
 pub fn resolve_settings(scene: &Scene, a: &SceneArgs) -> Result<RenderSettings, RenderError> {
     let daylight = a.daylight.at_time();
     if let Some(w) = daylight.as_ref().and_then(|d| d.below_horizon_warning()) {
         warn_once(&w);
     }
-    settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options_at(daylight.as_ref()))
-        .map_err(|e| RenderError::Usage(e.to_string()))
+    let settings =
+        settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options_at(daylight.as_ref()))
+            .map_err(|e| RenderError::Usage(e.to_string()))?;
+    if let (Some(sun), None) = (&settings.lights.sun, &daylight) {
+        let d = sun.direction.as_dvec3();
+        if d.y < 0.0 {
+            let elevation = d.y.atan2(d.x.hypot(d.z)).to_degrees();
+            warn_once(&format!(
+                "the sun is below the horizon (elevation {elevation:.2}°): it lights the scene from below"
+            ));
+        }
+    }
+    let scene_unlit = scene.lights.sun.is_none() && scene.lights.disks.is_empty() && scene.lights.sky.is_none();
+    let other_light = a.sky_radiance.is_some() || !a.disk_lights.is_empty();
+    if scene_unlit && other_light && settings.lights.sun.is_none() {
+        warn_once(
+            "no sun: --sky-radiance or --disk-light light this scene alone (the default sun shines only where \
+             neither the scene nor the flags give light; --sun-elevation, --sun-dir or --time adds one)",
+        );
+    }
+    Ok(settings)
 }

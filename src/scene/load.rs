@@ -51,7 +51,7 @@ pub struct LoadOptions {
     pub scene: Option<usize>,
     /// Where buffer and image files may be (default: inside the scene's folder).
     pub uris: UriScope,
-    /// Pose the scene by animation N at time T \[s\] (`--animation N --time T`); `None`: the file's own transforms
+    /// Pose the scene by animation N at time T \[s\] (`--animation N --animation-time T`); `None`: the file's own transforms
     /// and weights (the rest pose).
     pub animation: Option<(usize, f64)>,
     /// Textures larger than this many texels on a side start at their first mip level that fits
@@ -148,7 +148,7 @@ impl<'a> Loader<'a> {
             self.poses = animation::sample(root, &self.reader, index, time)?;
         } else if !root.animations.is_empty() {
             self.scene.warnings.push(format!(
-                "the file has {} animation(s); drawn at rest (--animation N --time T poses it)",
+                "the file has {} animation(s); drawn at rest (--animation N --animation-time T poses it)",
                 root.animations.len()
             ));
         }

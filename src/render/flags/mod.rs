@@ -137,6 +137,23 @@ pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     Ok((k, n))
 }
 
+/// `--camera`: a glTF camera of the file, or the automatic one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraChoice {
+    Scene(usize),
+    Automatic,
+}
+
+impl std::str::FromStr for CameraChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "auto" {
+            return Ok(CameraChoice::Automatic);
+        }
+        s.parse().map(CameraChoice::Scene).map_err(|_| format!("'{s}' is neither a glTF camera index nor 'auto'"))
+    }
+}
+
 /// Everything that defines the image: scene, size, camera, lights.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
@@ -179,9 +196,10 @@ pub struct SceneArgs {
     #[arg(help_heading = "Scene", long, value_name = "SECONDS", requires = "animation", allow_negative_numbers = true)]
     pub animation_time: Option<f64>,
 
-    /// Use glTF camera N (as placed by the scene's nodes) instead of the first one.
-    #[arg(help_heading = "Camera", long, value_name = "N")]
-    pub camera: Option<usize>,
+    /// Use glTF camera N (as placed by the scene's nodes) instead of the first one, or `auto`: the automatic camera
+    /// (the scene's bounding sphere framed from +Z, 45° vertical field of view) even where the file has cameras.
+    #[arg(help_heading = "Camera", long, value_name = "N|auto")]
+    pub camera: Option<CameraChoice>,
 
     /// Camera position x,y,z [m] (world, +Y up).
     #[arg(help_heading = "Camera", long, value_parser = parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
@@ -416,7 +434,12 @@ impl SceneArgs {
     }
 
     pub fn camera_options(&self) -> CameraOptions {
-        CameraOptions { camera: self.camera, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
+        let (camera, automatic) = match self.camera {
+            Some(CameraChoice::Scene(n)) => (Some(n), false),
+            Some(CameraChoice::Automatic) => (None, true),
+            None => (None, false),
+        };
+        CameraOptions { camera, automatic, eye: self.eye, target: self.target, up: self.up, fov_degrees: self.fov }
     }
 
     /// The light options with the sun and clear sky of `daylight` (the flags' own where they give them): the sun's

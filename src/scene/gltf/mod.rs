@@ -46,6 +46,13 @@ pub struct Gltf {
 /// name (the caller adds it).
 pub fn read(path: &Path, scope: &UriScope) -> Result<Gltf, String> {
     let bytes = files::read_regular_file(path, None).map_err(|e| format!("cannot read the scene: {e}"))?;
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(if bytes.is_empty() {
+            "empty file (0 bytes)".into()
+        } else {
+            "the file holds only whitespace".into()
+        });
+    }
     let (json, bin) = if glb::is_glb(&bytes) {
         let g = glb::parse(&bytes)?;
         (g.json, g.bin)
