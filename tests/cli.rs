@@ -403,6 +403,11 @@ fn batch_renders_like_render_goes_on_after_a_failure_and_shards() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("3 of 3 jobs rendered"), "{}", stderr(&o));
     assert_eq!(std::fs::read(dir.path("a.exr")).unwrap(), a);
+    // --filter: the jobs whose output path matches (a glob here), numbered as in the manifest.
+    std::fs::remove_file(dir.path("c.png")).unwrap();
+    let o = sunshade(&["batch", s(&manifest), "--filter", "*.png"]);
+    assert!(o.status.success() && stderr(&o).contains("1 of 1 jobs rendered"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(dir.path("c.png")).unwrap(), c);
     let o = sunshade(&["batch", s(&manifest), "--shard", "2/2"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     std::fs::write(&manifest, "{\"not\": \"an array\"}").unwrap();
@@ -542,6 +547,25 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     let o = sunshade(&["test", s(&suite), "--shard", "1/3"]);
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(o.status.success() && out.contains("PASS ref") && !out.contains("golden"), "{out}");
+    // --update rewrites the failing golden only; the passing one is kept as it was.
+    let strict = dir.path("goldens/b.exr");
+    let kept = std::fs::read(&strict).unwrap();
+    let stamp = std::fs::metadata(&strict).unwrap().modified().unwrap();
+    let o = sunshade(&["test", s(&suite), "--update", "--report", s(&dir.path("report"))]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success() && out.contains("UPDATED golden") && out.contains("PASS strict"), "{out}");
+    assert_eq!(std::fs::metadata(&strict).unwrap().modified().unwrap(), stamp);
+    // The run removed the previous run's actual image and heatmap of the case that failed then.
+    assert!(!dir.path("report/golden.actual.exr").exists(), "a stale actual image is left");
+    // --update-all rewrites every golden; --filter runs the matching cases (a substring or a glob).
+    let o = sunshade(&["test", s(&suite), "--update-all", "--filter", "str*"]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(o.status.success() && out.contains("UPDATED strict") && !out.contains("golden"), "{out}");
+    assert!(out.contains("1 passed, 0 failed"), "{out}");
+    assert_eq!(std::fs::read(&strict).unwrap(), kept, "the same image rewritten");
+    let o = sunshade(&["test", s(&suite), "--filter", "re"]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(out.contains("PASS ref") && !out.contains("strict") && out.contains("1 passed"), "{out}");
 }
 
 #[test]
@@ -1196,7 +1220,10 @@ fn renders_say_what_they_drew_and_warn_about_light_the_flags_may_not_mean() {
     };
     let text = v(&["--sun-elevation", "15", "--sun-azimuth", "90"]);
     assert!(text.contains(&format!("camera: the file's camera {camera}")), "{text}");
-    assert!(text.contains("sun position: elevation 15.000°, azimuth 90.000°") && text.contains("from the flags"), "{text}");
+    assert!(
+        text.contains("sun position: elevation 15.000°, azimuth 90.000°") && text.contains("from the flags"),
+        "{text}"
+    );
     let text = v(&["--camera", "auto"]);
     assert!(text.contains("camera: automatic (--camera auto)") && text.contains("from the default"), "{text}");
     assert!(!text.contains("warning"), "{text}");

@@ -46,14 +46,48 @@ pub struct RunArgs {
     /// Do not read or write the pipeline cache on disk.
     #[arg(long)]
     pub no_cache: bool,
+    /// Run only the cases whose name (`test`), or the jobs whose output path (`batch`), matches PATTERN: a
+    /// substring, or a glob where it holds `*` (any run of characters) or `?` (one character). With --shard, the
+    /// matching ones are split.
+    #[arg(long, value_name = "PATTERN")]
+    pub filter: Option<String>,
 }
 
 impl RunArgs {
-    /// The indices of `count` items this shard runs.
-    pub fn mine(&self, count: usize) -> Vec<usize> {
+    /// The indices of the items (named `names`) this process runs: those `--filter` matches, then this shard's.
+    pub fn mine(&self, names: &[String]) -> Vec<usize> {
         let (k, n) = self.shard.unwrap_or((0, 1));
-        (0..count).filter(|i| i % n == k).collect()
+        let matching =
+            (0..names.len()).filter(|&i| self.filter.as_deref().is_none_or(|p| matches_pattern(p, &names[i])));
+        matching.enumerate().filter(|(j, _)| j % n == k).map(|(_, i)| i).collect()
     }
+}
+
+/// `--filter`'s rule: a glob where `pattern` holds `*` or `?` (the whole text must match), else a substring.
+pub fn matches_pattern(pattern: &str, text: &str) -> bool {
+    if !pattern.contains(['*', '?']) {
+        return text.contains(pattern);
+    }
+    // Glob by dynamic programming over (pattern, text) prefixes: linear space, no backtracking blow-up.
+    let (p, t): (Vec<char>, Vec<char>) = (pattern.chars().collect(), text.chars().collect());
+    let mut row = vec![false; t.len() + 1];
+    row[0] = true;
+    for &c in &p {
+        let mut next = vec![false; t.len() + 1];
+        if c == '*' {
+            let mut any = false;
+            for j in 0..=t.len() {
+                any = any || row[j];
+                next[j] = any;
+            }
+        } else {
+            for j in 1..=t.len() {
+                next[j] = row[j - 1] && (c == '?' || c == t[j - 1]);
+            }
+        }
+        row = next;
+    }
+    row[t.len()]
 }
 
 /// A job object → `render`'s argument list. Errors name the key.
@@ -92,12 +126,17 @@ pub fn job_arguments(job: &Value) -> Result<Vec<String>, String> {
 }
 
 /// The jobs of a manifest, each parsed or the reason it cannot be.
-fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliError> {
+/// The manifest's jobs, each parsed or why it cannot be, and their names for `--filter` (their output paths).
+type Manifest = (Vec<Result<RenderArgs, String>>, Vec<String>);
+
+fn read_manifest(path: &Path) -> Result<Manifest, CliError> {
     let fail = |m: String| CliError::Failure(anyhow::anyhow!("{}: {m}", path.display()));
     let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
     let value: Value = serde_json::from_str(&text).map_err(|e| fail(format!("invalid JSON: {e}")))?;
     let jobs = value.as_array().ok_or_else(|| fail("the manifest must be a JSON array of jobs".into()))?;
-    Ok(jobs
+    let text_of = |job: &Value, key: &str| job.get(key).and_then(Value::as_str).unwrap_or("").to_string();
+    let names = jobs.iter().map(|job| text_of(job, "output")).collect();
+    let parsed = jobs
         .iter()
         .map(|job| {
             let args = RenderArgs::parse_list(&job_arguments(job)?)?;
@@ -113,7 +152,8 @@ fn read_manifest(path: &Path) -> Result<Vec<Result<RenderArgs, String>>, CliErro
             }
             Ok(args)
         })
-        .collect())
+        .collect();
+    Ok((parsed, names))
 }
 
 /// An image to write, and which job it is.
@@ -126,8 +166,8 @@ struct Encode {
 }
 
 pub fn run(a: &BatchArgs) -> Result<(), CliError> {
-    let jobs = read_manifest(&a.manifest)?;
-    let mine = a.run.mine(jobs.len());
+    let (jobs, names) = read_manifest(&a.manifest)?;
+    let mine = a.run.mine(&names);
     let bar = if a.quiet {
         ProgressBar::hidden()
     } else {
@@ -267,5 +307,21 @@ mod tests {
         assert_eq!(parse_shard("0/3"), Ok((0, 3)));
         assert_eq!(parse_shard("2/3"), Ok((2, 3)));
         assert!(parse_shard("3/3").is_err() && parse_shard("1/0").is_err() && parse_shard("x").is_err());
+        for (pattern, text, want) in [
+            ("pot", "teapot-sunset", true),
+            ("tea*set", "teapot-sunset", true),
+            ("tea*", "a-teapot", false),
+            ("*pot?sun*", "teapot-sunset", true),
+            ("?", "", false),
+            ("*", "", true),
+            ("x", "teapot", false),
+        ] {
+            assert_eq!(matches_pattern(pattern, text), want, "{pattern} {text}");
+        }
+        let run = |filter: Option<&str>, shard| RunArgs { shard, no_cache: false, filter: filter.map(String::from) };
+        let names: Vec<String> = ["a1", "b1", "a2", "a3"].map(String::from).to_vec();
+        assert_eq!(run(Some("a"), None).mine(&names), [0, 2, 3]);
+        assert_eq!(run(Some("a"), Some((1, 2))).mine(&names), [2]);
+        assert_eq!(run(None, Some((0, 2))).mine(&names), [0, 2]);
     }
 }

@@ -4,7 +4,8 @@
 //! batch job without `output` ([`super::batch`]: `scene` and `render`'s flags by their long names) plus `name`,
 //! `golden` (an EXR path, or `"reference"` to compare with the CPU reference rendered with the device's sub-pixel
 //! bits) and optional `tolerances` (the flags of `diff`, e.g. `{"fail-rel": 1e-4, "fail-count": 3}`, over the
-//! suite's). Paths are relative to the suite file. A missing golden fails; `--update` writes the goldens. A failed
+//! suite's). Paths are relative to the suite file. A missing golden fails; `--update` writes the missing and failing
+//! goldens, `--update-all` every one; `--filter` runs the cases whose name matches. A failed
 //! case leaves its actual image (`NAME.actual.exr`) and heatmap (`NAME.heatmap.png`) in the results folder
 //! (`--report DIR`, else `SUITE-results/` next to the suite). `--junit FILE` writes JUnit XML; `--report DIR`
 //! an HTML page with each case's golden, actual and heatmap side by side. Exit 0 when every case passes.
@@ -28,9 +29,13 @@ use crate::film::{auto_exposure_ev, read_image, write_atomically, write_image, E
 pub struct TestArgs {
     /// The suite file (JSON).
     pub suite: PathBuf,
-    /// Write every case's golden from its rendered image (cases against "reference" have none).
+    /// Write the goldens that are missing or fail, from the rendered images (a passing golden is kept; cases
+    /// against "reference" have none).
     #[arg(long)]
     pub update: bool,
+    /// Write every case's golden from its rendered image, the passing ones too.
+    #[arg(long)]
+    pub update_all: bool,
     /// Write the results as JUnit XML to FILE.
     #[arg(long, value_name = "FILE")]
     pub junit: Option<PathBuf>,
@@ -175,7 +180,9 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
     let mut session = Session::new(cache_dir(a.run.no_cache));
     let started = Instant::now();
     let mut outcomes = Vec::new();
-    for case in a.run.mine(cases.len()).into_iter().map(|i| &cases[i]) {
+    let names: Vec<String> =
+        cases.iter().map(|c| c.as_ref().map_or_else(|(name, _)| name.clone(), |c| c.name.clone())).collect();
+    for case in a.run.mine(&names).into_iter().map(|i| &cases[i]) {
         let t = Instant::now();
         let mut outcome = match case {
             Err((name, e)) => Outcome {
@@ -221,8 +228,13 @@ pub fn run(a: &TestArgs) -> Result<(), CliError> {
 }
 
 fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) -> Outcome {
-    // read_suite made the case's --output the results folder's NAME.actual.exr.
+    // read_suite made the case's --output the results folder's NAME.actual.exr. A previous run's actual image and
+    // heatmap of this case go first, so that what the folder holds is this run's.
     let actual = &case.args.output.output;
+    let heatmap = results.join(format!("{}.heatmap.png", case.name));
+    for stale in [actual, &heatmap] {
+        let _ = std::fs::remove_file(stale);
+    }
     let mut outcome =
         Outcome { name: case.name.clone(), status: Status::Passed, seconds: 0.0, report: None, previews: None };
     let job = match render_job(session, &case.args) {
@@ -239,7 +251,7 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             apart = class;
             image
         }
-        Expected::Golden(path) if a.update => {
+        Expected::Golden(path) if a.update_all || (a.update && !path.exists()) => {
             // The golden's folder is made where it does not exist yet (a suite's first --update).
             let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
             let made = folder.map_or(Ok(()), |f| {
@@ -267,14 +279,24 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         },
     };
     let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
-    let (report, per_pixel) = match compare::diff_apart(&job.image, &expected, &case.tolerances.options(), apart) {
+    let compared = compare::diff_apart(&job.image, &expected, &case.tolerances.options(), apart);
+    // --update: a golden that fails (or cannot be compared: another size) is rewritten from this image.
+    if let (Expected::Golden(path), true) = (&case.expected, a.update || a.update_all) {
+        if !compared.as_ref().is_ok_and(|(report, _)| report.pass) {
+            outcome.status = match write_image(&job.image, path, Exposure::Auto) {
+                Ok(_) => Status::Updated,
+                Err(e) => Status::Error(e.to_string()),
+            };
+            return outcome;
+        }
+    }
+    let (report, per_pixel) = match compared {
         Ok(r) => r,
         Err(e) => {
             outcome.status = Status::Failed(e);
             return outcome;
         }
     };
-    let heatmap = results.join(format!("{}.heatmap.png", case.name));
     if !report.pass {
         outcome.status = Status::Failed(format!(
             "{} px over tolerance, {} coverage mismatches, max rel {:.3e} (actual: {}, heatmap: {})",
