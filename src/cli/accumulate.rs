@@ -97,6 +97,9 @@ pub fn accumulate(
         ProgressStyle::with_template("sunshade: {msg} step {pos}/{len} [{elapsed}, {eta} left]").expect("template"),
     );
     bar.set_message(a.quantity.name());
+    // Warnings (the shadow technique's, a sun below the horizon) print above the bar, not into its line.
+    let printer = bar.clone();
+    let _warnings = crate::render::warnings::print_through(move |line| printer.suspend(|| eprintln!("{line}")));
     for &k in &mine {
         let step = all[k];
         hours_in_shard += step.hours;

@@ -179,6 +179,9 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
     );
     let mut failed = 0usize;
     // A job is done when it failed to render or its image is written (or failed to be): count and report it.
+    // Warnings print above the bar, not into its line.
+    let printer = bar.clone();
+    let _warnings = crate::render::warnings::print_through(move |line| printer.suspend(|| eprintln!("{line}")));
     let mut finish = |job: usize, result: Result<(), String>| {
         if let Err(e) = result {
             failed += 1;
