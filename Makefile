@@ -19,10 +19,11 @@ render: build
 # system). Where it cannot be installed those tests are skipped with a message, never silently.
 test: setup
 	@./scripts/machine.sh
-	$(CARGO) test --release --workspace
+	CARGO=$(CARGO) ./scripts/cargo-test-or-backtrace.sh --release --workspace
 	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
 		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
-		SUNSHADE_REQUIRE_RAY_QUERIES=1 $(CARGO) test --release --test shadows --test cli --test measured --test startup -- gpu_ ray_quer; \
+		SUNSHADE_REQUIRE_RAY_QUERIES=1 CARGO=$(CARGO) ./scripts/cargo-test-or-backtrace.sh --release --test shadows \
+			--test cli --test measured --test startup -- gpu_ ray_quer; \
 	else \
 		echo "make test: SKIPPED the ray-query tests: scripts/lavapipe-rt.sh could not install Mesa 25's lavapipe (above)"; \
 	fi

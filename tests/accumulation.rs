@@ -133,7 +133,9 @@ fn a_roof_over_a_day_is_the_sum_of_the_suns_normal_irradiance_times_the_cosine()
             .concat(),
         );
         assert!(o.status.success(), "{}", stderr(&o));
-        assert!(stderr(&o).contains("steps in this shard rendered"), "{}", stderr(&o));
+        // Without --shard no shard is spoken of.
+        let err = stderr(&o);
+        assert!(err.contains("of 24 steps rendered (the sun up)") && !err.contains("shard"), "{err}");
         let image = sunshade::film::read_image(&out).unwrap();
         let worst = worst_relative(&covered(&image, 500), truth);
         eprintln!("roof, delta sun, {command}: {truth:.3} Wh/m², max relative error {worst:.2e}");
