@@ -1,6 +1,9 @@
 //! The flags that define an image, shared by `render`, `reference`, `bench`, jobs of `batch` and `test`, and the
 //! `testing` API: the scene, image size, camera, lights, models and `--tolerance`.
 
+// The fields' doc comments are clap's help texts, where "[m]", "[s]" and "[degrees]" are units, not links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 pub mod daylight;
 pub mod quantity;
 
