@@ -541,8 +541,12 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert_eq!(o.status.code(), Some(1), "{out}");
     assert!(out.contains("FAIL golden") && out.contains("px over tolerance"), "{out}");
+    // The failure says what changed: the golden records its render's lights and settings (here its sun, 60° up).
+    assert!(out.contains("settings as recorded (golden → now): Lights.sun.direction_towards_sun: ["), "{out}");
+    assert!(!out.contains("Settings.width"), "only what differs is named: {out}");
     assert!(dir.path("report/golden.actual.exr").exists() && dir.path("report/golden.heatmap.png").exists());
-    assert!(std::fs::read_to_string(dir.path("j.xml")).unwrap().contains("failures=\"1\""));
+    let xml = std::fs::read_to_string(dir.path("j.xml")).unwrap();
+    assert!(xml.contains("failures=\"1\"") && xml.contains("Lights.sun.direction_towards_sun"), "{xml}");
     // Shards: 1/3 runs only "ref".
     let o = sunshade(&["test", s(&suite), "--shard", "1/3"]);
     let out = String::from_utf8_lossy(&o.stdout).into_owned();

@@ -23,7 +23,10 @@ use super::render::{cache_dir, checked_reference_of, render_job, RenderArgs};
 use super::session::Session;
 use super::{clap_error_line, CliError};
 use crate::compare::{self, DiffReport};
-use crate::film::{auto_exposure_ev, read_image, write_atomically, write_image, Exposure, Image};
+use crate::film::{
+    auto_exposure_ev, read_image, read_recorded, write_atomically, write_image, write_image_with, Exposure, Image,
+    Metadata,
+};
 
 #[derive(Args, Debug)]
 pub struct TestArgs {
@@ -244,6 +247,9 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             return outcome;
         }
     };
+    // What a golden records of its render (lights, settings, renderer), written with it and compared on failure.
+    let recorded = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+    let write_golden = |path: &Path| write_image_with(&job.image, path, Exposure::Auto, &recorded).map(|_| ());
     let mut apart = None;
     let expected = match &case.expected {
         Expected::Reference => {
@@ -257,11 +263,10 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             let made = folder.map_or(Ok(()), |f| {
                 std::fs::create_dir_all(f).map_err(|e| format!("{}: cannot create the folder: {e}", f.display()))
             });
-            outcome.status =
-                match made.and_then(|_| write_image(&job.image, path, Exposure::Auto).map_err(|e| e.to_string())) {
-                    Ok(_) => Status::Updated,
-                    Err(e) => Status::Error(e),
-                };
+            outcome.status = match made.and_then(|_| write_golden(path).map_err(|e| e.to_string())) {
+                Ok(_) => Status::Updated,
+                Err(e) => Status::Error(e),
+            };
             return outcome;
         }
         Expected::Golden(path) if !path.exists() => {
@@ -283,8 +288,8 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
     // --update: a golden that fails (or cannot be compared: another size) is rewritten from this image.
     if let (Expected::Golden(path), true) = (&case.expected, a.update || a.update_all) {
         if !compared.as_ref().is_ok_and(|(report, _)| report.pass) {
-            outcome.status = match write_image(&job.image, path, Exposure::Auto) {
-                Ok(_) => Status::Updated,
+            outcome.status = match write_golden(path) {
+                Ok(()) => Status::Updated,
                 Err(e) => Status::Error(e.to_string()),
             };
             return outcome;
@@ -298,8 +303,12 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         }
     };
     if !report.pass {
+        let changed = match &case.expected {
+            Expected::Golden(path) => format!("; {}", recorded_changes(path, &recorded)),
+            Expected::Reference => String::new(),
+        };
         outcome.status = Status::Failed(format!(
-            "{} px over tolerance, {} coverage mismatches, max rel {:.3e} (actual: {}, heatmap: {})",
+            "{} px over tolerance, {} coverage mismatches, max rel {:.3e} (actual: {}, heatmap: {}){changed}",
             report.over_tolerance.total,
             report.coverage_mismatches.total,
             report.max_rel,
@@ -316,6 +325,52 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
     }
     outcome.report = Some(report);
     outcome
+}
+
+/// What the golden at `golden` records of its render against this render's `now` (the lights, the settings with the
+/// camera, the renderer with its device and driver, sunshade's version): "settings as recorded: PATH: GOLDEN →
+/// NOW; ..." for those that differ (at most 8 named), or why there is nothing to compare.
+fn recorded_changes(golden: &Path, now: &Metadata) -> String {
+    const COMPARED: [&str; 3] = ["sunshadeLights", "sunshadeSettings", "sunshadeVersion"];
+    let Some(then) = read_recorded(golden) else {
+        return "the golden records no settings (--update rewrites it with them)".into();
+    };
+    let (mut was, mut is) = (Vec::new(), Vec::new());
+    for key in COMPARED {
+        flatten(key, then.get(key).unwrap_or(&Value::Null), &mut was);
+        let current = now.text.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str()).unwrap_or("null");
+        let current = serde_json::from_str(current).unwrap_or_else(|_| Value::String(current.to_string()));
+        flatten(key, &current, &mut is);
+    }
+    let mut keys: Vec<&String> = was.iter().chain(&is).map(|(k, _)| k).collect();
+    keys.sort();
+    keys.dedup();
+    let value = |list: &[(String, String)], k: &str| {
+        list.iter().find(|(key, _)| key == k).map_or("(none)".to_string(), |(_, v)| v.clone())
+    };
+    let differ: Vec<String> = keys
+        .into_iter()
+        .filter_map(|k| {
+            let (a, b) = (value(&was, k), value(&is, k));
+            (a != b).then(|| format!("{}: {a} → {b}", k.trim_start_matches("sunshade")))
+        })
+        .collect();
+    match differ.len() {
+        0 => "settings as recorded: the same as the golden's".into(),
+        n if n > 8 => format!("settings as recorded (golden → now): {}; and {} more", differ[..8].join("; "), n - 8),
+        _ => format!("settings as recorded (golden → now): {}", differ.join("; ")),
+    }
+}
+
+/// `value` as (dotted path, compact JSON) leaves; arrays of numbers stay one leaf, as written.
+fn flatten(path: &str, value: &Value, out: &mut Vec<(String, String)>) {
+    match value {
+        Value::Object(o) => o.iter().for_each(|(k, v)| flatten(&format!("{path}.{k}"), v, out)),
+        Value::Array(a) if a.iter().any(|v| v.is_object()) => {
+            a.iter().enumerate().for_each(|(i, v)| flatten(&format!("{path}[{i}]"), v, out))
+        }
+        v => out.push((path.to_string(), v.to_string())),
+    }
 }
 
 /// PNGs of the expected and actual images at one exposure (the expected image's auto exposure), and the heatmap.
@@ -382,7 +437,10 @@ fn html(suite: &str, outcomes: &[Outcome]) -> String {
         outcomes.len() - failed,
         s = escape(suite)
     );
-    for o in outcomes {
+    // Failures first: what needs a look is at the top.
+    let failures_first =
+        outcomes.iter().filter(|o| o.status.is_failure()).chain(outcomes.iter().filter(|o| !o.status.is_failure()));
+    for o in failures_first {
         let (class, text) = match &o.status {
             Status::Passed => ("pass", "PASS".to_string()),
             Status::Updated => ("pass", "UPDATED".to_string()),

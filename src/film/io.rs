@@ -246,6 +246,21 @@ pub fn read_quantity(path: &Path) -> Option<(String, String)> {
     Some((name.to_string(), unit.to_string()))
 }
 
+/// The metadata an EXR sunshade wrote records (its `sunshade` attribute: the quantity, `sunshadeLights`,
+/// `sunshadeSettings`, ...) as a JSON object; `None` for another format or a file without it. Reads only the header.
+pub fn read_recorded(path: &Path) -> Option<serde_json::Map<String, serde_json::Value>> {
+    if ImageFormat::from_path(path)? != ImageFormat::Exr {
+        return None;
+    }
+    let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+    let value = meta.headers.first()?.own_attributes.other.get(&exr::prelude::Text::from("sunshade"))?;
+    let exr::meta::attribute::AttributeValue::Text(t) = value else { return None };
+    match serde_json::from_str(&t.to_string()).ok()? {
+        serde_json::Value::Object(all) => Some(all),
+        _ => None,
+    }
+}
+
 fn write_pfm(image: &Image, w: &mut impl Write) -> io::Result<()> {
     write!(w, "PF\n{} {}\n-1.0\n", image.width(), image.height())?;
     let width = image.width() as usize;
