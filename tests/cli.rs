@@ -915,6 +915,10 @@ fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
     assert!(o.status.success(), "{}", stderr(&o));
     let check: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(check["predicted_error"]["max_relative_error"].as_f64(), Some(recorded));
+    // And what it drew: the lights and the settings, the camera among them, as the files record them.
+    assert_eq!(check["render"]["lights"], all["sunshadeLights"], "{check}");
+    assert!(check["render"]["settings"]["camera"]["eye"].is_array(), "{check}");
+    assert_eq!(check["render"]["settings"]["shadows"], "none", "{check}");
     // Looser tolerance, fewer samples; each bound within its tolerance.
     let mut samples = Vec::new();
     for t in ["1e-2", "1e-4"] {

@@ -184,7 +184,15 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     // The JSON also carries the render's predicted error against the truth (the comparison is against the
     // reference with the same models).
     let unit = job.settings.shading.quantity.unit();
-    let format = ReportFormat::new(a.json, unit, vec![("predicted_error".to_string(), job.prediction.json())]);
+    // And what was drawn: the lights and the settings (camera, models, technique, renderer) the files record.
+    let recorded = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+    let as_json = |key: &str| {
+        let text = recorded.text.iter().find(|(k, _)| k == key).map_or("null", |(_, v)| v.as_str());
+        serde_json::from_str(text).unwrap_or(serde_json::Value::Null)
+    };
+    let drew = serde_json::json!({ "lights": as_json("sunshadeLights"), "settings": as_json("sunshadeSettings") });
+    let extra = vec![("predicted_error".to_string(), job.prediction.json()), ("render".to_string(), drew)];
+    let format = ReportFormat::new(a.json, unit, extra);
     let report = compare_and_report(
         job.device_image.as_ref().unwrap_or(&job.image),
         &reference,
