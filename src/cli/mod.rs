@@ -105,6 +105,7 @@ enum Command {
     TabulateBrdf(tabulate_brdf::TabulateBrdfArgs),
 }
 
+pub(crate) use crate::render::request::clap_error_line;
 pub(crate) use crate::render::warnings::{quiet, set_quiet, warn};
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
@@ -203,22 +204,6 @@ pub fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
-}
-
-/// clap's usage error on one line: its text without the "Usage:" block and the "--help" hint.
-pub(crate) fn clap_error_line(e: &clap::Error) -> String {
-    let text = e.to_string();
-    let mut parts = Vec::new();
-    for line in text.lines() {
-        let line = line.trim();
-        if line.starts_with("Usage:") || line.starts_with("For more information") {
-            break;
-        }
-        if !line.is_empty() {
-            parts.push(line.strip_prefix("error: ").unwrap_or(line));
-        }
-    }
-    parts.join(" ")
 }
 
 /// The error and its causes on one line.

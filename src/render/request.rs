@@ -48,11 +48,7 @@ struct RequestParser {
 impl RequestArgs {
     /// Parses a request's argument list (scene first, no program name); the error is clap's first line.
     pub fn parse_list(argv: &[String]) -> Result<Self, String> {
-        <RequestParser as clap::Parser>::try_parse_from(argv).map(|p| p.args).map_err(|e| {
-            let text = e.to_string();
-            let line = text.lines().map(str::trim).find(|l| !l.is_empty()).unwrap_or("invalid flags");
-            line.strip_prefix("error: ").unwrap_or(line).to_string()
-        })
+        <RequestParser as clap::Parser>::try_parse_from(argv).map(|p| p.args).map_err(|e| clap_error_line(&e))
     }
 }
 
@@ -107,4 +103,20 @@ pub fn resolve_settings(scene: &Scene, a: &SceneArgs) -> Result<RenderSettings, 
         );
     }
     Ok(settings)
+}
+
+/// clap's usage error on one line: its text without the "Usage:" block and the "--help" hint.
+pub fn clap_error_line(e: &clap::Error) -> String {
+    let text = e.to_string();
+    let mut parts = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line.strip_prefix("error: ").unwrap_or(line));
+        }
+    }
+    parts.join(" ")
 }
