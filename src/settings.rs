@@ -159,6 +159,13 @@ pub fn sun_direction_from_angles(elevation_degrees: f64, azimuth_degrees: f64) -
     DVec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos())
 }
 
+/// The inverse of [`sun_direction_from_angles`]: the elevation and azimuth \[degrees\] of the direction `d` (need
+/// not be unit), the azimuth in [0, 360). The elevation is the atan2 of the vertical part against the horizontal
+/// one, accurate at the zenith and at the horizon alike (an asin of `d.y` loses digits near the zenith).
+pub fn sun_angles_from_direction(d: DVec3) -> (f64, f64) {
+    (d.y.atan2(d.x.hypot(d.z)).to_degrees(), d.x.atan2(d.z).to_degrees().rem_euclid(360.0))
+}
+
 /// Resolves the camera and lights of a render, with the sun the only light option.
 pub fn resolve(
     scene: &Scene,
@@ -308,6 +315,14 @@ fn resolve_sun(scene_sun: Option<Sun>, scene_unlit: bool, opts: &SunOptions) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sun_angles_invert_the_direction() {
+        for (e, a) in [(15.0, 90.0), (-10.0, 0.0), (89.999, 250.0), (0.0, 359.5), (45.0, 180.0)] {
+            let (e2, a2) = sun_angles_from_direction(sun_direction_from_angles(e, a) * 3.0);
+            assert!((e2 - e).abs() < 1e-10 && (a2 - a).abs() < 1e-9, "{e} {a}: {e2} {a2}");
+        }
+    }
 
     #[test]
     fn elevation_azimuth_convention() {

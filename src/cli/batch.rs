@@ -223,14 +223,14 @@ pub fn run(a: &BatchArgs) -> Result<(), CliError> {
                 Ok(job) => {
                     let args = jobs[i].as_ref().expect("rendered");
                     let mut metadata = super::metadata::of_render_predicted(
-                        &job.settings,
+                        &job.render.settings,
                         &session.renderer_description(job.renderer),
-                        &job.prediction,
+                        &job.render.prediction,
                     );
                     metadata.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
                     let item = Encode {
                         job: i,
-                        image: job.image,
+                        image: job.render.image,
                         metadata,
                         output: args.output.output.clone(),
                         exposure: args.output.exposure(),

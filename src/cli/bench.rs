@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 
 use super::args::parse_positive;
-use super::generated::{check_region, machine, print_output, today, update_region};
+use super::generated::{check_region, machine, publish, today};
 use super::CliError;
 use crate::authoring::chart;
 use crate::compare::{self, DiffOptions};
@@ -240,12 +240,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         out += "\n";
         out += &process_timing(a.process_scene.as_ref().unwrap_or(&scenes[0]), width, height, a.process_runs)?;
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "")
 }
 
 /// The renderer of a bench table on `--device`, checked for the image size, its device, and the reference options
@@ -302,12 +297,7 @@ fn brdf_chart(a: &BenchArgs) -> Result<(), CliError> {
     let result = brdf_chart_in(a, &dir, width, height);
     let _ = std::fs::remove_dir_all(&dir);
     let out = result?;
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "brdf-chart", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "brdf-chart")
 }
 
 fn brdf_chart_in(a: &BenchArgs, dir: &Path, width: u32, height: u32) -> Result<String, CliError> {

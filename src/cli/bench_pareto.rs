@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::bench::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
 use super::bench_tolerance::{table_size, tolerance_rows, tolerance_table};
-use super::generated::{machine, print_output, today, update_region};
+use super::generated::{machine, publish, today};
 use super::sweep::{sweep, Relevance};
 use super::CliError;
 use crate::accuracy::converged::{render_converged, ConvergenceOptions};
@@ -230,12 +230,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     if let Some(plot) = &a.plot {
         write_plot(plot, &charts)?;
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, super::bench::pareto_region(a.visibility_rule), &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, super::bench::pareto_region(a.visibility_rule))
 }
 
 /// The tolerances of "what exactness costs".

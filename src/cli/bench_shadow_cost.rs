@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
-use super::generated::{print_output, update_region};
+use super::generated::publish;
 use super::CliError;
 use crate::cpu;
 use crate::scene::{self, LoadOptions};
@@ -79,10 +79,5 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         );
         eprintln!("sunshade bench: {name} done");
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "shadow-cost", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "shadow-cost")
 }

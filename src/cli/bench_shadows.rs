@@ -10,7 +10,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::bench::{bench_renderer, build, device_description, median, ms, warm_frames, BenchArgs};
-use super::generated::{machine, print_output, today, update_region};
+use super::generated::{machine, publish, today};
 use super::CliError;
 use crate::compare::{self, DiffOptions};
 use crate::cpu;
@@ -198,10 +198,5 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         }
         out += "\n";
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "shadows", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "shadows")
 }

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::bench::{build, default_scenes, median, median_f64, ms, phase_line, render_process, BenchArgs};
-use super::generated::{machine, print_output, today, update_region};
+use super::generated::{machine, publish, today};
 use super::CliError;
 
 /// One scene's run: the scene, its size, and the flags beyond `--width`/`--height`.
@@ -140,10 +140,5 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let w = if a.whole_shaders { format!(" {:.1} |", median_f64(whole)) } else { String::new() };
         out += &format!("| {what} | {n} | {:.1} |{w}\n", median_f64(times));
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "startup", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "startup")
 }

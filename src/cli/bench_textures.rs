@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
-use super::generated::{print_output, update_region};
+use super::generated::publish;
 use super::CliError;
 use crate::compare::{self, DiffOptions};
 use crate::cpu;
@@ -104,10 +104,5 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         );
         eprintln!("sunshade bench: {name} done");
     }
-    print_output(&out, a.json);
-    for doc in &a.update {
-        update_region(doc, "textures", &out)?;
-        eprintln!("sunshade bench: updated {}", doc.display());
-    }
-    Ok(())
+    publish(&out, a.json, &a.update, "textures")
 }

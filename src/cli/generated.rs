@@ -103,6 +103,17 @@ pub fn tables_json(markdown: &str) -> serde_json::Value {
     serde_json::json!({ "tables": tables })
 }
 
+/// A bench's table: printed (Markdown, or its tables as JSON) and written into region `region` of each document
+/// `--update` names.
+pub fn publish(markdown: &str, json: bool, docs: &[std::path::PathBuf], region: &str) -> Result<(), CliError> {
+    print_output(markdown, json);
+    for doc in docs {
+        update_region(doc, region, markdown)?;
+        eprintln!("sunshade bench: updated {}", doc.display());
+    }
+    Ok(())
+}
+
 /// Prints a command's Markdown output, or its tables as JSON.
 pub fn print_output(markdown: &str, json: bool) {
     if json {

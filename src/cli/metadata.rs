@@ -158,9 +158,7 @@ pub fn daylight(a: &super::args::SceneArgs) -> Option<(String, String)> {
 pub fn sun_position_line(settings: &RenderSettings, scene: &Scene, a: &SceneArgs) -> Option<String> {
     let sun = settings.lights.sun.as_ref()?;
     let d = sun.direction.as_dvec3();
-    // atan2 of the vertical part against the horizontal one: accurate at the zenith and at the horizon alike.
-    let elevation = d.y.atan2(d.x.hypot(d.z)).to_degrees();
-    let azimuth = d.x.atan2(d.z).to_degrees().rem_euclid(360.0);
+    let (elevation, azimuth) = crate::settings::sun_angles_from_direction(d);
     let from = if let Some(at) = a.daylight.at_time() {
         format!(
             "--time {} at {:.4}°, {:.4}° (azimuth {:.3}° clockwise from north)",

@@ -105,7 +105,8 @@ enum Command {
     TabulateBrdf(tabulate_brdf::TabulateBrdfArgs),
 }
 
-pub(crate) use crate::render::request::clap_error_line;
+pub(crate) use crate::render::one_line;
+pub(crate) use crate::render::request::{clap_error_line, load as load_only, resolve_settings};
 pub(crate) use crate::render::warnings::{quiet, set_quiet, warn};
 
 /// A failure of a subcommand: a usage error (exit 2) or any other failure (exit 1).
@@ -206,26 +207,11 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// The error and its causes on one line.
-pub(crate) fn one_line(e: &anyhow::Error) -> String {
-    format!("{e:#}").replace('\n', "; ")
-}
-
 /// Loads the scene and resolves the render settings; prints the loader's warnings.
 fn load_scene(a: &args::SceneArgs) -> Result<(Scene, RenderSettings, Duration), CliError> {
     let (scene, load_time) = load_only(a)?;
     let settings = resolve_settings(&scene, a)?;
     Ok((scene, settings, load_time))
-}
-
-/// Loads the scene (with `--brdf` applied) and prints the loader's warnings.
-pub(crate) fn load_only(a: &args::SceneArgs) -> Result<(Scene, Duration), CliError> {
-    Ok(crate::render::request::load(a)?)
-}
-
-/// The settings of a render of `scene` with these flags (usage errors for flags the scene cannot take).
-pub(crate) fn resolve_settings(scene: &Scene, a: &args::SceneArgs) -> Result<RenderSettings, CliError> {
-    Ok(crate::render::request::resolve_settings(scene, a)?)
 }
 
 /// Refuses an output path whose extension names no supported format, or whose folder does not exist, before any

@@ -8,12 +8,10 @@ use super::args::OutputArgs;
 use super::diff::{compare_and_report, ReportFormat, ToleranceArgs};
 use super::session::Session;
 use super::{check_heatmap_path, print_exposure, print_phases, resolve_settings, warn_if_nothing_covered, CliError};
-use crate::accuracy::predicted::Prediction;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::{write_image_with, Image};
-use crate::gpu::{pipeline_cache, FrameTimings};
+use crate::gpu::pipeline_cache;
 use crate::render::RequestArgs;
-use crate::settings::RenderSettings;
 use crate::shading::Shadows;
 
 #[derive(Args, Debug)]
@@ -84,24 +82,15 @@ impl RenderArgs {
 
 /// A rendered job, not yet written: the render layer's image and where in the session it was made.
 pub struct Rendered {
-    pub image: Image,
-    /// The settings it was rendered with, `shadows` the technique actually used (never `auto`).
-    pub settings: RenderSettings,
-    /// Why that shadow technique.
-    pub shadow_reason: String,
-    /// The predicted error of the models used.
-    pub prediction: Prediction,
-    pub frame: FrameTimings,
+    /// The image, its final settings, prediction and timings, and what `--tolerance` measured against the
+    /// reference (`render::Rendered`: `--check` compares with its `reference` rather than render it again,
+    /// [`checked_reference_of`]).
+    pub render: crate::render::Rendered,
     pub load: Duration,
     pub upload: Duration,
     /// The session's scene and renderer it used.
     pub scene: usize,
     pub renderer: usize,
-    /// The reference's image `--tolerance` rendered to measure the GPU's against (`render::Rendered::reference`):
-    /// `--check` compares with it rather than render it again ([`checked_reference_of`]).
-    pub reference: Option<Image>,
-    /// The GPU's own image where `--tolerance` took some of `image`'s pixels from `reference`.
-    pub device_image: Option<Image>,
 }
 
 /// Renders one job on the session's renderer for its device: the scene loaded (unless the session has it), the
@@ -122,21 +111,9 @@ pub fn render_job(session: &mut Session, a: &RenderArgs) -> Result<Rendered, Cli
     let upload = session.upload(scene, renderer)?;
     let (scene_data, gpu_scene, r) = session.parts(scene, renderer);
     let reference = device_reference_options(r.device_info(), a);
-    let done = crate::render::on_gpu(r, (scene_data, gpu_scene), &q.scene, q.visibility_rule, settings, &reference)?;
-    warn_if_nothing_covered(&done.image, &q.scene.scene);
-    Ok(Rendered {
-        image: done.image,
-        settings: done.settings,
-        shadow_reason: done.shadow_reason,
-        prediction: done.prediction,
-        frame: done.frame,
-        load,
-        upload,
-        scene,
-        renderer,
-        reference: done.reference,
-        device_image: done.device_image,
-    })
+    let render = crate::render::on_gpu(r, (scene_data, gpu_scene), &q.scene, q.visibility_rule, settings, &reference)?;
+    warn_if_nothing_covered(&render.image, &q.scene.scene);
+    Ok(Rendered { render, load, upload, scene, renderer })
 }
 
 /// The reference options that mirror the device that rendered `job`.
@@ -164,10 +141,11 @@ pub fn checked_reference_of(
 ) -> (Image, Option<cpu::checked::ApartClass>) {
     let options = reference_options(session, a, job);
     let scene = session.scene_ref(job.scene);
-    let plain = !cpu::checked::may_be_fragile(scene, &job.settings) && job.settings.shading.shadows != Shadows::Map;
-    match &job.reference {
+    let plain = !cpu::checked::may_be_fragile(scene, &job.render.settings)
+        && job.render.settings.shading.shadows != Shadows::Map;
+    match &job.render.reference {
         Some(image) if plain => (image.clone(), None),
-        _ => cpu::checked::checked_reference(scene, &job.settings, &options),
+        _ => cpu::checked::checked_reference(scene, &job.render.settings, &options),
     }
 }
 
@@ -183,18 +161,18 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
     }
     // The JSON also carries the render's predicted error against the truth (the comparison is against the
     // reference with the same models).
-    let unit = job.settings.shading.quantity.unit();
+    let unit = job.render.settings.shading.quantity.unit();
     // And what was drawn: the lights and the settings (camera, models, technique, renderer) the files record.
-    let recorded = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
+    let recorded = super::metadata::of_render(&job.render.settings, &session.renderer_description(job.renderer));
     let as_json = |key: &str| {
         let text = recorded.text.iter().find(|(k, _)| k == key).map_or("null", |(_, v)| v.as_str());
         serde_json::from_str(text).unwrap_or(serde_json::Value::Null)
     };
     let drew = serde_json::json!({ "lights": as_json("sunshadeLights"), "settings": as_json("sunshadeSettings") });
-    let extra = vec![("predicted_error".to_string(), job.prediction.json()), ("render".to_string(), drew)];
+    let extra = vec![("predicted_error".to_string(), job.render.prediction.json()), ("render".to_string(), drew)];
     let format = ReportFormat::new(a.json, unit, extra);
     let report = compare_and_report(
-        job.device_image.as_ref().unwrap_or(&job.image),
+        job.render.device_image.as_ref().unwrap_or(&job.render.image),
         &reference,
         ("gpu", "cpu reference"),
         &a.tolerances.options(),
@@ -232,22 +210,23 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
     let cache_save = t_cache.elapsed();
     let t_encode = Instant::now();
     let mut meta = super::metadata::of_render_predicted(
-        &job.settings,
+        &job.render.settings,
         &session.renderer_description(job.renderer),
-        &job.prediction,
+        &job.render.prediction,
     );
     meta.text.extend(super::metadata::measured_materials(session.scene_ref(job.scene)));
     meta.text.extend(super::metadata::daylight(&a.request.scene));
-    let ev = write_image_with(&job.image, &a.output.output, a.output.exposure(), &meta)?;
-    a.output.write_false_color(&job.image, a.request.scene.quantity)?;
+    let ev = write_image_with(&job.render.image, &a.output.output, a.output.exposure(), &meta)?;
+    a.output.write_false_color(&job.render.image, a.request.scene.quantity)?;
     let encode_time = t_encode.elapsed();
     if a.verbose {
         let triangles = session.scene_ref(job.scene).triangle_count();
-        let sun_line = super::metadata::sun_model_line(&job.settings, session.scene_ref(job.scene));
+        let sun_line = super::metadata::sun_model_line(&job.render.settings, session.scene_ref(job.scene));
         let scene_flags = &a.request.scene;
-        let sun_position = super::metadata::sun_position_line(&job.settings, session.scene_ref(job.scene), scene_flags);
-        let camera_line = super::metadata::camera_line(&job.settings, session.scene_ref(job.scene), scene_flags);
-        let lobe_line = super::metadata::lobe_model_line(&job.settings, session.scene_ref(job.scene));
+        let sun_position =
+            super::metadata::sun_position_line(&job.render.settings, session.scene_ref(job.scene), scene_flags);
+        let camera_line = super::metadata::camera_line(&job.render.settings, session.scene_ref(job.scene), scene_flags);
+        let lobe_line = super::metadata::lobe_model_line(&job.render.settings, session.scene_ref(job.scene));
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
         let created = renderer.take_created_pipelines();
@@ -263,26 +242,26 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         );
         eprintln!(
             "sunshade: {triangles} triangles, {}x{} pixels, {} covered",
-            job.settings.width,
-            job.settings.height,
-            job.image.covered_count()
+            job.render.settings.width,
+            job.render.settings.height,
+            job.render.image.covered_count()
         );
         eprintln!("sunshade: {camera_line}");
         if let Some(line) = sun_position {
             eprintln!("sunshade: {line}");
         }
-        eprintln!("sunshade: shadows: {} ({})", job.settings.shading.shadows.name(), job.shadow_reason);
+        eprintln!("sunshade: shadows: {} ({})", job.render.settings.shading.shadows.name(), job.render.shadow_reason);
         eprintln!("sunshade: {sun_line}");
         if let Some(line) = lobe_line {
             eprintln!("sunshade: {line}");
         }
-        if let Some(lights) = crate::gpu::slice_passes::passed_lights(job.frame.lights_in_passes) {
+        if let Some(lights) = crate::gpu::slice_passes::passed_lights(job.render.frame.lights_in_passes) {
             eprintln!("sunshade: slices in passes before the frame: {lights} (gpu::slice_passes)");
         }
-        if let Some(probe) = job.frame.probe {
+        if let Some(probe) = job.render.frame.probe {
             eprintln!("sunshade: {}", probe.describe());
         }
-        eprintln!("sunshade: {}", job.prediction.line());
+        eprintln!("sunshade: {}", job.render.prediction.line());
         print_exposure(ev);
         for p in created {
             eprintln!(
@@ -304,11 +283,11 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
                 ("instance", setup.instance),
                 ("shader compile", setup.shader_compile), // on other threads, during "instance"
                 ("upload", job.upload),
-                ("shadow setup", job.frame.shadow_setup),
-                ("pipelines", job.frame.pipelines),
+                ("shadow setup", job.render.frame.shadow_setup),
+                ("pipelines", job.render.frame.pipelines),
                 ("cache save", cache_save),
-                ("render", job.frame.render),
-                ("readback", job.frame.readback),
+                ("render", job.render.frame.render),
+                ("readback", job.render.frame.readback),
                 ("encode", encode_time),
             ],
             started.elapsed(),

@@ -248,8 +248,8 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         }
     };
     // What a golden records of its render (lights, settings, renderer), written with it and compared on failure.
-    let recorded = super::metadata::of_render(&job.settings, &session.renderer_description(job.renderer));
-    let write_golden = |path: &Path| write_image_with(&job.image, path, Exposure::Auto, &recorded).map(|_| ());
+    let recorded = super::metadata::of_render(&job.render.settings, &session.renderer_description(job.renderer));
+    let write_golden = |path: &Path| write_image_with(&job.render.image, path, Exposure::Auto, &recorded).map(|_| ());
     let mut apart = None;
     let expected = match &case.expected {
         Expected::Reference => {
@@ -272,7 +272,7 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         Expected::Golden(path) if !path.exists() => {
             outcome.status = Status::Failed(format!("golden {} is missing (--update writes it)", path.display()));
             // A result file that cannot be written does not change the outcome, which is already a failure.
-            let _ = write_image(&job.image, actual, Exposure::Auto);
+            let _ = write_image(&job.render.image, actual, Exposure::Auto);
             return outcome;
         }
         Expected::Golden(path) => match read_image(path) {
@@ -284,7 +284,7 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
         },
     };
     let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
-    let compared = compare::diff_apart(&job.image, &expected, &case.tolerances.options(), apart);
+    let compared = compare::diff_apart(&job.render.image, &expected, &case.tolerances.options(), apart);
     // --update: a golden that fails (or cannot be compared: another size) is rewritten from this image.
     if let (Expected::Golden(path), true) = (&case.expected, a.update || a.update_all) {
         if !compared.as_ref().is_ok_and(|(report, _)| report.pass) {
@@ -315,13 +315,13 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             actual.display(),
             heatmap.display()
         ));
-        let _ = write_image(&job.image, actual, Exposure::Auto);
+        let _ = write_image(&job.render.image, actual, Exposure::Auto);
     }
     if a.report.is_some() || !report.pass {
-        let _ = compare::write_heatmap(&heatmap, job.image.width(), job.image.height(), &per_pixel);
+        let _ = compare::write_heatmap(&heatmap, job.render.image.width(), job.render.image.height(), &per_pixel);
     }
     if a.report.is_some() {
-        outcome.previews = previews(&case.name, &expected, &job.image, results);
+        outcome.previews = previews(&case.name, &expected, &job.render.image, results);
     }
     outcome.report = Some(report);
     outcome

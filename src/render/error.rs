@@ -15,9 +15,14 @@ impl RenderError {
     pub fn message(&self) -> String {
         match self {
             RenderError::Usage(m) => m.clone(),
-            RenderError::Failure(e) => format!("{e:#}").replace('\n', "; "),
+            RenderError::Failure(e) => one_line(e),
         }
     }
+}
+
+/// An error and its causes on one line.
+pub fn one_line(e: &anyhow::Error) -> String {
+    format!("{e:#}").replace('\n', "; ")
 }
 
 impl std::fmt::Display for RenderError {

@@ -16,7 +16,7 @@ pub mod request;
 mod tolerance;
 pub mod warnings;
 
-pub use error::RenderError;
+pub use error::{one_line, RenderError};
 pub use gpu::{on_gpu, predicted_barycentrics, Rendered};
 pub use reference::on_reference;
 pub use request::RequestArgs;

@@ -86,9 +86,8 @@ pub fn resolve_settings(scene: &Scene, a: &SceneArgs) -> Result<RenderSettings, 
         settings::resolve_with(scene, a.width, a.height, &a.camera_options(), &a.light_options_at(daylight.as_ref()))
             .map_err(|e| RenderError::Usage(e.to_string()))?;
     if let (Some(sun), None) = (&settings.lights.sun, &daylight) {
-        let d = sun.direction.as_dvec3();
-        if d.y < 0.0 {
-            let elevation = d.y.atan2(d.x.hypot(d.z)).to_degrees();
+        let (elevation, _) = settings::sun_angles_from_direction(sun.direction.as_dvec3());
+        if elevation < 0.0 {
             warn_once(&format!(
                 "the sun is below the horizon (elevation {elevation:.2}°): it lights the scene from below"
             ));
