@@ -272,13 +272,20 @@ layout(std430, set = 0, binding = 11) readonly buffer MeasuredBuffer {
     vec4 measured_values[];
 };
 
-// Every texture's texels, linear RGBA f32, level after level (scene::texture; read by texture_filter.glsl with
-// texelFetch: a plain load of the stored floats, no filtering or conversion by the device). A uniform texel
-// buffer rather than a storage buffer, which lavapipe limits to 128 MiB.
+// The textures' texels (gpu::texture_buffers; read by texture_filter.glsl with texelFetch: a plain load of what
+// is stored, no filtering or conversion by the device). texels: the code tables (a code's linear value in x:
+// CODE_TABLE_LINEAR + code, CODE_TABLE_SRGB + code), then the linear RGBA f32 levels; texel_codes: the 8-bit
+// levels' RGBA codes. Uniform texel buffers rather than storage buffers, which lavapipe limits to 128 MiB.
 layout(set = 0, binding = 7) uniform samplerBuffer texels;
+layout(set = 0, binding = 16) uniform usamplerBuffer texel_codes;
+#define TEXELS_LINEAR 0u
+#define TEXELS_CODES_LINEAR 1u
+#define TEXELS_CODES_SRGB 2u
+#define CODE_TABLE_LINEAR 0u
+#define CODE_TABLE_SRGB 256u
 
 // Texture t's header at texture_table[t]: (first level entry, level count, sampler bits, 0); a level entry:
-// (first texel in texels[], width, height, 0).
+// (first texel in its buffer, width, height, TEXELS_*).
 layout(std430, set = 0, binding = 8) readonly buffer TextureTable {
     uvec4 texture_table[];
 };

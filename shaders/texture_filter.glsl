@@ -37,9 +37,22 @@ REAL texel_coordinate(REAL x) {
     return abs(x) < REAL(MAX_TEXEL_COORDINATE) ? x : REAL(0.0);
 }
 
-// The texel (i, j) of a level entry (texels offset, width, height).
+// The linear value of an 8-bit code from the code table at `table` (Rust: code_value).
+float code_value(uint table, uint code) {
+    return texelFetch(texels, int(table + code)).x;
+}
+
+// The texel (i, j) of a level entry (first texel, width, height, TEXELS_*): linear RGBA, an 8-bit level's codes
+// read through the tables (colour channels in the level's colour space, alpha linear).
 vec4 texel(uvec4 level, uint i, uint j) {
-    return texelFetch(texels, int(level.x + j * level.y + i));
+    int index = int(level.x + j * level.y + i);
+    if (level.w == TEXELS_LINEAR) {
+        return texelFetch(texels, index);
+    }
+    uvec4 c = texelFetch(texel_codes, index);
+    uint colour = level.w == TEXELS_CODES_SRGB ? CODE_TABLE_SRGB : CODE_TABLE_LINEAR;
+    return vec4(code_value(colour, c.r), code_value(colour, c.g), code_value(colour, c.b),
+                code_value(CODE_TABLE_LINEAR, c.a));
 }
 
 // One level filtered at uv: nearest, or bilinear between the four texel centres around (u w - 1/2, v h - 1/2).

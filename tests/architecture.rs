@@ -105,7 +105,11 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
         &["src/shading/surface.rs", "src/scene/material.rs"],
         "the metallic-roughness mapping is a material's (scene/material.rs), which the surface applies per pixel",
     ),
-    ("texture_filter.glsl", &["src/shading/texture_filter.rs"], ""),
+    (
+        "texture_filter.glsl",
+        &["src/shading/texture_filter.rs", "src/scene/texture.rs"],
+        "an 8-bit texel's linear value (code_value) belongs to how a texture stores its texels",
+    ),
     ("measured.glsl", &["src/shading/measured.rs"], ""),
     ("transform.glsl", &["src/cpu/transform.rs"], ""),
     ("barycentric.glsl", &["src/cpu/barycentric.rs"], ""),

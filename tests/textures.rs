@@ -145,6 +145,57 @@ fn nearest_and_linear_magnification_follow_the_texel_centres() {
     });
 }
 
+/// A 16-bit RGBA PNG (big-endian samples, as PNG stores them).
+fn png_rgba16(width: u32, height: u32, rgba: &[[u16; 4]]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width, height);
+    enc.set_color(png::ColorType::Rgba);
+    enc.set_depth(png::BitDepth::Sixteen);
+    let data: Vec<u8> = rgba.iter().flatten().flat_map(|v| v.to_be_bytes()).collect();
+    enc.write_header().and_then(|mut w| w.write_image_data(&data)).expect("PNG in memory");
+    out
+}
+
+#[test]
+fn eight_and_sixteen_bit_textures_in_one_frame() {
+    // Two squares side by side, the left one's base colour an 8-bit sRGB image (kept as codes), the right one's a
+    // 16-bit one (decoded to f32): NEAREST, so each pixel is one texel's value by the sRGB curve computed here.
+    let (w, h, n) = (4u32, 4u32, 16u32);
+    let t8 = ramp(w, h);
+    let t16: Vec<[u16; 4]> =
+        t8.iter().map(|c| [c[0] as u16 * 257 + 100, c[1] as u16 * 251, c[2] as u16 * 3, 65535]).collect();
+    let dir = TempDir::new("bit-depths");
+    let mut b = GltfBuilder::new();
+    let mut material = |png: Vec<u8>| {
+        let image = b.add_png_image(&png);
+        let t = b.add_texture(image, Some(9728), Some(9728), [33071, 33071]);
+        b.add_material_json(json!({
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": t }, "metallicFactor": 0.0 }
+        }))
+    };
+    let (m8, m16) = (material(png_rgba8(w, h, &t8)), material(png_rgba16(w, h, &t16)));
+    // Each square squeezed into one half of the view: x in (−1, 0) and (0, 1).
+    let half = |material: usize, x0: f32| {
+        let mut p = square(0.0, material, None);
+        for v in p.positions.iter_mut() {
+            v[0] = x0 + (v[0] + 1.0) / 2.0;
+        }
+        p
+    };
+    let scene = load(&dir.write("t.glb", &one_mesh(b, &[half(m8, -1.0), half(m16, 0.0)])));
+    let srgb = |c: f64| if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
+    assert_matches(&both(&scene, &settings(2 * n, DVec3::Z)), 1e-5, |x, y| {
+        let (half_x, u) = (x / n, ((x % n) as f64 + 0.5) / n as f64);
+        let v = (y as f64 + 0.5) / (2 * n) as f64;
+        let (i, j) = ((u * w as f64) as usize, (v * h as f64) as usize);
+        let k = j * w as usize + i;
+        [0, 1, 2].map(|c| {
+            let linear = if half_x == 0 { srgb(t8[k][c] as f64 / 255.0) } else { srgb(t16[k][c] as f64 / 65535.0) };
+            linear / PI * E_PERP as f64
+        })
+    });
+}
+
 #[test]
 fn texture_transform_and_wrap_modes() {
     // KHR_texture_transform (offset, rotation, scale) with REPEAT and MIRRORED_REPEAT, NEAREST: the texel at

@@ -328,7 +328,7 @@ pub fn sharpest_brdf(material: &Material, scene: &Scene) -> Brdf {
             .textures
             .get(t.texture)
             .and_then(|t| t.levels.first())
-            .map_or(0.0, |l| l.texels.iter().map(|p| p[1]).fold(1.0f32, f32::min));
+            .map_or(0.0, |l| (0..l.len()).map(|i| l.texel(i)[1]).fold(1.0f32, f32::min));
         roughness *= min_texel.clamp(0.0, 1.0);
     }
     let alpha = (roughness * roughness).max(MIN_MAPPED_ALPHA);

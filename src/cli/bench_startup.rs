@@ -1,7 +1,8 @@
 //! `sunshade bench --startup`: what a whole `sunshade render` process costs, and where the time goes. Each scene is
 //! rendered by `--repeat` separate processes (as users run it, once per image); the table gives the medians of the
 //! process's wall time and of its phases (from `-v`), the process against the phases that make the image (render,
-//! readback, encode), and the pipelines the driver created: each variant's SPIR-V size and creation time. With
+//! readback, encode), the load and upload phases with the process's peak memory (large textured samples included),
+//! and the pipelines the driver created: each variant's SPIR-V size and creation time. With
 //! `--whole-shaders` the same processes run again handing the driver the whole shaders (`SUNSHADE_WHOLE_SHADERS=1`),
 //! to show what specializing them saves. Its --update region is "startup".
 
@@ -27,7 +28,12 @@ struct Run {
     /// (what, SPIR-V instructions, creation time [ms]).
     pipelines: Vec<(String, usize, f64)>,
     device: String,
+    /// Peak resident memory [MB] (`-v`'s "peak memory"; 0 where not printed).
+    peak_mb: f64,
 }
+
+/// Samples in models/gltf-samples with large textures (three and two 2048² images).
+const LARGE_TEXTURED_SAMPLES: [&str; 2] = ["AlphaBlendModeTest", "NormalTangentMirrorTest"];
 
 fn cases(a: &BenchArgs) -> Result<Vec<Case>, CliError> {
     let size = (a.width.unwrap_or(512), a.height.unwrap_or(512));
@@ -37,6 +43,13 @@ fn cases(a: &BenchArgs) -> Result<Vec<Case>, CliError> {
     let mut v: Vec<Case> = default_scenes()?.into_iter().map(|scene| Case { scene, size }).collect();
     // Two triangles, nothing to shadow: the process with the least to do.
     v.push(Case { scene: Path::new("models").join("square.gltf"), size: (64, 64) });
+    // Real assets: several 2048² textures each, whose loading and upload are most of the process.
+    for sample in LARGE_TEXTURED_SAMPLES {
+        let scene = Path::new("models").join("gltf-samples").join(sample).join(format!("{sample}.glb"));
+        if scene.exists() {
+            v.push(Case { scene, size: (800, 600) });
+        }
+    }
     Ok(v)
 }
 
@@ -53,6 +66,8 @@ fn run_once(case: &Case, whole: bool) -> Result<Run, CliError> {
             run.pipelines.extend(parsed);
         } else if let Some(rest) = line.strip_prefix("sunshade: device ") {
             run.device = rest.split_once(": ").map_or(rest, |(_, d)| d).to_string();
+        } else if let Some(mb) = line.trim().strip_prefix("peak memory").and_then(|t| t.strip_suffix(" MB")) {
+            run.peak_mb = mb.trim().parse().unwrap_or(0.0);
         } else {
             run.phases.extend(phase_line(line));
         }
@@ -106,10 +121,13 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             .max_by(|x, y| x.0.total_cmp(&y.0));
         let whole = if a.whole_shaders { format!(" {:.0} |", phase(&whole_runs, "pipelines")) } else { String::new() };
         rows += &format!(
-            "| {} | {}×{} | {process:.0} | {:.1} | {:.1} |{whole} {image:.1} | {:.2} | {} |\n",
+            "| {} | {}×{} | {process:.0} | {:.1} | {:.1} | {:.0} | {:.1} | {:.1} |{whole} {image:.1} | {:.2} | {} |\n",
             case.scene.display(),
             case.size.0,
             case.size.1,
+            phase(&runs, "load"),
+            phase(&runs, "upload"),
+            median_f64(runs.iter().map(|r| r.peak_mb).collect()),
             phase(&runs, "instance"),
             phase(&runs, "pipelines"),
             if image > 0.0 { process / image } else { f64::NAN },
@@ -127,8 +145,9 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let whole_title = if a.whole_shaders { " pipelines, whole shaders [ms] |" } else { "" };
     let whole_rule = if a.whole_shaders { "---:|" } else { "" };
     out += &format!(
-        "| scene | pixels | process [ms] | instance [ms] | pipelines [ms] |{whole_title} render + readback + encode [ms] \
-         | process ÷ image phases | slowest pipeline [ms] |\n|---|---|---:|---:|---:|{whole_rule}---:|---:|---|\n"
+        "| scene | pixels | process [ms] | load [ms] | upload [ms] | peak memory [MB] | instance [ms] | pipelines [ms] \
+         |{whole_title} render + readback + encode [ms] | process ÷ image phases | slowest pipeline [ms] \
+         |\n|---|---|---:|---:|---:|---:|---:|---:|{whole_rule}---:|---:|---|\n"
     );
     out += &rows;
     out += &format!(

@@ -89,7 +89,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let (g_plain, c_plain, _, _) = time(&plain)?;
         let (report, _) =
             compare::diff(&gi, &ci, &DiffOptions::default()).map_err(|e| CliError::Failure(anyhow::anyhow!(e)))?;
-        let texels: usize = scene.textures.iter().flat_map(|t| &t.levels).map(|l| l.texels.len()).sum();
+        let texels: usize = scene.textures.iter().flat_map(|t| &t.levels).map(|l| l.len()).sum();
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         out += &format!(
             "| {name} | {} | {texels} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2e} | {} |\n",

@@ -263,10 +263,20 @@ fn print_exposure(ev: Option<f64>) {
     }
 }
 
-/// Prints phase timings as a small table on stderr.
-/// Prints each phase's time and `total`, the wall-clock time of the whole command (phases may overlap).
+/// Prints each phase's time and `total`, the wall-clock time of the whole command (phases may overlap), as a
+/// small table on stderr; then the process's peak resident memory where the system says it.
 fn print_phases(phases: &[(&str, Duration)], total: Duration) {
     for (name, d) in phases.iter().chain(std::iter::once(&("total", total))) {
         eprintln!("  {name:<15} {:>9.2} ms", d.as_secs_f64() * 1e3);
     }
+    if let Some(kib) = peak_resident_kib() {
+        eprintln!("  {:<15} {:>9.1} MB", "peak memory", kib as f64 * 1024.0 / 1e6);
+    }
+}
+
+/// The process's peak resident set [KiB] (Linux: `VmHWM` in /proc/self/status; `None` elsewhere).
+fn peak_resident_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?;
+    line.trim().strip_suffix("kB")?.trim().parse().ok()
 }

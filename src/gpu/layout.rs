@@ -2,7 +2,6 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::scene::texture::{Filter, MipFilter, Wrap};
 use crate::scene::{AlphaMode, Brdf, Lights, Material, Scene, TextureRef};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, Quantity, ShadingOptions, ShadowMapFilter, SunModel};
@@ -374,44 +373,6 @@ pub fn occluder_records(scene: &Scene, vertex_offsets: &[i32], needed: bool) -> 
     records
 }
 
-/// The texel buffer (every texture's levels, linear RGBA f32) and the texture table (`TextureTable` in the
-/// shaders: a header per texture, then a record per level). Both at least one element long, so that a scene
-/// without textures binds valid buffers.
-pub fn texture_buffers(scene: &Scene) -> (Vec<[f32; 4]>, Vec<[u32; 4]>) {
-    let mut texels: Vec<[f32; 4]> = Vec::new();
-    let mut table: Vec<[u32; 4]> = vec![[0; 4]; scene.textures.len()];
-    for (t, texture) in scene.textures.iter().enumerate() {
-        let s = texture.sampler;
-        let wrap = |w: Wrap| match w {
-            Wrap::Repeat => WRAP_REPEAT,
-            Wrap::MirroredRepeat => WRAP_MIRRORED_REPEAT,
-            Wrap::ClampToEdge => WRAP_CLAMP_TO_EDGE,
-        };
-        let filter = |f: Filter| match f {
-            Filter::Nearest => FILTER_NEAREST,
-            Filter::Linear => FILTER_LINEAR,
-        };
-        let mip = match s.mip {
-            MipFilter::None => MIP_NONE,
-            MipFilter::Nearest => MIP_NEAREST,
-            MipFilter::Linear => MIP_LINEAR,
-        };
-        let bits = wrap(s.wrap_s) | wrap(s.wrap_t) << 2 | filter(s.mag) << 4 | filter(s.min) << 5 | mip << 6;
-        table[t] = [table.len() as u32, texture.levels.len() as u32, bits, 0];
-        for level in &texture.levels {
-            table.push([texels.len() as u32, level.width, level.height, 0]);
-            texels.extend_from_slice(&level.texels);
-        }
-    }
-    if texels.is_empty() {
-        texels.push([0.0; 4]);
-    }
-    if table.is_empty() {
-        table.push([0; 4]);
-    }
-    (texels, table)
-}
-
 /// The light buffer's bytes.
 pub fn lights_bytes(
     lights: &Lights,
@@ -542,6 +503,11 @@ mod tests {
             ("MIP_NONE", MIP_NONE),
             ("MIP_NEAREST", MIP_NEAREST),
             ("MIP_LINEAR", MIP_LINEAR),
+            ("TEXELS_LINEAR", super::super::texture_buffers::TEXELS_LINEAR),
+            ("TEXELS_CODES_LINEAR", super::super::texture_buffers::TEXELS_CODES_LINEAR),
+            ("TEXELS_CODES_SRGB", super::super::texture_buffers::TEXELS_CODES_SRGB),
+            ("CODE_TABLE_LINEAR", super::super::texture_buffers::CODE_TABLE_LINEAR),
+            ("CODE_TABLE_SRGB", super::super::texture_buffers::CODE_TABLE_SRGB),
             ("SURFACE_EVAL", crate::shading::surface::SURFACE_EVAL),
             ("SURFACE_NORMAL_MAP", crate::shading::surface::SURFACE_NORMAL_MAP),
             ("SURFACE_EMISSION", crate::shading::surface::SURFACE_EMISSION),

@@ -77,8 +77,8 @@ impl Buffer {
     }
 }
 
-/// A host-visible buffer of RGBA32F texels read through a buffer view (a uniform texel buffer: `texelFetch`
-/// returns a texel's four floats as stored, with no filtering or conversion), for data larger than
+/// A host-visible buffer of texels read through a buffer view (a uniform texel buffer: `texelFetch` returns a
+/// texel as stored, with no filtering; RGBA32F as its floats, RGBA8UI as its integer codes), for data larger than
 /// `maxStorageBufferRange` allows in a storage buffer.
 pub(crate) struct TexelBuffer {
     pub view: vk::BufferView,
@@ -86,14 +86,19 @@ pub(crate) struct TexelBuffer {
 }
 
 impl TexelBuffer {
-    pub fn with_texels(dev: &Arc<Device>, texels: &[[f32; 4]], name: &str) -> Result<Self, GpuError> {
-        let buffer =
-            Buffer::with_data(dev, bytemuck::cast_slice(texels), vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, name)?;
-        let info = vk::BufferViewCreateInfo::default()
-            .buffer(buffer.buffer)
-            .format(vk::Format::R32G32B32A32_SFLOAT)
-            .offset(0)
-            .range(vk::WHOLE_SIZE);
+    /// `count` texels of `T` in `format`, written by `fill` straight into the mapped memory (no host copy).
+    pub fn filled<T: bytemuck::Pod>(
+        dev: &Arc<Device>,
+        count: usize,
+        format: vk::Format,
+        name: &str,
+        fill: impl FnOnce(&mut [T]),
+    ) -> Result<Self, GpuError> {
+        let bytes = (count * std::mem::size_of::<T>()) as u64;
+        let mut buffer =
+            Buffer::new(dev, bytes, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, MemoryLocation::CpuToGpu, name)?;
+        fill(bytemuck::cast_slice_mut(buffer.mapped_mut()));
+        let info = vk::BufferViewCreateInfo::default().buffer(buffer.buffer).format(format).offset(0).range(bytes);
         // SAFETY: valid device and buffer created with UNIFORM_TEXEL_BUFFER usage.
         let view = unsafe { dev.device.create_buffer_view(&info, None) }.vk("vkCreateBufferView")?;
         Ok(Self { view, buffer })

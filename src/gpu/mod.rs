@@ -32,6 +32,7 @@ mod shadow_map;
 pub mod slice_gather;
 pub mod slice_passes;
 pub mod sun_cells;
+pub mod texture_buffers;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
 pub use device_info::DeviceInfo;

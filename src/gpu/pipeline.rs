@@ -116,9 +116,9 @@ impl ScenePipeline {
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
             // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table, 9 the surface
-            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the texels (a
-            // uniform texel buffer: lavapipe's storage buffers stop at 128 MiB, a texel buffer holds
-            // maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps
+            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the f32 texels and
+            // 16 the 8-bit ones (uniform texel buffers: lavapipe's storage buffers stop at 128 MiB, a texel buffer
+            // holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps
             // until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices with ray queries,
             // and 12 the occluders' BVH nodes and 13 the sky's fractions from its passes of slices (storage buffers) on
             // every device with shadow rays (the slices walk the tree), 14 the walk's records in the tree's leaf order
@@ -134,6 +134,7 @@ impl ScenePipeline {
                 (10, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (11, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (7, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
+                (16, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];

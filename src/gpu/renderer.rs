@@ -13,10 +13,10 @@ use super::device_info::DeviceInfo;
 use super::error::GpuError;
 use super::frame_probe;
 use super::layout::{
-    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, texture_buffers, with_light_rows,
-    MaterialGpu, PushConstants, ShaderVariant, SurfaceVertex, Vertex, BRDF_LAMBERT, DISKS_EXACT, LIGHT_ABSENT,
-    MAX_DISK_MAPS, QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_CELLS_COMPLETE,
-    SUN_CELLS_NONE, SUN_CELLS_PARTIAL, SUN_DISK,
+    lights_bytes, material_gpu, measured_tables, occluder_records, push_constants, with_light_rows, MaterialGpu,
+    PushConstants, ShaderVariant, SurfaceVertex, Vertex, BRDF_LAMBERT, DISKS_EXACT, LIGHT_ABSENT, MAX_DISK_MAPS,
+    QUANTITY_LIGHT_ROWS, ROWS_OF_SKY, SHADOWS_MAP, SHADOWS_NONE, SHADOWS_RAY, SUN_CELLS_COMPLETE, SUN_CELLS_NONE,
+    SUN_CELLS_PARTIAL, SUN_DISK,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
@@ -24,6 +24,7 @@ use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
 use super::slice_passes;
+use super::texture_buffers::TextureLayout;
 use crate::film::{rgba32f_bytes, Image};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -82,8 +83,10 @@ pub struct GpuScene {
     vertices: Option<Buffer>,
     indices: Option<Buffer>,
     materials: Buffer,
-    /// Every texture's levels as linear RGBA f32, and the texture table (headers and level records).
+    /// Every texture's levels (`texture_buffers`): linear RGBA f32 after the code tables, 8-bit codes, and the
+    /// texture table (headers and level records).
     texels: TexelBuffer,
+    texel_codes: TexelBuffer,
     texture_table: Buffer,
     /// Texture coordinates and colours per vertex (`SurfaceVertex`), read by textured materials.
     surface_vertices: Buffer,
@@ -372,7 +375,7 @@ impl Renderer {
         }
         let no_material = [MaterialGpu::zeroed()];
         let materials_bytes: &[u8] = bytemuck::cast_slice(if materials.is_empty() { &no_material } else { &materials });
-        let (texels, texture_table) = texture_buffers(scene);
+        let textures = TextureLayout::of(scene);
         let limit = self.dev.info.max_storage_buffer_range as u64;
         let vertex_bytes = std::mem::size_of_val(&vertices[..]) as u64;
         if vertex_bytes.max(std::mem::size_of_val(&surface_vertices[..]) as u64) > limit {
@@ -396,24 +399,41 @@ impl Renderer {
             )));
         }
         let texel_limit = self.dev.info.max_texel_buffer_elements as usize;
-        let texel_bytes = std::mem::size_of_val(&texels[..]) as u64;
-        if texels.len() > texel_limit || texel_bytes > self.dev.info.max_memory_allocation_size {
+        let (linear_bytes, code_bytes) = (textures.linear_texels as u64 * 16, textures.code_texels as u64 * 4);
+        if textures.linear_texels.max(textures.code_texels) > texel_limit
+            || linear_bytes.max(code_bytes) > self.dev.info.max_memory_allocation_size
+        {
             return Err(GpuError::TooLarge(format!(
-                "the scene's textures and their mip levels are {} texels ({:.1} MiB as f32 RGBA); {} reads at most \
-                 {texel_limit} from one texel buffer in one allocation of {:.1} MiB (--max-texture-size N draws \
-                 large textures from a smaller mip level)",
-                texels.len(),
-                texel_bytes as f64 / (1 << 20) as f64,
+                "the scene's textures and their mip levels are {} texels as 8-bit codes ({:.1} MiB) and {} as f32 \
+                 RGBA ({:.1} MiB); {} reads at most {texel_limit} from one texel buffer in one allocation of {:.1} \
+                 MiB (--max-texture-size N draws large textures from a smaller mip level)",
+                textures.code_texels,
+                code_bytes as f64 / (1 << 20) as f64,
+                textures.linear_texels,
+                linear_bytes as f64 / (1 << 20) as f64,
                 self.dev.info.name,
                 self.dev.info.max_memory_allocation_size as f64 / (1 << 20) as f64
             )));
         }
-        let texels = TexelBuffer::with_texels(&self.dev, &texels, "texels")?;
+        let texels = TexelBuffer::filled(
+            &self.dev,
+            textures.linear_texels,
+            vk::Format::R32G32B32A32_SFLOAT,
+            "texels",
+            |out: &mut [[f32; 4]]| textures.write_linear(scene, out),
+        )?;
+        let texel_codes = TexelBuffer::filled(
+            &self.dev,
+            textures.code_texels,
+            vk::Format::R8G8B8A8_UINT,
+            "texel codes",
+            |out: &mut [[u8; 4]]| textures.write_codes(scene, out),
+        )?;
         if surface_vertices.is_empty() {
             surface_vertices.push(SurfaceVertex::zeroed());
         }
         let surface_vertices = Buffer::storage(&self.dev, bytemuck::cast_slice(&surface_vertices), "surface vertices")?;
-        let texture_table = Buffer::storage(&self.dev, bytemuck::cast_slice(&texture_table), "texture table")?;
+        let texture_table = Buffer::storage(&self.dev, bytemuck::cast_slice(&textures.table), "texture table")?;
         // With ray queries the vertex buffer is also the acceleration structure's build input.
         let accel_usage = if rq {
             vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR
@@ -469,6 +489,7 @@ impl Renderer {
             indices,
             materials: Buffer::storage(&self.dev, materials_bytes, "materials")?,
             texels,
+            texel_codes,
             texture_table,
             surface_vertices,
             occluder_triangles,
@@ -940,14 +961,16 @@ impl Renderer {
                     })
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
-                // 7: the texels, a uniform texel buffer.
-                let views = [scene.texels.view];
-                let write = vk::WriteDescriptorSet::default()
-                    .dst_set(self.pipeline.descriptor_set)
-                    .dst_binding(7)
-                    .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
-                    .texel_buffer_view(&views);
-                d.update_descriptor_sets(&[write], &[]);
+                // 7: the f32 texels, 16: the 8-bit codes; uniform texel buffers.
+                let views = [[scene.texels.view], [scene.texel_codes.view]];
+                let writes = [(7, &views[0]), (16, &views[1])].map(|(binding, view)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(self.pipeline.descriptor_set)
+                        .dst_binding(binding)
+                        .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                        .texel_buffer_view(view)
+                });
+                d.update_descriptor_sets(&writes, &[]);
             }
             // Binding 5: the sun's shadow map, 6: the first disks' (valid images in every frame; read only by
             // SHADOWS_MAP pipelines).

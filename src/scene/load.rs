@@ -139,7 +139,7 @@ impl<'a> Loader<'a> {
             let m = materials.read(index, material)?;
             self.scene.materials.push(m);
         }
-        self.scene.textures = materials.textures;
+        self.scene.textures = materials.decode_textures()?;
         self.scene.warnings.extend(materials.warnings);
         if let Some((index, time)) = options.animation {
             if !time.is_finite() {

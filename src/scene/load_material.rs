@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use super::gltf::document::{lookup, MaterialDef, Root, TextureInfo};
 use super::gltf::files::AssetFiles;
-use super::gltf::image::{decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
+use super::gltf::image::{check, decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
 use super::gltf::uri::{resolve, UriTarget};
 use super::material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
 use super::measured::{parse_merl, SharedMeasuredBrdf, MERL_FILE_BYTES};
@@ -26,9 +26,10 @@ pub struct MaterialReader<'a> {
     pub files: &'a AssetFiles,
     /// (glTF texture, colour space) → index into `textures`.
     cache: HashMap<(u64, ColorSpace), usize>,
+    /// The images to decode, in the order of their scene textures ([`MaterialReader::decode_textures`]).
+    textures: Vec<PendingTexture>,
     /// Measured BRDF tables by the URI that names them: materials naming the same URI share one table.
     measured: HashMap<String, SharedMeasuredBrdf>,
-    pub textures: Vec<Texture>,
     pub warnings: Vec<String>,
     /// What is left of the scene's texel budget.
     texels_left: u64,
@@ -218,15 +219,44 @@ impl<'a> MaterialReader<'a> {
             None => Sampler::default(),
         };
         let (bytes, _mime) = image_bytes(root, self.buffers, self.files, source, &what)?;
-        let level0 = decode(&bytes, space, &format!("{what} image {source}"), &mut self.texels_left)?;
-        let mut texture = Texture::new(format!("{what} (image {source})"), level0, sampler);
-        if let Some(max) = self.max_texture_size {
-            texture.limit_size(max);
-        }
-        self.textures.push(texture);
+        check(&bytes, &format!("{what} image {source}"), &mut self.texels_left)?;
+        self.textures.push(PendingTexture { what, source, bytes, space, sampler });
         let index = self.textures.len() - 1;
         self.cache.insert(key, index);
         Ok(Some(TextureRef { texture: index, tex_coord: tex_coord as u32, transform: matrix }))
+    }
+}
+
+/// A texture whose image passed [`check`] and waits to be decoded.
+struct PendingTexture {
+    /// "texture N".
+    what: String,
+    /// The glTF image.
+    source: u64,
+    bytes: Vec<u8>,
+    space: ColorSpace,
+    sampler: Sampler,
+}
+
+impl MaterialReader<'_> {
+    /// Decodes every texture the materials read used, with its mip chain, in parallel (each image alone, so the
+    /// texels do not depend on the order); the first error in texture order is the one returned.
+    pub fn decode_textures(&mut self) -> Result<Vec<Texture>, String> {
+        use rayon::prelude::*;
+        let max = self.max_texture_size;
+        let decoded: Vec<Result<Texture, String>> = std::mem::take(&mut self.textures)
+            .into_par_iter()
+            .map(|t| {
+                let level0 = decode(&t.bytes, t.space, &format!("{} image {}", t.what, t.source))?;
+                drop(t.bytes);
+                let mut texture = Texture::new(format!("{} (image {})", t.what, t.source), level0, t.sampler);
+                if let Some(max) = max {
+                    texture.limit_size(max);
+                }
+                Ok(texture)
+            })
+            .collect();
+        decoded.into_iter().collect()
     }
 }
 

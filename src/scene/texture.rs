@@ -1,5 +1,6 @@
-//! Textures as both renderers read them: texels decoded once to linear f32 RGBA, a mip chain built once here on
-//! the CPU, and the sampler's wrap and filter modes. How a texture is looked up (texel centres, wrapping, the
+//! Textures as both renderers read them: 8-bit images kept as their codes (decoded to linear f32 on lookup,
+//! through one table per colour space), other texels as linear f32 RGBA, a mip chain built once here on the CPU,
+//! and the sampler's wrap and filter modes. How a texture is looked up (texel centres, wrapping, the
 //! level chosen from UV derivatives, the blends) is `shading::texture_filter`, mirrored by
 //! `shaders/texture_filter.glsl`; docs/textures.md gives the formulas.
 
@@ -88,13 +89,86 @@ impl Sampler {
     }
 }
 
-/// One level of a mip chain: `width × height` linear RGBA texels, row by row from the image's top row (glTF's
-/// UV (0, 0) is the top-left corner of the image).
+/// How an image's colour channels are encoded: sRGB (base colour, emission) or linear (metallic-roughness,
+/// normals). Alpha is always linear.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    Srgb,
+    Linear,
+}
+
+/// A level's texels as stored, row by row from the image's top row.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texels {
+    /// Linear RGBA (16-bit images, the box-filtered mip levels).
+    Linear(Vec<[f32; 4]>),
+    /// An 8-bit image's RGBA codes as the file stores them: the colour channels encoded in `space`, alpha
+    /// linear. Read through [`code_value`], which gives the f32 that decoding to linear would have stored, at a
+    /// quarter of the memory.
+    Codes { codes: Vec<[u8; 4]>, space: ColorSpace },
+}
+
+/// One level of a mip chain: `width × height` texels, row by row from the image's top row (glTF's UV (0, 0) is
+/// the top-left corner of the image).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Level {
     pub width: u32,
     pub height: u32,
-    pub texels: Vec<[f32; 4]>,
+    pub texels: Texels,
+}
+
+impl Level {
+    /// A level of linear RGBA texels.
+    pub fn linear(width: u32, height: u32, texels: Vec<[f32; 4]>) -> Self {
+        Self { width, height, texels: Texels::Linear(texels) }
+    }
+
+    /// Texel `index` (row-major), linear RGBA.
+    pub fn texel(&self, index: usize) -> [f32; 4] {
+        match &self.texels {
+            Texels::Linear(t) => t[index],
+            Texels::Codes { codes, space } => {
+                let [r, g, b, a] = codes[index];
+                let colour = code_table(*space);
+                let alpha = code_table(ColorSpace::Linear);
+                [colour[r as usize], colour[g as usize], colour[b as usize], alpha[a as usize]]
+            }
+        }
+    }
+
+    /// How many texels the level holds.
+    pub fn len(&self) -> usize {
+        match &self.texels {
+            Texels::Linear(t) => t.len(),
+            Texels::Codes { codes, .. } => codes.len(),
+        }
+    }
+
+    /// Whether the level holds no texel.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The linear value of an 8-bit code in `space`: `code/255` (linear) or the sRGB curve at `code/255`, each
+/// computed in f64 and rounded once to f32. The GPU reads the same 256 values from its texel buffer.
+pub fn code_value(space: ColorSpace, code: u8) -> f32 {
+    code_table(space)[code as usize]
+}
+
+/// The 256 values of [`code_value`] in `space`, computed once.
+pub fn code_table(space: ColorSpace) -> &'static [f32; 256] {
+    use std::sync::OnceLock;
+    static TABLES: OnceLock<[[f32; 256]; 2]> = OnceLock::new();
+    let tables = TABLES.get_or_init(|| {
+        let linear = std::array::from_fn(|c| (c as f64 / 255.0) as f32);
+        let srgb = std::array::from_fn(|c| srgb_to_linear(c as u8));
+        [linear, srgb]
+    });
+    match space {
+        ColorSpace::Linear => &tables[0],
+        ColorSpace::Srgb => &tables[1],
+    }
 }
 
 /// A texture: its mip chain (level 0 the image itself) and its sampler.
@@ -154,7 +228,8 @@ pub fn level_count(width: u32, height: u32) -> usize {
 /// `[i·N/M, (i+1)·N/M)` of the larger level's texels (N → M = max(1, ⌊N/2⌋) texels); each source texel weighs by
 /// the length of its overlap with that interval, divided by N/M. For even N that is the 2 × 2 average; for odd N
 /// it spreads over three texels, so no texel is dropped and every level keeps the image's mean. Computed
-/// separably in f64 (rows, then columns) from linear texels, rounded once to f32.
+/// separably in f64 (rows, then columns) from linear texels, rounded once to f32 (so the levels below an 8-bit
+/// image are linear f32, not codes).
 pub fn mip_chain(level0: Level) -> Vec<Level> {
     use rayon::prelude::*;
     let count = level_count(level0.width, level0.height);
@@ -162,34 +237,46 @@ pub fn mip_chain(level0: Level) -> Vec<Level> {
     while levels.len() < count {
         let prev = levels.last().expect("level 0 is there");
         let (w, h) = ((prev.width / 2).max(1), (prev.height / 2).max(1));
-        // Rows in parallel: each texel is computed alone, so the result does not depend on the order.
-        let across: Vec<[f64; 4]> = (0..prev.height)
-            .into_par_iter()
-            .flat_map_iter(|y| {
-                let row = &prev.texels[(y * prev.width) as usize..((y + 1) * prev.width) as usize];
-                (0..w).map(move |i| box_filter(prev.width, w, i, |s| row[s].map(f64::from)))
-            })
-            .collect();
-        let texels = (0..h)
-            .into_par_iter()
-            .flat_map_iter(|j| {
-                let across = &across;
-                (0..w).map(move |i| {
-                    box_filter(prev.height, h, j, |s| across[s * w as usize + i as usize]).map(|v| v as f32)
+        let mut texels = vec![[0.0f32; 4]; (w * h) as usize];
+        // Output rows in parallel, each from the two or three source rows it covers, filtered across first
+        // (a source row shared by two output rows is filtered for each, the same way): every texel is computed
+        // alone, so the result does not depend on the order or the split.
+        texels.par_chunks_mut(w as usize).enumerate().for_each(|(j, out)| {
+            let (first, end) = box_span(prev.height, h, j as u32);
+            let across: Vec<Vec<[f64; 4]>> = (first..end)
+                .map(|y| {
+                    let row: Vec<[f64; 4]> =
+                        (0..prev.width).map(|x| prev.texel((y * prev.width + x) as usize).map(f64::from)).collect();
+                    (0..w).map(|i| box_filter(prev.width, w, i, |s| row[s])).collect()
                 })
-            })
-            .collect();
-        levels.push(Level { width: w, height: h, texels });
+                .collect();
+            for (i, texel) in out.iter_mut().enumerate() {
+                *texel = box_filter(prev.height, h, j as u32, |s| across[s - first as usize][i]).map(|v| v as f32);
+            }
+        });
+        levels.push(Level::linear(w, h, texels));
     }
     levels
 }
 
+/// The source texels `[first, end)` that texel `i` of `m` box-filtered from `n` reads (see [`box_filter`]).
+fn box_span(n: u32, m: u32, i: u32) -> (u32, u32) {
+    let scale = n as f64 / m as f64;
+    ((i as f64 * scale).floor() as u32, (((i + 1) as f64 * scale).ceil() as u32).min(n))
+}
+
 /// Texel `i` of `m` texels box-filtered from `n` (see [`mip_chain`]).
 fn box_filter(n: u32, m: u32, i: u32, texel: impl Fn(usize) -> [f64; 4]) -> [f64; 4] {
+    if n == 2 * m {
+        // Even n: texels 2i and 2i + 1, each overlapping by exactly 1: the loop's sums below, term for term.
+        let (a, b) = (texel(2 * i as usize), texel(2 * i as usize + 1));
+        return std::array::from_fn(|c| (0.0 + 1.0 * a[c] + 1.0 * b[c]) / 2.0);
+    }
     let scale = n as f64 / m as f64;
     let (lo, hi) = (i as f64 * scale, (i + 1) as f64 * scale);
     let mut sum = [0.0; 4];
-    for s in (lo.floor() as u32)..(hi.ceil() as u32).min(n) {
+    let (first, end) = box_span(n, m, i);
+    for s in first..end {
         let overlap = (hi.min(s as f64 + 1.0) - lo.max(s as f64)).max(0.0);
         let t = texel(s as usize);
         for c in 0..4 {
@@ -221,24 +308,24 @@ mod tests {
     fn mip_chain_keeps_the_mean_and_halves_down_to_one() {
         // A 5 × 3 ramp: sizes 5×3 → 2×1 → 1×1; every level's mean equals level 0's.
         let texels: Vec<[f32; 4]> = (0..15).map(|i| [i as f32, 1.0, 0.5, 1.0]).collect();
-        let levels = mip_chain(Level { width: 5, height: 3, texels });
+        let levels = mip_chain(Level::linear(5, 3, texels));
         let sizes: Vec<(u32, u32)> = levels.iter().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, [(5, 3), (2, 1), (1, 1)]);
         for l in &levels {
-            let mean = l.texels.iter().map(|t| t[0] as f64).sum::<f64>() / l.texels.len() as f64;
+            let mean = (0..l.len()).map(|i| l.texel(i)[0] as f64).sum::<f64>() / l.len() as f64;
             assert!((mean - 7.0).abs() < 1e-5, "{l:?}");
-            assert!(l.texels.iter().all(|t| t[1] == 1.0 && t[3] == 1.0));
+            assert!((0..l.len()).all(|i| l.texel(i)[1] == 1.0 && l.texel(i)[3] == 1.0));
         }
         // An even size is the 2 × 2 average.
-        let l = mip_chain(Level { width: 2, height: 2, texels: vec![[0.0; 4], [1.0; 4], [2.0; 4], [5.0; 4]] });
-        assert_eq!(l[1].texels, vec![[2.0; 4]]);
+        let l = mip_chain(Level::linear(2, 2, vec![[0.0; 4], [1.0; 4], [2.0; 4], [5.0; 4]]));
+        assert_eq!(l[1].texels, Texels::Linear(vec![[2.0; 4]]));
         assert_eq!(level_count(1, 1), 1);
         assert_eq!(level_count(1024, 3), 11);
     }
 
     #[test]
     fn limiting_the_size_keeps_the_smaller_levels() {
-        let level0 = Level { width: 8, height: 2, texels: vec![[1.0; 4]; 16] };
+        let level0 = Level::linear(8, 2, vec![[1.0; 4]; 16]);
         let mut t = Texture::new("t".into(), level0, Sampler::default());
         assert_eq!(t.levels.len(), 4);
         assert_eq!(t.limit_size(4), 1);
@@ -253,6 +340,38 @@ mod tests {
         assert_eq!(srgb_to_linear(255), 1.0);
         assert!((srgb_to_linear(10) as f64 - 10.0 / 255.0 / 12.92).abs() < 1e-9);
         assert!((srgb_to_linear(128) - 0.2158605).abs() < 1e-6);
+    }
+
+    #[test]
+    fn codes_read_as_their_linear_values_and_filter_alike() {
+        // A 7 × 5 image of every kind of code, kept as codes and decoded up front: the same texels, the same
+        // mip chain, bit for bit.
+        let codes: Vec<[u8; 4]> =
+            (0..35u32).map(|i| [(i * 7) as u8, (i * 53) as u8, 255 - i as u8, (i * 31) as u8]).collect();
+        for space in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let decoded: Vec<[f32; 4]> = codes
+                .iter()
+                .map(|c| {
+                    let v = |x: u8| match space {
+                        ColorSpace::Srgb => srgb_to_linear(x),
+                        ColorSpace::Linear => (x as f64 / 255.0) as f32,
+                    };
+                    [v(c[0]), v(c[1]), v(c[2]), (c[3] as f64 / 255.0) as f32]
+                })
+                .collect();
+            let kept = mip_chain(Level { width: 7, height: 5, texels: Texels::Codes { codes: codes.clone(), space } });
+            let up_front = mip_chain(Level::linear(7, 5, decoded));
+            assert_eq!(kept.len(), up_front.len());
+            for (k, u) in kept.iter().zip(&up_front) {
+                assert_eq!(k.len(), u.len());
+                for i in 0..k.len() {
+                    assert_eq!(k.texel(i).map(f32::to_bits), u.texel(i).map(f32::to_bits), "{space:?} texel {i}");
+                }
+            }
+            assert!(matches!(kept[1].texels, Texels::Linear(_)));
+        }
+        assert_eq!(code_value(ColorSpace::Srgb, 128), srgb_to_linear(128));
+        assert_eq!(code_value(ColorSpace::Linear, 51), 0.2);
     }
 
     #[test]

@@ -47,7 +47,7 @@ pub fn texel_coordinate(x: f64) -> f64 {
 
 /// The texel `(i, j)` of a level (already wrapped).
 pub fn texel(level: &Level, i: u32, j: u32) -> [f32; 4] {
-    level.texels[(j * level.width + i) as usize]
+    level.texel((j * level.width + i) as usize)
 }
 
 /// One level filtered at `uv` ((0, 0) the image's top-left corner, (1, 1) its bottom-right):
@@ -203,7 +203,7 @@ mod tests {
         let texels = (0..n * n)
             .map(|k| if (k % n + k / n).is_multiple_of(2) { [1.0; 4] } else { [0.0, 0.0, 0.0, 1.0] })
             .collect();
-        Texture::new("checker".into(), Level { width: n, height: n, texels }, Sampler::default())
+        Texture::new("checker".into(), Level::linear(n, n, texels), Sampler::default())
     }
 
     #[test]
@@ -220,7 +220,7 @@ mod tests {
 
     #[test]
     fn linear_magnification_hits_texel_centres_and_midpoints() {
-        let level = Level { width: 2, height: 1, texels: vec![[0.0; 4], [1.0; 4]] };
+        let level = Level::linear(2, 1, vec![[0.0; 4], [1.0; 4]]);
         let f = |u: f64| filter_level(&level, Filter::Linear, [Wrap::ClampToEdge; 2], [u, 0.5])[0];
         assert_eq!(f(0.25), 0.0); // centre of texel 0
         assert_eq!(f(0.75), 1.0); // centre of texel 1

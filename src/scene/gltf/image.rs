@@ -1,11 +1,12 @@
-//! glTF images → linear f32 texels: PNG and JPEG, from a buffer view, a data URI or a file inside the asset
+//! glTF images → texels (8-bit images as their codes, 16-bit ones as linear f32): PNG and JPEG, from a buffer view, a data URI or a file inside the asset
 //! folder (the same rules as buffers). Decoding is bounded: at most [`MAX_TEXTURE_SIDE`] texels a side, checked
 //! from the header before the pixels are decoded.
 
 use super::document::{lookup, ImageDef, Root};
 use super::files::AssetFiles;
 use super::uri::{self, UriTarget};
-use crate::scene::texture::{srgb_decode, srgb_to_linear, Level};
+pub use crate::scene::texture::ColorSpace;
+use crate::scene::texture::{srgb_decode, Level, Texels};
 
 /// The longest side of an image sunshade decodes [texels] (lavapipe's `maxImageDimension2D`).
 pub const MAX_TEXTURE_SIDE: u32 = 16384;
@@ -50,31 +51,11 @@ pub fn image_bytes(
     }
 }
 
-/// How a texture's colour channels are encoded: sRGB (base colour, emission) or linear (metallic-roughness,
-/// normals). Alpha is always linear.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ColorSpace {
-    Srgb,
-    Linear,
-}
-
-/// Decodes PNG (8 or 16 bits, any channel count) or JPEG to linear RGBA f32 (missing channels: grey to RGB,
-/// alpha 1). `what` names the image in errors. `texels_left`: the scene's remaining budget of texels (of
-/// [`MAX_SCENE_TEXELS`]), charged with the image's mip chain (at most 4/3 of its texels) before decoding.
-pub fn decode(bytes: &[u8], space: ColorSpace, what: &str, texels_left: &mut u64) -> Result<Level, String> {
-    use image::ImageDecoder;
-    let format = image::guess_format(bytes).map_err(|_| format!("{what}: not a PNG or JPEG image"))?;
-    if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
-        return Err(format!("{what}: {format:?} images are not read (PNG and JPEG are)"));
-    }
-    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
-    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
-    limits.max_alloc = Some(2 << 30);
-    reader.limits(limits);
-    let decoder = reader.into_decoder().map_err(|e| format!("{what}: {e}"))?;
-    let (width, height) = decoder.dimensions();
+/// Checks an image before decoding it: PNG or JPEG, at most [`MAX_TEXTURE_SIDE`] a side, not empty, and its mip
+/// chain (at most 4/3 of its texels) within `texels_left`, the scene's remaining budget of texels (of
+/// [`MAX_SCENE_TEXELS`]), which it is charged with. Reads the header only. `what` names the image in errors.
+pub fn check(bytes: &[u8], what: &str, texels_left: &mut u64) -> Result<(), String> {
+    let (width, height) = reader(bytes, what)?.into_dimensions().map_err(|e| format!("{what}: {e}"))?;
     if width == 0 || height == 0 {
         return Err(format!("{what}: the image is empty ({width}x{height})"));
     }
@@ -87,36 +68,60 @@ pub fn decode(bytes: &[u8], space: ColorSpace, what: &str, texels_left: &mut u64
         ));
     }
     *texels_left -= chain;
+    Ok(())
+}
+
+/// A reader of a PNG or JPEG image, bounded to [`MAX_TEXTURE_SIDE`] a side and 2 GiB of decoding memory.
+fn reader<'a>(bytes: &'a [u8], what: &str) -> Result<image::ImageReader<std::io::Cursor<&'a [u8]>>, String> {
+    let format = image::guess_format(bytes).map_err(|_| format!("{what}: not a PNG or JPEG image"))?;
+    if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg) {
+        return Err(format!("{what}: {format:?} images are not read (PNG and JPEG are)"));
+    }
+    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(2 << 30);
+    reader.limits(limits);
+    Ok(reader)
+}
+
+/// Decodes PNG (8 or 16 bits, any channel count) or JPEG that [`check`] passed to RGBA (missing channels: grey
+/// to RGB, alpha 1): 8-bit images as their codes in `space` ([`Texels::Codes`]), 16-bit ones to linear f32.
+pub fn decode(bytes: &[u8], space: ColorSpace, what: &str) -> Result<Level, String> {
+    use image::ImageDecoder;
+    let decoder = reader(bytes, what)?.into_decoder().map_err(|e| format!("{what}: {e}"))?;
+    let (width, height) = decoder.dimensions();
+    if width == 0 || height == 0 {
+        return Err(format!("{what}: the image is empty ({width}x{height})"));
+    }
     let decoded = image::DynamicImage::from_decoder(decoder).map_err(|e| format!("{what}: {e}"))?;
     let sixteen = matches!(
         decoded.color(),
         image::ColorType::L16 | image::ColorType::La16 | image::ColorType::Rgb16 | image::ColorType::Rgba16
     );
-    let texels: Vec<[f32; 4]> = if sixteen {
-        let rgba = decoded.to_rgba16();
-        rgba.pixels()
-            .map(|p| {
-                let c = |v: u16| {
-                    let x = v as f64 / 65535.0;
-                    match space {
-                        ColorSpace::Linear => x as f32,
-                        ColorSpace::Srgb => srgb_decode(x) as f32,
-                    }
-                };
-                [c(p[0]), c(p[1]), c(p[2]), (p[3] as f64 / 65535.0) as f32]
-            })
-            .collect()
+    let texels = if sixteen {
+        let rgba = decoded.into_rgba16();
+        Texels::Linear(
+            rgba.pixels()
+                .map(|p| {
+                    let c = |v: u16| {
+                        let x = v as f64 / 65535.0;
+                        match space {
+                            ColorSpace::Linear => x as f32,
+                            ColorSpace::Srgb => srgb_decode(x) as f32,
+                        }
+                    };
+                    [c(p[0]), c(p[1]), c(p[2]), (p[3] as f64 / 65535.0) as f32]
+                })
+                .collect(),
+        )
     } else {
-        let table: Vec<f32> = (0..=255u8)
-            .map(|v| match space {
-                ColorSpace::Linear => (v as f64 / 255.0) as f32,
-                ColorSpace::Srgb => srgb_to_linear(v),
-            })
-            .collect();
-        let rgba = decoded.to_rgba8();
-        rgba.pixels()
-            .map(|p| [table[p[0] as usize], table[p[1] as usize], table[p[2] as usize], (p[3] as f64 / 255.0) as f32])
-            .collect()
+        // The decoder's RGBA bytes become the texels without a copy where the allocation allows it.
+        let bytes = decoded.into_rgba8().into_raw();
+        let codes = bytemuck::allocation::try_cast_vec(bytes)
+            .unwrap_or_else(|(_, bytes)| bytes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect());
+        Texels::Codes { codes, space }
     };
     Ok(Level { width, height, texels })
 }
@@ -124,6 +129,7 @@ pub fn decode(bytes: &[u8], space: ColorSpace, what: &str, texels_left: &mut u64
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::texture::srgb_to_linear;
 
     fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
         let mut out = Vec::new();
@@ -138,15 +144,18 @@ mod tests {
     fn decodes_png_in_both_colour_spaces() {
         let bytes = png(2, 1, &[255, 128, 0, 255, 10, 20, 30, 128]);
         let budget = &mut MAX_SCENE_TEXELS.clone();
-        let lin = decode(&bytes, ColorSpace::Linear, "t", budget).unwrap();
+        check(&bytes, "t", budget).unwrap();
+        let lin = decode(&bytes, ColorSpace::Linear, "t").unwrap();
         assert_eq!((lin.width, lin.height), (2, 1));
-        assert_eq!(lin.texels[0], [1.0, (128.0f64 / 255.0) as f32, 0.0, 1.0]);
-        let srgb = decode(&bytes, ColorSpace::Srgb, "t", budget).unwrap();
-        assert_eq!(*budget, MAX_SCENE_TEXELS - 2 * 4);
+        assert_eq!(lin.texel(0), [1.0, (128.0f64 / 255.0) as f32, 0.0, 1.0]);
+        assert!(matches!(lin.texels, Texels::Codes { space: ColorSpace::Linear, .. }));
+        let srgb = decode(&bytes, ColorSpace::Srgb, "t").unwrap();
+        assert_eq!(*budget, MAX_SCENE_TEXELS - 4);
         let mut small = 3;
-        assert!(decode(&bytes, ColorSpace::Srgb, "image 7", &mut small).unwrap_err().contains("budget"));
+        assert!(check(&bytes, "image 7", &mut small).unwrap_err().contains("budget"));
+        assert_eq!(small, 3);
         assert_eq!(
-            srgb.texels[1],
+            srgb.texel(1),
             [srgb_to_linear(10), srgb_to_linear(20), srgb_to_linear(30), (128.0f64 / 255.0) as f32]
         );
     }
@@ -154,9 +163,10 @@ mod tests {
     #[test]
     fn refuses_what_it_cannot_decode() {
         let budget = &mut MAX_SCENE_TEXELS.clone();
-        assert!(decode(b"not an image", ColorSpace::Linear, "image 3", budget).unwrap_err().starts_with("image 3"));
+        assert!(check(b"not an image", "image 3", budget).unwrap_err().starts_with("image 3"));
+        assert!(decode(b"not an image", ColorSpace::Linear, "image 3").unwrap_err().starts_with("image 3"));
         let mut bytes = png(4, 4, &[0; 64]);
         bytes.truncate(bytes.len() - 20);
-        assert!(decode(&bytes, ColorSpace::Linear, "image 3", budget).is_err());
+        assert!(decode(&bytes, ColorSpace::Linear, "image 3").is_err());
     }
 }
