@@ -28,15 +28,21 @@ const SLICES: &str = "SUNSHADE_SLICES";
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=shaders");
-    let mut sources: Vec<(String, String)> = std::fs::read_dir("shaders")
-        .expect("read shaders/")
-        .map(|e| {
-            let path = e.expect("entry of shaders/").path();
+    // Every file under shaders/, by its path relative to it ("lights/sun.glsl"), the name `#include` uses.
+    let mut sources: Vec<(String, String)> = Vec::new();
+    let mut folders = vec![PathBuf::from("shaders")];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).expect("read a folder of shaders/") {
+            let path = entry.expect("entry of shaders/").path();
             println!("cargo:rerun-if-changed={}", path.display());
-            let name = path.file_name().expect("file name").to_string_lossy().into_owned();
-            (name, std::fs::read_to_string(&path).expect("read a shader"))
-        })
-        .collect();
+            if path.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            let name = path.strip_prefix("shaders").expect("under shaders/").to_string_lossy().replace('\\', "/");
+            sources.push((name, std::fs::read_to_string(&path).expect("read a shader")));
+        }
+    }
     sources.sort();
     let refs: Vec<(&str, &str)> = sources.iter().map(|(n, s)| (n.as_str(), s.as_str())).collect();
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("OUT_DIR"));

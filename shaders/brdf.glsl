@@ -2,7 +2,7 @@
 #ifndef SUNSHADE_BRDF_GLSL
 #define SUNSHADE_BRDF_GLSL
 
-#include "radiometry.glsl"
+#include "math.glsl"
 
 // Lambertian: rho = albedo / pi.
 vec3 lambert_brdf(vec3 albedo) {

@@ -8,6 +8,8 @@
 #include "measured.glsl"
 #include "visibility.glsl"
 #include "shadow_map.glsl"
+#include "lights/sun.glsl"
+#include "lights/disk.glsl"
 
 // Whether this pipeline casts shadow rays (the pipeline variant; only modules built with SUNSHADE_RAY_QUERY can).
 const bool SHADOWS_ON = VARIANT_SHADOWS == SHADOWS_RAY;
@@ -43,107 +45,6 @@ struct Frame {
     vec3 shadow_origin; // the shadow rays' origin [m] (visibility.glsl's shadow_ray_origin)
     vec3 face_normal;   // the triangle's unit normal on the shaded side (shadow-map bias)
 };
-
-// Irradiance [W/m^2] per channel from the visible part of every light (which, and their models: the pipeline
-// variant): each light's exact unoccluded irradiance times its visible fraction (a single ray for a delta sun and
-// a small-source disk); every fraction is 1 without shadows.
-vec3 irradiance_visible(Frame p) {
-    vec3 position = p.position;
-    vec3 normal = p.normal;
-    uint k = lights.sampling.y;
-    vec3 e = vec3(0.0);
-    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
-        vec3 l = lights.sun.direction.xyz;
-        float n_dot_l = dot(normal, l);
-        float delta = lights.sun.direction.w;
-        vec3 unoccluded;
-        if (VARIANT_SUN == SUN_DELTA) {
-            unoccluded = sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
-        } else {
-            unoccluded = sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, delta);
-        }
-        float v = 1.0;
-        if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
-            if (VARIANT_SUN == SUN_DELTA) {
-                v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
-            } else {
-                // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
-                // sky_slices::slice_rows), or as their passes took them before this one where the frame could not
-                // (gpu::slice_passes); the grid where they cannot be taken.
-                v = -1.0;
-#ifdef SUNSHADE_SLICES
-                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
-                    v = (lights.light_rows.w & READ_SUN) != 0u
-                        ? PASSED_FRACTION(ROWS_OF_SUN)
-                        : sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
-                }
-#endif
-                if (v < 0.0) {
-                    v = sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
-                }
-            }
-            sun_ray_fraction = v;
-        }
-        if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
-            bool pcss = VARIANT_SUN != SUN_DELTA && lights.sampling.z == 1u;
-            v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, pcss);
-            sun_map_fraction = v;
-        }
-        e += unoccluded * v;
-    }
-    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
-        DiskGpu d = lights.disks[i];
-        float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
-            ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
-            : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
-        float v = 1.0;
-        if (SHADOWS_ON && omega > 0.0) {
-            if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
-                v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
-            } else {
-                // By slices where asked and the shader walks the BVH itself, or by their passes, as the sun's.
-                v = -1.0;
-#ifdef SUNSHADE_SLICES
-                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
-                    v = (lights.light_rows.w & READ_DISKS) != 0u
-                        ? PASSED_FRACTION(ROWS_OF_DISK + i)
-                        : disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
-                                                       d.center_radius.w, 4u * k * k);
-                }
-#endif
-                if (v < 0.0) {
-                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
-                                              d.direction.xyz, d.center_radius.w);
-                }
-            }
-        }
-        if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
-            bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;
-            v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal, d.center_radius.xyz,
-                d.direction.xyz, d.center_radius.w, pcss);
-            disk_map_fraction[i] = v;
-        }
-        omega = omega * v;
-        e += d.radiance.rgb * omega;
-    }
-    if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
-        float v = 1.0;
-        if (SHADOWS_ON && normal.y > -1.0) {
-            // By the slices the sky's passes took before this one, where they did (gpu::slice_passes).
-            v = -1.0;
-#ifdef SUNSHADE_SLICES
-            if ((lights.light_rows.w & READ_SKY) != 0u) {
-                v = PASSED_FRACTION(ROWS_OF_SKY);
-            }
-#endif
-            if (v < 0.0) {
-                v = sky_visible_fraction(p.shadow_origin, k, normal);
-            }
-        }
-        e += sky_irradiance(lights.sky.rgb, normal.y) * v;
-    }
-    return e;
-}
 
 // The specular lobe of a material (without ks) for light from l.
 float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
@@ -246,12 +147,6 @@ vec3 normalized_lobe_integral(SegmentSums sums, float exact) {
     return sums.projected > 0.0 ? sums.lobe * (1.0 + sums.uniformity * (exact / sums.projected - 1.0)) : sums.lobe;
 }
 
-// The projected solid angle [sr] of the sun's cap above the horizon: pi sin^2(delta/2) E / E_perp.
-float sun_projected_solid_angle_above(float n_dot_l, float angular_diameter) {
-    float s = sin(0.5 * angular_diameter);
-    return PI * s * s * sun_irradiance_disk(vec3(1.0), n_dot_l, angular_diameter).x;
-}
-
 // The grid's sums over a disk, per unit radiance, for the disk of radius `radius` centred at q from the point,
 // emitting along d: segment coordinates, the grid graded about the lobe's peak (see the Rust).
 SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d, float radius, uint per_axis, uint rays) {
@@ -348,96 +243,108 @@ float measured_sampling_alpha(float lobe_width) {
     return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
 }
 
-// integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
-// lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
-// (see the Rust).
-vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
-    vec3 n = p.normal;
-    vec3 v = p.to_viewer;
-    uint kind = VARIANT_BRDF;
-    // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
-    vec3 axis = kind == BRDF_PHONG ? mirror(v, n) : n;
-    vec3 t = orthonormal_to(axis);
-    vec3 b = cross(axis, t);
-    float k = float(per_axis);
-    vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < per_axis; ++i) {
-        float xi1 = (float(i) + 0.5) / k;
-        for (uint j = 0u; j < per_axis; ++j) {
-            float xi2 = (float(j) + 0.5) / k;
-            float phi = 2.0 * PI * xi2;
-            if (kind == BRDF_PHONG) {
-                float e = m.ks.w;
-                vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
-                float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
-                if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                    sum += value;
+#include "sky_lune.glsl"
+#include "lights/sky.glsl"
+
+// Irradiance [W/m^2] per channel from the visible part of every light (which, and their models: the pipeline
+// variant): each light's exact unoccluded irradiance times its visible fraction (a single ray for a delta sun and
+// a small-source disk); every fraction is 1 without shadows.
+vec3 irradiance_visible(Frame p) {
+    vec3 position = p.position;
+    vec3 normal = p.normal;
+    uint k = lights.sampling.y;
+    vec3 e = vec3(0.0);
+    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
+        vec3 l = lights.sun.direction.xyz;
+        float n_dot_l = dot(normal, l);
+        float delta = lights.sun.direction.w;
+        vec3 unoccluded;
+        if (VARIANT_SUN == SUN_DELTA) {
+            unoccluded = sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
+        } else {
+            unoccluded = sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, delta);
+        }
+        float v = 1.0;
+        if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
+            if (VARIANT_SUN == SUN_DELTA) {
+                v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
+            } else {
+                // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
+                // sky_slices::slice_rows), or as their passes took them before this one where the frame could not
+                // (gpu::slice_passes); the grid where they cannot be taken.
+                v = -1.0;
+#ifdef SUNSHADE_SLICES
+                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
+                    v = (lights.light_rows.w & READ_SUN) != 0u
+                        ? PASSED_FRACTION(ROWS_OF_SUN)
+                        : sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
                 }
-            } else if (kind == BRDF_BLINN_PHONG) {
-                float e = m.ks.w;
-                vec3 h = cos_power_direction(axis, t, b, e, xi1, phi);
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
-                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
+#endif
+                if (v < 0.0) {
+                    v = sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
                 }
-            } else if (kind == BRDF_WARD) {
-                float ax = m.params.x;
-                float ay = m.params.y;
-                float phi_h = atan2_accurate(ay * sin(phi), ax * cos(phi));
-                float sp = sin(phi_h);
-                float cp = cos(phi_h);
-                float tan2 = -log_accurate(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
-                float cos_d = 1.0 / sqrt(1.0 + tan2);
-                float sin_d = sqrt(tan2) * cos_d;
-                vec3 h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float value = max(dot(n, omega), 0.0) / (vh * cos_d);
-                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
+            }
+            sun_ray_fraction = v;
+        }
+        if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
+            bool pcss = VARIANT_SUN != SUN_DELTA && lights.sampling.z == 1u;
+            v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, pcss);
+            sun_map_fraction = v;
+        }
+        e += unoccluded * v;
+    }
+    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
+        DiskGpu d = lights.disks[i];
+        float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
+            ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
+            : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        float v = 1.0;
+        if (SHADOWS_ON && omega > 0.0) {
+            if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
+                v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
+            } else {
+                // By slices where asked and the shader walks the BVH itself, or by their passes, as the sun's.
+                v = -1.0;
+#ifdef SUNSHADE_SLICES
+                if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
+                    v = (lights.light_rows.w & READ_DISKS) != 0u
+                        ? PASSED_FRACTION(ROWS_OF_DISK + i)
+                        : disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
+                                                       d.center_radius.w, 4u * k * k);
                 }
-            } else if (kind == BRDF_MEASURED) {
-                // Ward's isotropic half-vector distribution about n with the table's alpha (see the Rust).
-                float alpha = measured_sampling_alpha(m.ks.w);
-                float tan2 = -alpha * alpha * log_accurate(xi1);
-                float cos_d = 1.0 / sqrt(1.0 + tan2);
-                float sin_d = sqrt(tan2) * cos_d;
-                vec3 h = sin_d * (cos(phi) * t + sin(phi) * b) + cos_d * n;
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
-                    vec3 value = specular_lobe_rgb(m, p, omega) * weight;
-                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
+#endif
+                if (v < 0.0) {
+                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
+                                              d.direction.xyz, d.center_radius.w);
                 }
             }
         }
+        if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
+            bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;
+            v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal, d.center_radius.xyz,
+                d.direction.xyz, d.center_radius.w, pcss);
+            disk_map_fraction[i] = v;
+        }
+        omega = omega * v;
+        e += d.radiance.rgb * omega;
     }
-    return sum / (k * k);
-}
-
-#include "sky_lune.glsl"
-
-// integral of lobe (n.w)+ over the sky (the hemisphere above the horizontal, per unit radiance): the hemisphere's
-// inverse-CDF grid less the lower lune while the lobe's peak is above the horizontal, the upper lune's own grid
-// once it is below, a blend between; at least 0 (see the Rust).
-vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
-    float s = sky_lune_blend(m, p);
-    vec3 direct = s > 0.0 ? sky_lobe_in_lune(m, p, per_axis, LUNE_ABOVE, shadowed) : vec3(0.0);
-    vec3 by_difference = vec3(0.0);
-    if (s < 1.0) {
-        by_difference = max(sky_lobe_hemisphere_grid(m, p, per_axis, shadowed)
-            - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false), vec3(0.0));
+    if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
+        float v = 1.0;
+        if (SHADOWS_ON && normal.y > -1.0) {
+            // By the slices the sky's passes took before this one, where they did (gpu::slice_passes).
+            v = -1.0;
+#ifdef SUNSHADE_SLICES
+            if ((lights.light_rows.w & READ_SKY) != 0u) {
+                v = PASSED_FRACTION(ROWS_OF_SKY);
+            }
+#endif
+            if (v < 0.0) {
+                v = sky_visible_fraction(p.shadow_origin, k, normal);
+            }
+        }
+        e += sky_irradiance(lights.sky.rgb, normal.y) * v;
     }
-    return (1.0 - s) * by_difference + s * direct;
+    return e;
 }
 
 // Outgoing radiance [W/(m^2 sr)] per channel from the visible part of each light. `p.normal` is unit (or 0) on

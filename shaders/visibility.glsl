@@ -404,43 +404,6 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     return fraction(visible, total);
 }
 
-// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]). Where the frame
-// has the sun's cells, their classification first: a cone that misses every triangle of its cell sees the whole
-// sun (1, what every ray of the grid would find), one within an opaque triangle none of it (0, where the whole disk
-// is above the surface's horizon so that the grid's weights are all positive); only a penumbra casts the grid's
-// rays, against the cell's triangles.
-float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
-    uint kind = GRID_LIGHT_SUN;
-#ifdef SUNSHADE_SHADOW_RAYS
-    float sin_sigma = sin(0.5 * angular_diameter);
-    uint cone = sun_cone_class(origin, n, l, sin_sigma);
-    if (cone == SUN_CONE_MISSES) {
-        return 1.0;
-    }
-    if (cone == SUN_CONE_COVERED && dot(n, l) > sin_sigma + SUN_CONE_MARGIN) {
-        return 0.0;
-    }
-    kind = cone == SUN_CONE_UNKNOWN ? GRID_LIGHT_SUN : GRID_LIGHT_SUN_CELLS;
-#endif
-    vec3 t = orthonormal_to(l);
-    VisibilityLight L = VisibilityLight(kind, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
-                                        tan(0.5 * angular_diameter), 0.0);
-    return grid_fraction(origin, k, L);
-}
-
-// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
-float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
-    vec3 a = orthonormal_to(d);
-    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius, 0.0);
-    return grid_fraction(origin, k, L);
-}
-
-// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: the
-// located grid over the sky's lune (sky_visible_fraction in the Rust).
-float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
-    return grid_fraction(origin, k, sky_lune(n));
-}
-
 // The push along the face normal: 2^-16 max |p_i|_inf.
 float ray_offset(vec3 p0, vec3 p1, vec3 p2) {
     vec3 m = max(max(abs(p0), abs(p1)), abs(p2));

@@ -6,9 +6,8 @@ use glam::{DVec3, Mat4, Vec4};
 
 use crate::scene::camera::{near_far_around, AUTO_FOV_DEGREES};
 use crate::scene::{BoundingSphere, Camera, DiskLight, Lights, Projection, Scene, Sun};
-use crate::shading::radiometry::{
-    degrees_to_radians, sun_irradiance_from_radiance, DEFAULT_SUN_IRRADIANCE, SUN_ANGULAR_DIAMETER_DEGREES,
-};
+use crate::shading::lights::sun::sun_irradiance_from_radiance;
+use crate::shading::radiometry::{degrees_to_radians, DEFAULT_SUN_IRRADIANCE, SUN_ANGULAR_DIAMETER_DEGREES};
 use crate::shading::{ShadingOptions, SunChoice};
 
 /// Default image size \[pixels\].

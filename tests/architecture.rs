@@ -95,7 +95,9 @@ fn the_glsl_parser_sees_every_definition() {
 /// relative path (the same name) first, where the pairing is one to one; else the reason the GPU's file gathers
 /// several.
 const MIRRORED: &[(&str, &[&str], &str)] = &[
-    ("radiometry.glsl", &["src/shading/radiometry.rs"], ""),
+    ("lights/sun.glsl", &["src/shading/lights/sun.rs"], ""),
+    ("lights/disk.glsl", &["src/shading/lights/disk.rs"], ""),
+    ("lights/sky.glsl", &["src/shading/lights/sky.rs"], ""),
     ("brdf.glsl", &["src/shading/brdf.rs"], ""),
     ("shade.glsl", &["src/shading/shade.rs"], ""),
     ("sky_lune.glsl", &["src/shading/sky_lune.rs"], ""),
@@ -157,8 +159,13 @@ const GPU_ONLY_FILES: &[(&str, &str)] = &[
 fn every_shader_file_has_its_rust_twin_by_path() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut functions = 0;
-    for entry in std::fs::read_dir(root.join("shaders")).unwrap() {
-        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+    let shaders = root.join("shaders");
+    let mut names: Vec<String> = sources("shaders")
+        .into_iter()
+        .map(|(path, _)| Path::new(&path).strip_prefix(&shaders).unwrap().to_string_lossy().replace('\\', "/"))
+        .collect();
+    names.sort();
+    for name in names {
         if GPU_ONLY_FILES.iter().any(|(f, _)| *f == name) {
             continue;
         }
@@ -166,11 +173,12 @@ fn every_shader_file_has_its_rust_twin_by_path() {
             .iter()
             .find(|(f, _, _)| *f == name)
             .unwrap_or_else(|| panic!("shaders/{name} is neither paired with its Rust twin nor declared GPU-only"));
+        // The twin at the same relative path: shaders/lights/sun.glsl ↔ src/shading/lights/sun.rs.
         let stem = name.trim_end_matches(".glsl");
-        let first = Path::new(rust_files[0]).file_stem().unwrap().to_string_lossy();
         assert!(
-            first == stem || !why_several.is_empty(),
-            "shaders/{name}: its twin is {stem}.rs, not {first}.rs (or say why the GPU's file gathers several)"
+            rust_files[0].ends_with(&format!("/{stem}.rs")) || !why_several.is_empty(),
+            "shaders/{name}: its twin is {stem}.rs, not {} (or say why the GPU's file gathers several)",
+            rust_files[0]
         );
         let rust: String = rust_files
             .iter()

@@ -135,7 +135,7 @@ fn sun_lobe_integral_matches_the_closed_form() {
 #[test]
 fn disk_lobe_integral_resolves_narrow_and_wide_lobes() {
     use sunshade::shading::disk_lobe_integral;
-    use sunshade::shading::radiometry::{disk_projected_solid_angle, DiskGeometry};
+    use sunshade::shading::lights::disk::{disk_projected_solid_angle, DiskGeometry};
     let disk = DiskGeometry { center: DVec3::new(0.0, 2.5, 0.0), direction: -DVec3::Y, radius: 0.6 };
     for x in [0.0f64, 0.8, 2.0] {
         let position = DVec3::new(x, 0.0, 0.3);

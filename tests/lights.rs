@@ -13,8 +13,9 @@ use sunshade::authoring::{GltfBuilder, Node, Primitive, Transform};
 use sunshade::cpu;
 use sunshade::scene::{Camera, Lights, Projection, Scene, Sun};
 use sunshade::settings::RenderSettings;
+use sunshade::shading::lights::disk::DiskGeometry;
+use sunshade::shading::lights::sun::sun_irradiance_disk;
 use sunshade::shading::quadrature::integrate_composite;
-use sunshade::shading::radiometry::{sun_irradiance_disk, DiskGeometry};
 use sunshade::shading::{DiskModel, ShadingOptions, SunModel};
 use sunshade::Image;
 
@@ -197,7 +198,7 @@ fn closed_form_matches_quadrature(disk: DiskGeometry) {
         let a = i as f64 * 0.7;
         let x = DVec3::new(1.3 * a.sin(), 0.3 * (1.7 * a).cos(), 1.1 * (0.6 * a).cos());
         let n = DVec3::new((1.3 * a).cos(), (0.9 * a).sin() + 0.2, (2.1 * a).sin()).normalize();
-        let got = sunshade::shading::radiometry::disk_projected_solid_angle(x, n, &disk);
+        let got = sunshade::shading::lights::disk::disk_projected_solid_angle(x, n, &disk);
         let want = disk_converged(x, n, &disk);
         let n_perp = (n - n.dot(disk.direction) * disk.direction).length();
         partial += (n.dot(disk.center - x).abs() < disk.radius * n_perp) as usize;
@@ -221,7 +222,7 @@ fn thin_visible_slivers_of_a_disk_match_quadrature() {
             let u = DVec3::new(azimuth.cos(), 0.0, azimuth.sin());
             for alpha in [0.5f64, 0.31, 0.29, 0.1, 0.01, 1e-3] {
                 let Some(n) = receiver_normal_for_alpha(&disk, x, u, alpha) else { continue };
-                let got = sunshade::shading::radiometry::disk_projected_solid_angle(x, n, &disk);
+                let got = sunshade::shading::lights::disk::disk_projected_solid_angle(x, n, &disk);
                 let want = disk_converged(x, n, &disk);
                 assert!(rel(got, want) < 1e-9, "x {x} α {alpha}: {got} vs {want}");
                 count += 1;
@@ -524,7 +525,7 @@ fn receiver_normal_for_alpha(disk: &DiskGeometry, x: DVec3, u: DVec3, alpha: f64
 
 #[test]
 fn segment_quadrature_accuracy() {
-    use sunshade::shading::radiometry::{segment_projected_solid_angle, SEGMENT_ORDER};
+    use sunshade::shading::lights::disk::{segment_projected_solid_angle, SEGMENT_ORDER};
     let mut count = 0;
     // Receivers at least a radius from the disk: above it (h ≥ R) or nearly in its plane but beyond the rim.
     for h_over_r in [1.0f64, 1.5, 2.0, 5.0, 0.05] {

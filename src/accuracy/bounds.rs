@@ -366,7 +366,7 @@ pub fn sun_horizon_in_view(scene: &Scene, l: DVec3, r: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::radiometry::{sun_irradiance_delta, sun_irradiance_disk};
+    use crate::shading::lights::sun::{sun_irradiance_delta, sun_irradiance_disk};
 
     #[test]
     fn the_horizon_term_is_the_largest_gap_between_delta_and_disk_irradiance() {

@@ -18,7 +18,7 @@ use super::generated::{check_region, machine, print_output, today, update_region
 use super::CliError;
 use crate::scene::{self, Brdf, LoadOptions};
 use crate::shading::albedo::lobe_albedo;
-use crate::shading::radiometry::DiskGeometry;
+use crate::shading::lights::disk::DiskGeometry;
 use std::f64::consts::PI;
 
 use crate::shading::measured::measured_albedo;

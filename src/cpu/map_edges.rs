@@ -28,7 +28,7 @@ use glam::{DVec3, DVec4};
 use super::Occluders;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
-use crate::shading::visibility::{disk_visible_fraction, sun_visible_fraction};
+use crate::shading::lights::{disk::disk_visible_fraction, sun::sun_visible_fraction};
 use crate::shading::{orthonormal_to, Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, SunModel};
 use crate::shading::{DiskModel, MAPPED_DISKS};
 use crate::visibility::shadow_map::{fit_disk_map, fit_sun_map, DiskMapFrame, SunMapFrame};

@@ -12,7 +12,7 @@ use super::fragment::ray_frame;
 use super::{render_inner, Occluders, Prepared, ReferenceOptions};
 use crate::scene::{AlphaMode, Scene};
 use crate::settings::RenderSettings;
-use crate::shading::visibility::sun_visible_fraction;
+use crate::shading::lights::sun::sun_visible_fraction;
 use crate::shading::{Occlusion, ShadowedLights, Shadowing, SunModel};
 use crate::visibility::sun_cells::{
     sun_cell_range, sun_cone_class, SunCells, SunCone, MAX_SUN_CELL_ENTRIES, SUN_CONE_MARGIN,

@@ -161,8 +161,9 @@ pub fn disk_rows_weights(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shading::lights::disk::disk_visible_fraction;
     use crate::shading::sun_slices::{sun_rows_weights, sun_visible_fraction_sliced};
-    use crate::shading::visibility::{disk_visible_fraction, test_shadowing};
+    use crate::shading::visibility::test_shadowing;
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 

@@ -1,18 +1,19 @@
 //! Shading: radiometry, BRDFs, and the outgoing radiance at a surface point.
 //!
 //! This Rust code is the specification. It is written for f64 and used as is by the CPU reference renderer;
-//! the GLSL in `shaders/` (`radiometry.glsl`, `brdf.glsl`, `shade.glsl`, `visibility.glsl`, `surface.glsl`,
+//! the GLSL in `shaders/` (`lights/*.glsl`, `brdf.glsl`, `shade.glsl`, `visibility.glsl`, `surface.glsl`,
 //! `texture_filter.glsl`) mirrors it name for name in f32.
 
 pub mod albedo;
 pub mod brdf;
 pub mod brdf_fit;
 pub mod disk_slices;
+pub mod lights;
 pub mod measured;
 pub mod quadrature;
 pub mod quantity;
 pub mod radiometry;
-mod shade;
+pub(crate) mod shade;
 pub mod sky_lune;
 pub mod sky_slices;
 pub mod slice_buckets;
@@ -22,11 +23,13 @@ pub mod surface;
 pub mod texture_filter;
 pub mod visibility;
 
+pub use lights::disk::{disk_geometry, disk_lobe_integral};
+pub use lights::sky::sky_lobe_integral;
+pub use lights::sun::sun_lobe_integral;
 pub use quantity::Quantity;
 pub use shade::{
-    disk_geometry, disk_lobe_integral, irradiance, irradiance_visible, lobe_about_z, lobe_width,
-    normalized_lobe_integral, orthonormal_to, radiance_out, radiance_out_visible, safe_normalize, sky_lobe_integral,
-    specular_lobe, sun_lobe_integral, DiskModel, ShadingOptions, SunChoice, SunModel, SurfacePoint,
+    irradiance, irradiance_visible, lobe_about_z, lobe_width, normalized_lobe_integral, orthonormal_to, radiance_out,
+    radiance_out_visible, safe_normalize, specular_lobe, DiskModel, ShadingOptions, SunChoice, SunModel, SurfacePoint,
     DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{

@@ -2,11 +2,11 @@
 //!
 //! The sky is uniform over the upper hemisphere (`ω·up > 0`, up = +Y), so a surface tilted by `t` from up sees
 //! it through the **upper lune** `{n·ω > 0, ω·up > 0}` of dihedral angle `π − t`: its irradiance is
-//! `π L (1 + cos t)/2` (`radiometry::sky_irradiance`). The lobe integral is sampled through each lobe's own
-//! inverse CDF over the whole hemisphere about n (`shade::sky_lobe_hemisphere_grid`), which cannot clip at the
+//! `π L (1 + cos t)/2` (`lights::sky::sky_irradiance`). The lobe integral is sampled through each lobe's own
+//! inverse CDF over the whole hemisphere about n (`lights::sky::sky_lobe_hemisphere_grid`), which cannot clip at the
 //! horizontal without an indicator that jumps inside the grid's cells (first-order convergence, and a sample
 //! within rounding of the horizontal counted by one renderer and not the other moves a pixel by its whole
-//! weight). So `shade::sky_lobe_integral_visible` subtracts the **lower lune**'s integral, computed here on a grid
+//! weight). So `lights::sky::sky_lobe_integral_visible` subtracts the **lower lune**'s integral, computed here on a grid
 //! whose edges are the lune's own, while the lobe's peak is above the horizontal, and takes the upper lune's
 //! integral from its own grid once the peak is below ([`sky_lune_blend`]).
 //!
@@ -258,7 +258,7 @@ pub fn sky_lobe_in_lune(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::shade::sky_lobe_integral;
+    use crate::shading::lights::sky::sky_lobe_integral;
 
     fn point(normal: DVec3, to_viewer: DVec3) -> SurfacePoint {
         let tangent = crate::scene::tangent::default_tangent(normal);

@@ -419,7 +419,8 @@ pub fn sky_rows_weights(s: &Shadowing, n: DVec3, rows: u32, first: u32, count: u
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::visibility::{sky_visible_fraction, test_shadowing};
+    use crate::shading::lights::sky::sky_visible_fraction;
+    use crate::shading::visibility::test_shadowing;
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 

@@ -149,7 +149,8 @@ pub fn sun_rows_weights(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shading::visibility::{sun_visible_fraction, test_shadowing};
+    use crate::shading::lights::sun::sun_visible_fraction;
+    use crate::shading::visibility::test_shadowing;
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 

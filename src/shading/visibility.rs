@@ -47,8 +47,6 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::shade::orthonormal_to;
-
 /// Default side of the visibility grids, `k = 6` (`--shadow-samples 36`): the sun and disk lights cast `(k + 1)² = 49`
 /// rays a pixel (up to 85 in a penumbra, locating its edges), the sky 30 (25 on a floor: its lune's sides of zero
 /// weight cast none; up to 66 with its edges). Chosen by measurement
@@ -331,7 +329,7 @@ fn sample_visible(s: &Shadowing, ray: SampleRay) -> bool {
 
 /// What a visible-fraction grid samples: the light and the receiving point's frame (mirrored by the shaders'
 /// `VisibilityLight`).
-enum GridLight {
+pub(crate) enum GridLight {
     /// The sun's cap: receiver normal `n`, direction `l`, frame `(t, b)` about it, disk radius `tan σ`.
     Sun { n: DVec3, l: DVec3, t: DVec3, b: DVec3, radius: f64 },
     /// A disk light seen from `x` with normal `n`: centre [m], emission direction `d`, frame `(a, b)`, radius [m].
@@ -468,7 +466,7 @@ pub fn cell_visible_area(seen: [bool; 4], bottom: f64, right: f64, top: f64, lef
 ///
 /// The sums run in a fixed order and add the same weights to `visible` and `total`, so a wholly visible light is
 /// exactly 1 and a wholly blocked one exactly 0: only penumbrae see the grid.
-fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
+pub(crate) fn grid_fraction(s: &Shadowing, light: &GridLight) -> f64 {
     let k = s.samples_per_axis as usize;
     if k <= 1 {
         let (w, ray) = light.light_sample((0.5, 0.5));
@@ -561,37 +559,6 @@ pub fn disk_sample(
     (y, if cos_r > 0.0 && cos_d > 0.0 { cos_r * cos_d / dist2 } else { 0.0 })
 }
 
-/// The cosine-weighted visible fraction of the sun's disk (direction `l`, angular diameter δ \[rad\]) from a point
-/// with unit normal `n`.
-///
-/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
-/// (`sun_slices`; the GPU too, shaders/slices.glsl, where its shader walks the BVH).
-pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter: f64) -> f64 {
-    if let Some(v) = s.by_slices(|rows| super::sun_slices::sun_visible_fraction_sliced(s, n, l, angular_diameter, rows))
-    {
-        return v;
-    }
-    let radius = (0.5 * angular_diameter).tan();
-    let t = orthonormal_to(l);
-    let b = l.cross(t);
-    grid_fraction(s, &GridLight::Sun { n, l, t, b, radius })
-}
-
-/// The visible fraction of a disk light (centre \[m\], unit emission direction `d`, radius \[m\]), weighted by
-/// projected solid angle, from the point `x` with unit normal `n`.
-///
-/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes it by slices instead
-/// (`disk_slices`; the GPU too, as the sun's).
-pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> f64 {
-    if let Some(v) = s.by_slices(|rows| super::disk_slices::disk_visible_fraction_sliced(s, n, center, d, radius, rows))
-    {
-        return v;
-    }
-    let a = orthonormal_to(d);
-    let b = d.cross(a);
-    grid_fraction(s, &GridLight::Disk { x, n, center, d, a, b, radius })
-}
-
 /// The sky above a surface, as a located grid samples it: the lune of directions above both the ground's horizon
 /// (`ω_y > 0`) and the surface's (`n·ω > 0`). Both horizons are great circles through the horizontal axis `a ⊥ n`,
 /// so the lune is `ω(β, ψ) = cos β a + sin β (cos ψ e + sin ψ ŷ)` for `β ∈ [0, π]` (the angle from `a`) and
@@ -644,30 +611,6 @@ pub fn sky_sample(lune: &SkyLune, (u, v): (f64, f64)) -> (DVec3, f64) {
     (omega, sin_b * sin_b * (psi + lune.tilt).min(width * (1.0 - u)).sin())
 }
 
-/// The visible fraction of the sky (the directions with `ω_y > 0`), cosine-weighted, from a point with unit
-/// normal `n`: its view factor to the sky relative to the unoccluded one, by `grid_fraction`'s located edges over
-/// the sky's lune ([`SkyLune`], [`sky_sample`]).
-///
-/// The grid covers the lune and nothing else, so neither horizon is an edge inside it: the ground's is the grid's
-/// side `u = 0`, the surface's the side `u = 1` (weight 0, no rays). Located on the cosine-weighted disk of the
-/// whole hemisphere instead (Malley's method, the count's grid before), the edges converged at first order on the
-/// roofs of the tests (5.1e-2, 2.7e-2, 1.3e-2 at 8², 16², 32² over a floor): the rim's rays graze the surface (a
-/// floor's rim is its horizon, and rounding decides what its rays meet), and for a tilted surface the ground's
-/// horizon is a curve inside the grid, near its rim, whose crossings use up the grid's allowance.
-/// The squares at the lune's ends and along the surface's horizon have corners of weight 0 and count their corners
-/// (first order), but their weight is itself of the order of the spacing there (`sin²β`, `sin(width − ψ)`), so
-/// their error is second order with the rest. The rays along the ground's horizon (`u = 0`) are horizontal: they
-/// reach what stands at the point's own height, the limit of the sky's rays just above it.
-///
-/// Where `s.slices` asks for it and the occluders are opaque triangles, the reference takes the fraction by
-/// slices instead (`sky_slices`: exact along one angle, second order in its rows; the GPU in passes of them).
-pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
-    if let Some(v) = s.by_slices(|rows| super::sky_slices::sky_visible_fraction_sliced(s, n, rows)) {
-        return v;
-    }
-    grid_fraction(s, &GridLight::Sky(sky_lune(n)))
-}
-
 /// The push along the face normal for a triangle with these corners \[m\]: `2⁻¹⁶ max |pᵢ|∞` (see the module docs).
 pub fn ray_offset(corners: &[DVec3; 3]) -> f64 {
     let m = corners.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max);
@@ -702,6 +645,8 @@ pub(crate) fn test_shadowing(occ: &dyn Occlusion, origin: DVec3, k: u32) -> Shad
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[allow(unused_imports)]
+    use crate::shading::lights::{disk::*, sky::*, sun::*};
 
     /// An infinite half-plane occluder `{y = height, x < edge}`: exact, for tests.
     struct HalfPlane {

@@ -1,54 +1,19 @@
-// Radiometry in f32. Mirrors src/shading/radiometry.rs name for name (the Rust is the specification, and its
-// doc comments derive the formulas and say where precision is at stake).
+// Disk lights in f32: the projected solid angle (the small-source estimate, and the exact value by Stokes' theorem,
+// the disk cut by the horizon included) and the visible fraction. Mirrors src/shading/lights/disk.rs name for name
+// (the Rust is the specification; its doc comments derive the formulas and say where precision is at stake).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
-#ifndef SUNSHADE_RADIOMETRY_GLSL
-#define SUNSHADE_RADIOMETRY_GLSL
+#ifndef SUNSHADE_LIGHTS_DISK_GLSL
+#define SUNSHADE_LIGHTS_DISK_GLSL
 
 #include "math.glsl"
+#include "visibility.glsl"
 
-// Irradiance [W/m^2] from the sun as a direction (delta light): E = E_perp * max(0, n.l).
-vec3 sun_irradiance_delta(vec3 irradiance_normal, float n_dot_l) {
-    return irradiance_normal * max(n_dot_l, 0.0);
-}
-
-// atan(t) - t without cancellation: the series for |t| < 0.5 (14 terms: below f32 rounding), else the difference.
-float atan_minus_identity(float t) {
-    if (abs(t) >= 0.5) {
-        return atan_accurate(t) - t;
-    }
-    float t2 = t * t;
-    float sum = 0.0;
-    for (int k = 14; k >= 1; --k) {
-        float sign = (k % 2 == 0) ? 1.0 : -1.0;
-        sum = sum * t2 + sign / float(2 * k + 1);
-    }
-    return sum * t2 * t;
-}
-
-// Irradiance [W/m^2] from the sun as a disk of angular diameter `angular_diameter`, exact also while it sets
-// (see the Rust for the derivation and the rewriting that avoids the cancellation of two terms of ~1/sigma).
-vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_diameter) {
-    float s = sin(0.5 * angular_diameter);
-    float c = cos(0.5 * angular_diameter);
-    if (cos_theta >= s) {
-        return irradiance_normal * cos_theta;
-    }
-    if (cos_theta <= -s) {
-        return vec3(0.0);
-    }
-    float sin_theta = sqrt((1.0 - cos_theta) * (1.0 + cos_theta));
-    float k = clamp((c * cos_theta) / (s * sin_theta), -1.0, 1.0);
-    float sin_phi0 = sqrt((1.0 - k) * (1.0 + k));
-    float pi_minus_phi0 = atan2_accurate(sin_phi0, -k);
-    float t = s * sin_theta * sin_phi0 / c;
-    float projected = s * s * (cos_theta * pi_minus_phi0 + t) + atan_minus_identity(t);
-    return irradiance_normal * (projected / (PI * s * s));
-}
-
-// Irradiance [W/m^2] from a uniform overcast sky of radiance L0: E = pi L0 (1 + cos t)/2.
-vec3 sky_irradiance(vec3 radiance, float n_dot_up) {
-    return PI * radiance * (0.5 * (1.0 + n_dot_up));
-}
+// A partly visible disk's segment is integrated directly when it is thin (rim arc half-angle below this) or the
+// receiver is at least a radius from every point of the disk; the contour form is used otherwise (see the Rust).
+const float THIN_SEGMENT_ALPHA = 0.3;
+// 16-point Gauss-Legendre, the positive half (nodes, weights); the rule is symmetric.
+const float GL16_X[8] = float[8](0.095012509837637441, 0.28160355077925892, 0.45801677765722737, 0.61787624440264377, 0.755404408355003, 0.86563120238783176, 0.9445750230732326, 0.98940093499164994);
+const float GL16_W[8] = float[8](0.18945061045506864, 0.18260341504492364, 0.16915651939500265, 0.14959598881657671, 0.12462897125553407, 0.095158511682492605, 0.062253523938647456, 0.027152459411754176);
 
 // The small-source estimate of a disk's projected solid angle [sr]: A cos_r cos_d / d^2.
 float disk_projected_solid_angle_small_source(vec3 x, vec3 n, vec3 center, vec3 direction, float radius) {
@@ -139,13 +104,6 @@ vec3 rim_integrals(float phi_a, float phi_b, float b0, float b) {
     return j;
 }
 
-// A partly visible disk's segment is integrated directly when it is thin (rim arc half-angle below this) or the
-// receiver is at least a radius from every point of the disk; the contour form is used otherwise (see the Rust).
-const float THIN_SEGMENT_ALPHA = 0.3;
-// 16-point Gauss-Legendre, the positive half (nodes, weights); the rule is symmetric.
-const float GL16_X[8] = float[8](0.095012509837637441, 0.28160355077925892, 0.45801677765722737, 0.61787624440264377, 0.755404408355003, 0.86563120238783176, 0.9445750230732326, 0.98940093499164994);
-const float GL16_W[8] = float[8](0.18945061045506864, 0.18260341504492364, 0.16915651939500265, 0.14959598881657671, 0.12462897125553407, 0.095158511682492605, 0.062253523938647456, 0.027152459411754176);
-
 // The projected solid angle of a visible segment by 16 x 16 Gauss-Legendre over beta in [0, alpha] and
 // s in [-1, 1]: the integrand (n.y) h / |y|^4 R^2 sin^2(beta) is positive and smooth, so nothing cancels.
 float segment_projected_solid_angle(vec3 n, vec3 d, vec3 q, float h, float radius, float alpha) {
@@ -216,6 +174,13 @@ float disk_projected_solid_angle(vec3 x, vec3 n, vec3 center, vec3 direction, fl
         return 0.0;
     }
     return partial_disk_projected_solid_angle(n, direction, q, r_perp, h, sqrt(rho2), radius);
+}
+
+// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
+float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+    vec3 a = orthonormal_to(d);
+    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius, 0.0);
+    return grid_fraction(origin, k, L);
 }
 
 #endif

@@ -1,0 +1,112 @@
+// The overcast sky in f32: the irradiance it gives a tilted surface, its visible fraction, and the specular lobe
+// integrated over it. Mirrors src/shading/lights/sky.rs name for name (see it for the derivations). Included by
+// shade.glsl after the lobe machinery and sky_lune.glsl, which its lobe integral uses.
+// Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
+#ifndef SUNSHADE_LIGHTS_SKY_GLSL
+#define SUNSHADE_LIGHTS_SKY_GLSL
+
+#include "math.glsl"
+#include "visibility.glsl"
+
+// Irradiance [W/m^2] from a uniform overcast sky of radiance L0: E = pi L0 (1 + cos t)/2.
+vec3 sky_irradiance(vec3 radiance, float n_dot_up) {
+    return PI * radiance * (0.5 * (1.0 + n_dot_up));
+}
+
+// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: the
+// located grid over the sky's lune (sky_visible_fraction in the Rust).
+float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
+    return grid_fraction(origin, k, sky_lune(n));
+}
+
+// integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
+// lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
+// (see the Rust).
+vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+    vec3 n = p.normal;
+    vec3 v = p.to_viewer;
+    uint kind = VARIANT_BRDF;
+    // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
+    vec3 axis = kind == BRDF_PHONG ? mirror(v, n) : n;
+    vec3 t = orthonormal_to(axis);
+    vec3 b = cross(axis, t);
+    float k = float(per_axis);
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < per_axis; ++i) {
+        float xi1 = (float(i) + 0.5) / k;
+        for (uint j = 0u; j < per_axis; ++j) {
+            float xi2 = (float(j) + 0.5) / k;
+            float phi = 2.0 * PI * xi2;
+            if (kind == BRDF_PHONG) {
+                float e = m.ks.w;
+                vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
+                float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
+                if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
+                    sum += value;
+                }
+            } else if (kind == BRDF_BLINN_PHONG) {
+                float e = m.ks.w;
+                vec3 h = cos_power_direction(axis, t, b, e, xi1, phi);
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
+                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
+                }
+            } else if (kind == BRDF_WARD) {
+                float ax = m.params.x;
+                float ay = m.params.y;
+                float phi_h = atan2_accurate(ay * sin(phi), ax * cos(phi));
+                float sp = sin(phi_h);
+                float cp = cos(phi_h);
+                float tan2 = -log_accurate(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
+                float cos_d = 1.0 / sqrt(1.0 + tan2);
+                float sin_d = sqrt(tan2) * cos_d;
+                vec3 h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    float value = max(dot(n, omega), 0.0) / (vh * cos_d);
+                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
+                }
+            } else if (kind == BRDF_MEASURED) {
+                // Ward's isotropic half-vector distribution about n with the table's alpha (see the Rust).
+                float alpha = measured_sampling_alpha(m.ks.w);
+                float tan2 = -alpha * alpha * log_accurate(xi1);
+                float cos_d = 1.0 / sqrt(1.0 + tan2);
+                float sin_d = sqrt(tan2) * cos_d;
+                vec3 h = sin_d * (cos(phi) * t + sin(phi) * b) + cos_d * n;
+                float vh = dot(v, h);
+                if (vh > 0.0) {
+                    vec3 omega = 2.0 * vh * h - v;
+                    float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
+                    vec3 value = specular_lobe_rgb(m, p, omega) * weight;
+                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
+                        sum += value;
+                    }
+                }
+            }
+        }
+    }
+    return sum / (k * k);
+}
+
+// integral of lobe (n.w)+ over the sky (the hemisphere above the horizontal, per unit radiance): the hemisphere's
+// inverse-CDF grid less the lower lune while the lobe's peak is above the horizontal, the upper lune's own grid
+// once it is below, a blend between; at least 0 (see the Rust).
+vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+    float s = sky_lune_blend(m, p);
+    vec3 direct = s > 0.0 ? sky_lobe_in_lune(m, p, per_axis, LUNE_ABOVE, shadowed) : vec3(0.0);
+    vec3 by_difference = vec3(0.0);
+    if (s < 1.0) {
+        by_difference = max(sky_lobe_hemisphere_grid(m, p, per_axis, shadowed)
+            - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false), vec3(0.0));
+    }
+    return (1.0 - s) * by_difference + s * direct;
+}
+
+#endif

@@ -1,0 +1,80 @@
+// The sun in f32: its irradiance (a delta light, and a disk cut by the horizon), its projected solid angle above
+// the horizon, and the visible fraction of its disk. Mirrors src/shading/lights/sun.rs name for name (the Rust is
+// the specification; its doc comments derive the formulas and say where precision is at stake).
+// Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
+#ifndef SUNSHADE_LIGHTS_SUN_GLSL
+#define SUNSHADE_LIGHTS_SUN_GLSL
+
+#include "math.glsl"
+#include "visibility.glsl"
+
+// Irradiance [W/m^2] from the sun as a direction (delta light): E = E_perp * max(0, n.l).
+vec3 sun_irradiance_delta(vec3 irradiance_normal, float n_dot_l) {
+    return irradiance_normal * max(n_dot_l, 0.0);
+}
+
+// atan(t) - t without cancellation: the series for |t| < 0.5 (14 terms: below f32 rounding), else the difference.
+float atan_minus_identity(float t) {
+    if (abs(t) >= 0.5) {
+        return atan_accurate(t) - t;
+    }
+    float t2 = t * t;
+    float sum = 0.0;
+    for (int k = 14; k >= 1; --k) {
+        float sign = (k % 2 == 0) ? 1.0 : -1.0;
+        sum = sum * t2 + sign / float(2 * k + 1);
+    }
+    return sum * t2 * t;
+}
+
+// Irradiance [W/m^2] from the sun as a disk of angular diameter `angular_diameter`, exact also while it sets
+// (see the Rust for the derivation and the rewriting that avoids the cancellation of two terms of ~1/sigma).
+vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_diameter) {
+    float s = sin(0.5 * angular_diameter);
+    float c = cos(0.5 * angular_diameter);
+    if (cos_theta >= s) {
+        return irradiance_normal * cos_theta;
+    }
+    if (cos_theta <= -s) {
+        return vec3(0.0);
+    }
+    float sin_theta = sqrt((1.0 - cos_theta) * (1.0 + cos_theta));
+    float k = clamp((c * cos_theta) / (s * sin_theta), -1.0, 1.0);
+    float sin_phi0 = sqrt((1.0 - k) * (1.0 + k));
+    float pi_minus_phi0 = atan2_accurate(sin_phi0, -k);
+    float t = s * sin_theta * sin_phi0 / c;
+    float projected = s * s * (cos_theta * pi_minus_phi0 + t) + atan_minus_identity(t);
+    return irradiance_normal * (projected / (PI * s * s));
+}
+
+// The projected solid angle [sr] of the sun's cap above the horizon: pi sin^2(delta/2) E / E_perp.
+float sun_projected_solid_angle_above(float n_dot_l, float angular_diameter) {
+    float s = sin(0.5 * angular_diameter);
+    return PI * s * s * sun_irradiance_disk(vec3(1.0), n_dot_l, angular_diameter).x;
+}
+
+// The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]). Where the frame
+// has the sun's cells, their classification first: a cone that misses every triangle of its cell sees the whole
+// sun (1, what every ray of the grid would find), one within an opaque triangle none of it (0, where the whole disk
+// is above the surface's horizon so that the grid's weights are all positive); only a penumbra casts the grid's
+// rays, against the cell's triangles.
+float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_diameter) {
+    uint kind = GRID_LIGHT_SUN;
+#ifdef SUNSHADE_SHADOW_RAYS
+    float sin_sigma = sin(0.5 * angular_diameter);
+    uint cone = sun_cone_class(origin, n, l, sin_sigma);
+    if (cone == SUN_CONE_MISSES) {
+        return 1.0;
+    }
+    if (cone == SUN_CONE_COVERED && dot(n, l) > sin_sigma + SUN_CONE_MARGIN) {
+        return 0.0;
+    }
+    kind = cone == SUN_CONE_UNKNOWN ? GRID_LIGHT_SUN : GRID_LIGHT_SUN_CELLS;
+#endif
+    vec3 t = orthonormal_to(l);
+    VisibilityLight L = VisibilityLight(kind, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
+                                        tan(0.5 * angular_diameter), 0.0);
+    return grid_fraction(origin, k, L);
+}
+
+#endif

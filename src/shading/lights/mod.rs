@@ -1,0 +1,7 @@
+//! The lights, one file each: a light's irradiance term, its specular lobe integrated over it, and its visible
+//! fraction, side by side (`shaders/lights/` mirrors each file). The sample grids the visible fractions share are in
+//! `shading::visibility`, the lobe integrals' quadrature in `shading::shade`.
+
+pub mod disk;
+pub mod sky;
+pub mod sun;
