@@ -652,8 +652,7 @@ pub fn radiance_out_visible(
 mod tests {
     use super::*;
     use crate::scene::Sun;
-    #[allow(unused_imports)]
-    use crate::shading::lights::{disk::*, sky::*, sun::*};
+    use crate::shading::lights::sky::sky_lobe_integral;
 
     fn point(normal: DVec3, to_viewer: DVec3) -> SurfacePoint {
         let tangent = crate::scene::tangent::default_tangent(normal);

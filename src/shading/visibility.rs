@@ -645,8 +645,7 @@ pub(crate) fn test_shadowing(occ: &dyn Occlusion, origin: DVec3, k: u32) -> Shad
 #[cfg(test)]
 mod tests {
     use super::*;
-    #[allow(unused_imports)]
-    use crate::shading::lights::{disk::*, sky::*, sun::*};
+    use crate::shading::lights::{disk::disk_visible_fraction, sky::sky_visible_fraction, sun::sun_visible_fraction};
 
     /// An infinite half-plane occluder `{y = height, x < edge}`: exact, for tests.
     struct HalfPlane {

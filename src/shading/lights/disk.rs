@@ -1,4 +1,4 @@
-//! Disk lights: a disk of radius `R` [m] and uniform radiance `L0` [W/(m²·sr)] emitting along `d`. Everything
+//! Disk lights: a disk of radius `R` \[m\] and uniform radiance `L0` [W/(m²·sr)] emitting along `d`. Everything
 //! sunshade computes of one in one place: its projected solid angle (the lecture's small-source estimate
 //! `A (n·l)⁴ / f²` and the exact value by Stokes' theorem, the disk cut by the horizon included), its specular lobe
 //! integrated over the disk, and its visible fraction. `shaders/lights/disk.glsl` mirrors it name for name.
@@ -245,7 +245,7 @@ pub fn disk_geometry(d: &DiskLight) -> DiskGeometry {
 }
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the part of a disk light above the horizon, per unit radiance.
-/// The grid's sum is taken as it is: the ratio of [`normalized_lobe_integral`] would bring the f32 error of the
+/// The grid's sum is taken as it is: the ratio of [`normalized_lobe_integral`](crate::shading::normalized_lobe_integral) would bring the f32 error of the
 /// disk's closed-form projected solid angle into every lobe on the GPU (measured: 3.3e-5 against the reference on
 /// brdfs.glb's disks, over the 1e-5 of `render --check`).
 /// Per channel, the first (an analytic lobe's three are equal).
@@ -267,4 +267,76 @@ pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d
     let a = orthonormal_to(d);
     let b = d.cross(a);
     grid_fraction(s, &GridLight::Disk { x, n, center, d, a, b, radius })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::quadrature::integrate_composite as composite;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    fn down_disk(height: f64, radius: f64) -> DiskGeometry {
+        DiskGeometry { center: DVec3::new(0.0, height, 0.0), direction: -DVec3::Y, radius }
+    }
+
+    #[test]
+    fn disk_on_axis_and_off_axis_match_the_view_factor_formulas() {
+        for (f, r) in [(2.0, 0.1), (2.0, 0.5), (2.0, 2.0), (2.0, 8.0), (1.0, 1e-3)] {
+            let disk = down_disk(f, r);
+            let on_axis = disk_projected_solid_angle(DVec3::ZERO, DVec3::Y, &disk);
+            assert!(rel(on_axis, PI * r * r / (r * r + f * f)) < 1e-14, "{f} {r}: {on_axis}");
+            for rho in [0.01, 0.3, 1.0, 1.999, 2.0, 2.001, 5.0, 40.0] {
+                let x = DVec3::new(rho * 0.6, 0.0, rho * 0.8);
+                let got = disk_projected_solid_angle(x, DVec3::Y, &disk);
+                let (a, b) = (f * f + rho * rho + r * r, f * f + rho * rho - r * r);
+                let s = (a * a - 4.0 * rho * rho * r * r).sqrt();
+                let want = 0.5 * PI * (1.0 - b / s);
+                // The textbook form itself cancels for small sources: compare to its own precision.
+                let tol = 1e-13 * (a / (want * s)).max(1.0);
+                assert!(rel(got, want) < tol.max(1e-12), "f {f} R {r} ρ {rho}: {got} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn receivers_behind_or_in_the_plane_of_the_disk_get_nothing() {
+        let disk = down_disk(2.0, 1.0);
+        assert_eq!(disk_projected_solid_angle(DVec3::new(0.0, 3.0, 0.0), -DVec3::Y, &disk), 0.0);
+        assert_eq!(disk_projected_solid_angle(DVec3::new(3.0, 2.0, 0.0), DVec3::Y, &disk), 0.0);
+        // Facing away from the disk: the whole disk is below the horizon.
+        assert_eq!(disk_projected_solid_angle(DVec3::ZERO, -DVec3::Y, &disk), 0.0);
+    }
+
+    #[test]
+    fn small_source_estimate_on_the_floor_is_l0_a_cos4_over_f2() {
+        let disk = down_disk(2.0, 0.1);
+        for x in [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.5), DVec3::new(-3.0, 0.0, 2.0)] {
+            let cos = 2.0 / (disk.center - x).length();
+            let want = PI * 0.01 * cos.powi(4) / 4.0;
+            assert!(rel(disk_projected_solid_angle_small_source(x, DVec3::Y, &disk), want) < 1e-14);
+        }
+        // The estimate converges to the exact value as the disk shrinks, and differs for a big one.
+        let exact = |r: f64| disk_projected_solid_angle(DVec3::ZERO, DVec3::Y, &down_disk(2.0, r));
+        let small = |r: f64| disk_projected_solid_angle_small_source(DVec3::ZERO, DVec3::Y, &down_disk(2.0, r));
+        assert!(rel(small(0.01), exact(0.01)) < 3e-5);
+        assert!(rel(small(2.0), exact(2.0)) > 0.5);
+    }
+
+    #[test]
+    fn rim_integrals_match_quadrature_on_and_off_the_axis() {
+        for (b0, b) in [(2.0, 0.0), (2.0, 1e-9), (2.0, 1e-3), (2.0, 1.0), (2.0, 1.99)] {
+            for (pa, pb) in [(-0.3, 1.2), (2.0, 4.0), (-3.5, -2.9), (-1.0, 5.0), (0.0, 2.0 * PI)] {
+                let (j0, jc, js) = rim_integrals(pa, pb, b0, b);
+                let w0 = composite(pa, pb, 200, 32, |p| 1.0 / (b0 + b * p.cos()));
+                let wc = composite(pa, pb, 200, 32, |p| p.cos() / (b0 + b * p.cos()));
+                let ws = composite(pa, pb, 200, 32, |p| p.sin() / (b0 + b * p.cos()));
+                for (g, w) in [(j0, w0), (jc, wc), (js, ws)] {
+                    assert!((g - w).abs() < 1e-11 * w0.abs(), "B0 {b0} B {b} [{pa}, {pb}]: {g} vs {w}");
+                }
+            }
+        }
+    }
 }

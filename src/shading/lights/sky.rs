@@ -152,7 +152,7 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
 
 /// The visible fraction of the sky (the directions with `ω_y > 0`), cosine-weighted, from a point with unit
 /// normal `n`: its view factor to the sky relative to the unoccluded one, by `grid_fraction`'s located edges over
-/// the sky's lune ([`SkyLune`], [`sky_sample`]).
+/// the sky's lune ([`SkyLune`](crate::shading::visibility::SkyLune), [`sky_sample`](crate::shading::visibility::sky_sample)).
 ///
 /// The grid covers the lune and nothing else, so neither horizon is an edge inside it: the ground's is the grid's
 /// side `u = 0`, the surface's the side `u = 1` (weight 0, no rays). Located on the cosine-weighted disk of the
@@ -172,4 +172,20 @@ pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
         return v;
     }
     grid_fraction(s, &GridLight::Sky(sky_lune(n)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn sky_irradiance_of_an_overcast_day() {
+        assert!(rel(sky_irradiance(100.0, 1.0), PI * 100.0) < 1e-15);
+        assert!(rel(sky_irradiance(100.0, 0.0), PI * 50.0) < 1e-15);
+        assert_eq!(sky_irradiance(100.0, -1.0), 0.0);
+    }
 }

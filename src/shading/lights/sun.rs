@@ -1,5 +1,5 @@
 //! The sun: a disk of radiance `L_sun` [W/(m²·sr)] and angular diameter `θ` (0.53° by default), seen from a
-//! surface as a small cone of solid angle `Ω_sun = 2π(1 − cos(θ/2))` [sr]. Everything sunshade computes of it in
+//! surface as a small cone of solid angle `Ω_sun = 2π(1 − cos(θ/2))` \[sr\]. Everything sunshade computes of it in
 //! one place: its solid angles and the irradiance it gives (as a delta light and as a disk cut by the horizon), its
 //! specular lobe integrated over the disk, and the visible fraction of the disk. `shaders/lights/sun.glsl` mirrors
 //! it name for name.
@@ -104,7 +104,7 @@ pub fn sun_lobe_integral(brdf: &Brdf, p: &SurfacePoint, direction: DVec3, angula
     normalized_lobe_integral(sums, sun_projected_solid_angle_above(p.normal.dot(direction), angular_diameter))[0]
 }
 
-/// The projected solid angle [sr] of the sun's cap above a surface's horizon, `∫ (n·ω)+ dω`: the disk sun's
+/// The projected solid angle \[sr\] of the sun's cap above a surface's horizon, `∫ (n·ω)+ dω`: the disk sun's
 /// irradiance per unit radiance, `π sin²(δ/2) E/E⊥`.
 pub fn sun_projected_solid_angle_above(n_dot_l: f64, angular_diameter: f64) -> f64 {
     let s = (0.5 * angular_diameter).sin();
@@ -126,4 +126,120 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
     let t = orthonormal_to(l);
     let b = l.cross(t);
     grid_fraction(s, &GridLight::Sun { n, l, t, b, radius })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shading::quadrature::integrate;
+    use crate::shading::radiometry::*;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs()
+    }
+
+    #[test]
+    fn sun_solid_angle_and_radiance_give_1000_w_per_m2() {
+        let delta = degrees_to_radians(0.53);
+        let omega = sun_solid_angle(delta);
+        // Hand value: a = 0.265° = 4.6251e-3 rad, Ω ≈ π a² (1 − a²/12) = 6.7204e-5 sr.
+        assert!(rel(omega, 6.7204e-5) < 1e-4, "{omega}");
+        // The brief's figure: L_sun ≈ 1.47e7 W/(m²·sr) gives ≈ 1000 W/m² (within its 2 significant digits).
+        let e = sun_irradiance_from_radiance(1.47e7, delta);
+        assert!((e - 1000.0).abs() < 20.0, "{e}");
+        // E⊥ = L_sun Ω_sun to within sin²(δ/4) = 5.3e-6 relative.
+        let l = 1.47e7;
+        assert!((rel(l * omega, e) - 5.3e-6).abs() < 0.1e-6, "{}", rel(l * omega, e));
+        assert!(rel(sun_radiance_from_irradiance(e, delta), l) < 1e-15);
+    }
+
+    /// The sun's projected solid angle by quadrature over the cap's directions: polar angle β from the sun's
+    /// centre, azimuth ψ, visible where n·ω > 0 (a ψ-interval for each β).
+    fn sun_numerical(cos_theta: f64, sigma: f64, order: usize) -> f64 {
+        let sin_theta = (1.0 - cos_theta * cos_theta).sqrt();
+        let inner = |beta: f64| {
+            // n·ω = cos β cos θ + sin β sin θ cos ψ > 0.
+            let (sb, cb) = beta.sin_cos();
+            let f = |psi: f64| (cb * cos_theta + sb * sin_theta * psi.cos()).max(0.0) * sb;
+            let bound = if sb * sin_theta == 0.0 { 2.0 } else { -cb * cos_theta / (sb * sin_theta) };
+            if bound <= -1.0 {
+                integrate(0.0, 2.0 * PI, order, f)
+            } else if bound >= 1.0 {
+                0.0
+            } else {
+                2.0 * integrate(0.0, bound.acos(), order, f)
+            }
+        };
+        // The ψ-interval changes form where the bound crosses ±1.
+        let mut cuts = vec![0.0, sigma];
+        let b = (cos_theta / sin_theta).abs().atan();
+        if b > 0.0 && b < sigma {
+            cuts.insert(1, b);
+        }
+        cuts.windows(2).map(|w| integrate(w[0], w[1], order, inner)).sum()
+    }
+
+    #[test]
+    fn partly_set_sun_matches_numerical_integration_over_the_cap() {
+        for diameter_degrees in [0.53, 5.0, 30.0] {
+            let delta = degrees_to_radians(diameter_degrees);
+            let sigma = 0.5 * delta;
+            for frac in [-0.999, -0.7, -0.3, 0.0, 0.2, 0.6, 0.95, 0.999] {
+                let theta = 0.5 * PI - frac * sigma;
+                let e = sun_irradiance_disk(1.0, theta.cos(), delta);
+                let want = sun_numerical(theta.cos(), sigma, 200) / sun_projected_solid_angle(delta);
+                assert!(
+                    (e - want).abs() < 1e-10 * want.max(1e-12) + 1e-14,
+                    "δ {diameter_degrees}° frac {frac}: {e} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sun_irradiance_is_continuous_and_monotone_through_sunset() {
+        let delta = degrees_to_radians(0.53);
+        let sigma = 0.5 * delta;
+        let steps = 20_000;
+        let mut prev = f64::INFINITY;
+        let mut max_jump = 0.0f64;
+        for i in 0..=steps {
+            // Elevation of the centre from +2σ down to −2σ.
+            let elevation = sigma * (2.0 - 4.0 * i as f64 / steps as f64);
+            let e = sun_irradiance_disk(1000.0, elevation.sin(), delta);
+            assert!(e <= prev + 1e-12, "not monotone at elevation {elevation}");
+            if prev.is_finite() {
+                max_jump = max_jump.max(prev - e);
+            }
+            prev = e;
+        }
+        // A step of 4σ/20000 in elevation moves E by at most E⊥ · step (the slope of E⊥ sin(elevation) ≤ E⊥).
+        let step = 4.0 * sigma / steps as f64;
+        assert!(max_jump <= 1000.0 * step * 1.0001, "jump {max_jump} > {}", 1000.0 * step);
+        assert_eq!(sun_irradiance_disk(1000.0, (-1.01 * sigma).sin(), delta), 0.0);
+        let above = (1.01 * sigma).sin();
+        assert_eq!(sun_irradiance_disk(1000.0, above, delta), 1000.0 * above);
+        // Half set: E/E⊥ = 2σ/(3π) to leading order (the visible half-disk's mean elevation is 4σ/(3π)).
+        let half = sun_irradiance_disk(1.0, 0.0, delta);
+        assert!(rel(half, 2.0 * sigma / (3.0 * PI)) < 1e-4, "{half}");
+    }
+
+    #[test]
+    fn atan_minus_identity_is_accurate_near_zero() {
+        for t in [1e-8, 1e-4, 0.01, 0.3, 0.49, 0.5, 2.0, -0.2] {
+            // Reference from the series in higher effective precision: compare with atan(t) − t where that is
+            // well conditioned, and with −t³/3 + t⁵/5 for tiny t.
+            let got = atan_minus_identity(t);
+            let want = if t.abs() < 1e-3 { -t.powi(3) / 3.0 + t.powi(5) / 5.0 } else { t.atan() - t };
+            let tol = if t.abs() < 1e-3 { 1e-15 } else { 1e-15 / (want / t).abs() };
+            assert!(rel(got, want) < tol.max(1e-15), "{t}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn delta_sun_irradiance() {
+        assert_eq!(sun_irradiance_delta(1000.0, 0.5), 500.0);
+        assert_eq!(sun_irradiance_delta(1000.0, -0.5), 0.0);
+        assert_eq!(sun_irradiance_delta(1000.0, 0.0), 0.0);
+    }
 }
