@@ -100,6 +100,7 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
     ("lights/sky.glsl", &["src/shading/lights/sky.rs"], ""),
     ("brdf.glsl", &["src/shading/brdf.rs"], ""),
     ("shade.glsl", &["src/shading/shade.rs"], ""),
+    ("lobe.glsl", &["src/shading/lobe.rs"], ""),
     ("sky_lune.glsl", &["src/shading/sky_lune.rs"], ""),
     ("visibility.glsl", &["src/shading/visibility.rs"], ""),
     (

@@ -12,6 +12,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
     ("measured.glsl", include_str!("../../shaders/measured.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
+    ("lobe.glsl", include_str!("../../shaders/lobe.glsl")),
     ("sky_lune.glsl", include_str!("../../shaders/sky_lune.glsl")),
     ("lights/sun.glsl", include_str!("../../shaders/lights/sun.glsl")),
     ("lights/disk.glsl", include_str!("../../shaders/lights/disk.glsl")),

@@ -13,8 +13,8 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
+use super::lobe::{specular_lobe, SurfacePoint};
 use super::quadrature::gauss_legendre;
-use super::shade::{specular_lobe, SurfacePoint};
 use crate::scene::Brdf;
 
 /// A width [rad] on which the lobe varies in h, for grading the panels.

@@ -25,8 +25,8 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::lobe::lobe_about_z;
 use super::measured::{brdf_about_z, half_diff_directions};
-use super::shade::lobe_about_z;
 use crate::scene::measured::{merl_index, MeasuredBrdf, PHI_D_BINS, THETA_D_BINS, THETA_H_BINS};
 use crate::scene::{Brdf, BrdfKind};
 

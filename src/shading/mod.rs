@@ -9,6 +9,7 @@ pub mod brdf;
 pub mod brdf_fit;
 pub mod disk_slices;
 pub mod lights;
+pub mod lobe;
 pub mod measured;
 pub mod quadrature;
 pub mod quantity;
@@ -26,10 +27,12 @@ pub mod visibility;
 pub use lights::disk::{disk_geometry, disk_lobe_integral};
 pub use lights::sky::sky_lobe_integral;
 pub use lights::sun::sun_lobe_integral;
+pub use lobe::{
+    lobe_about_z, lobe_width, normalized_lobe_integral, orthonormal_to, safe_normalize, specular_lobe, SurfacePoint,
+};
 pub use quantity::Quantity;
 pub use shade::{
-    irradiance, irradiance_visible, lobe_about_z, lobe_width, normalized_lobe_integral, orthonormal_to, radiance_out,
-    radiance_out_visible, safe_normalize, specular_lobe, DiskModel, ShadingOptions, SunChoice, SunModel, SurfacePoint,
+    irradiance, irradiance_visible, radiance_out, radiance_out_visible, DiskModel, ShadingOptions, SunChoice, SunModel,
     DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
 pub use visibility::{

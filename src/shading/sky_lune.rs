@@ -27,7 +27,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::brdf::mirror;
-use super::shade::{
+use super::lobe::{
     graded_axis, graded_point, lobe_width, orthonormal_to, specular_lobe, specular_lobe_rgb, SurfacePoint,
 };
 use super::visibility::Shadowing;

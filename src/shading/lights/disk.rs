@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use crate::scene::{Brdf, DiskLight};
-use crate::shading::shade::segment_lobe_integral;
+use crate::shading::lobe::segment_lobe_integral;
 use crate::shading::visibility::{grid_fraction, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
 

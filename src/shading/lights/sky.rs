@@ -9,7 +9,7 @@ use glam::DVec3;
 
 use crate::scene::Brdf;
 use crate::shading::brdf::mirror;
-use crate::shading::shade::{cos_power_direction, measured_sampling_alpha, specular_lobe_rgb};
+use crate::shading::lobe::{cos_power_direction, measured_sampling_alpha, specular_lobe_rgb};
 use crate::shading::sky_lune::{sky_lobe_in_lune, sky_lune_blend, Lune};
 use crate::shading::visibility::{grid_fraction, sky_lune, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};

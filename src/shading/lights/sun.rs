@@ -9,8 +9,8 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use crate::scene::Brdf;
+use crate::shading::lobe::{normalized_lobe_integral, segment_lobe_integral};
 use crate::shading::radiometry::cone_solid_angle;
-use crate::shading::shade::{normalized_lobe_integral, segment_lobe_integral};
 use crate::shading::visibility::{grid_fraction, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
 
