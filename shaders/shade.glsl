@@ -53,7 +53,7 @@ vec3 irradiance_visible(Frame p) {
                 v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
             } else {
                 // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
-                // sky_slices::slice_rows), or as their passes took them before this one where the frame could not
+                // visibility::slice_rows), or as their passes took them before this one where the frame could not
                 // (gpu::slice_passes); the grid where they cannot be taken.
                 v = -1.0;
 #ifdef SUNSHADE_SLICES

@@ -108,7 +108,7 @@ pub struct GpuScene {
     masked: bool,
     /// The scene's bounds (the sun's shadow map is fitted to them).
     bounds: Option<crate::scene::Aabb>,
-    /// The fewest rows (`sky_slices::slice_rows`) at which a frame of this scene that sliced the sun and disk lights
+    /// The fewest rows (`visibility::slice_rows`) at which a frame of this scene that sliced the sun and disk lights
     /// itself ran out of the loop budget (`u32::MAX`: none has): a render with as many takes them in passes from
     /// the start (`slice_passes`) rather than draw a frame that would be cut short (a study's rungs only grow).
     passes_from_rows: std::cell::Cell<u32>,
@@ -710,7 +710,7 @@ impl Renderer {
         } else {
             Vec::new()
         };
-        let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
+        let rows = crate::shading::visibility::slice_rows(settings.shading.shadow_samples_per_axis);
         if rows >= scene.passes_from_rows.get() {
             slots.extend(&passable);
         }
@@ -843,7 +843,7 @@ impl Renderer {
             .collect();
         let pass_pipelines = self.pipeline.pipelines_of(&pass_variants)?;
         let made = t.elapsed();
-        let rows = crate::shading::sky_slices::slice_rows(settings.shading.shadow_samples_per_axis);
+        let rows = crate::shading::visibility::slice_rows(settings.shading.shadow_samples_per_axis);
         let pixels = (settings.width * settings.height) as usize;
         for slot in slots {
             let mut passes: std::collections::VecDeque<_> = slice_passes::first_passes(rows).into();

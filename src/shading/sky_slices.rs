@@ -40,13 +40,6 @@ use super::visibility::{Shadowing, SliceReach};
 /// normalised.
 pub const SLICE_AXIS: [f64; 3] = [0.33232518133916444, 0.8023039599071088, 0.4958511165312262];
 
-/// Rows of the sliced sky for a shadow-ray grid of `k²`: `4 k²` (each row cutting the triangles its bucket
-/// holds, `slice_buckets`, costing about what a ray does); refining `k → ⌈k√2⌉` at least doubles them, as it does
-/// every grid's count.
-pub fn slice_rows(k: u32) -> u32 {
-    4 * k.max(1).saturating_mul(k.max(1))
-}
-
 /// `∫_{b0}^{b1} sin²β dβ` for `0 ≤ b0 ≤ b1 ≤ π`, without the cancellation of `Δ/2 − cos(b0 + b1) sin Δ / 2` for a
 /// short interval: written as `(Δ − sin Δ)/2 + sin Δ sin²((b0 + b1)/2)`, both terms non-negative, and `Δ − sin Δ`
 /// by its series below 1/4 (where the subtraction would lose up to half the digits; the series' first omitted
@@ -420,7 +413,7 @@ pub fn sky_rows_weights(s: &Shadowing, n: DVec3, rows: u32, first: u32, count: u
 mod tests {
     use super::*;
     use crate::shading::lights::sky::sky_visible_fraction;
-    use crate::shading::visibility::test_shadowing;
+    use crate::shading::visibility::{slice_rows, test_shadowing};
     use crate::shading::{Occlusion, Unoccluded};
     use crate::visibility::Bvh;
 

@@ -218,6 +218,13 @@ pub struct ShadowedLights {
 /// The disk lights a shadow-map render gives a map of their own (the first ones; `MAX_DISK_MAPS` in the shaders).
 pub const MAPPED_DISKS: usize = 4;
 
+/// Rows of a light's slices (the sky's, the sun's, a disk's) for a shadow-ray grid of `k²`: `4 k²` (each row
+/// cutting the triangles its bucket holds, `slice_buckets`, costing about what a ray does); refining `k → ⌈k√2⌉`
+/// at least doubles them, as it does every grid's count.
+pub fn slice_rows(k: u32) -> u32 {
+    4 * k.max(1).saturating_mul(k.max(1))
+}
+
 impl ShadowedLights {
     /// Every light (rays).
     pub const ALL: Self = Self { sun: true, disks: usize::MAX, sky: true };
@@ -252,11 +259,11 @@ pub struct Shadowing<'a> {
 }
 
 impl<'a> Shadowing<'a> {
-    /// A light's visible fraction by slices (`sliced`, given the rows, `sky_slices::slice_rows` of the grid's
+    /// A light's visible fraction by slices (`sliced`, given the rows, `slice_rows` of the grid's
     /// count), where `slices` asks for it; `None` where it does not or the occluders cannot be sliced (then the
     /// caller takes the grid).
     pub fn by_slices(&self, sliced: impl FnOnce(u32) -> Option<f64>) -> Option<f64> {
-        self.slices.then(|| sliced(super::sky_slices::slice_rows(self.samples_per_axis))).flatten()
+        self.slices.then(|| sliced(slice_rows(self.samples_per_axis))).flatten()
     }
 
     /// These rays for the sun, if it is shadowed.
