@@ -58,6 +58,128 @@ fn modules_depend_one_way() {
     assert_free_of("src/testing.rs", &["crate::cli", "super::cli"]);
 }
 
+/// The files of `dir` (a module folder of src/) as modules (`lights::sun`), each with the sibling modules its code
+/// (not its comments, not its tests) names through `crate::MODULE::` or `super::`.
+fn import_graph(dir: &str) -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let prefix = format!("crate::{}::", dir.trim_start_matches("src/"));
+    let files: Vec<(String, String)> = sources(dir)
+        .into_iter()
+        .map(|(path, text)| {
+            let rel = Path::new(&path).strip_prefix(&root).unwrap().with_extension("");
+            let module = rel.to_string_lossy().replace('\\', "/").trim_end_matches("/mod").replace('/', "::");
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            let code: String =
+                code.lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n");
+            (module, code)
+        })
+        .collect();
+    let modules: std::collections::BTreeSet<String> = files.iter().map(|(m, _)| m.clone()).collect();
+    let mut graph = std::collections::BTreeMap::new();
+    for (module, code) in &files {
+        let parent = module.rsplit_once("::").map_or("", |(p, _)| p);
+        let mut deps = std::collections::BTreeSet::new();
+        for (pattern, base) in [(prefix.as_str(), ""), ("super::", parent)] {
+            for (i, _) in code.match_indices(pattern) {
+                let path: String = code[i + pattern.len()..]
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == ':')
+                    .collect();
+                let parts: Vec<&str> = path.split("::").filter(|p| !p.is_empty()).collect();
+                // The longest prefix of the path that names a module of the folder.
+                for n in (1..=parts.len()).rev() {
+                    let name = parts[..n].join("::");
+                    let full = if base.is_empty() { name } else { format!("{base}::{name}") };
+                    if modules.contains(&full) {
+                        if &full != module {
+                            deps.insert(full);
+                        }
+                        break;
+                    }
+                }
+            }
+        }
+        graph.insert(module.clone(), deps);
+    }
+    graph
+}
+
+/// The import circles of a graph: its strongly connected components of more than one module (Tarjan).
+fn import_circles(graph: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct State<'a> {
+        graph: &'a std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
+        index: std::collections::HashMap<&'a str, usize>,
+        low: std::collections::HashMap<&'a str, usize>,
+        stack: Vec<&'a str>,
+        circles: Vec<Vec<String>>,
+    }
+    fn visit<'a>(s: &mut State<'a>, v: &'a str) {
+        let i = s.index.len();
+        s.index.insert(v, i);
+        s.low.insert(v, i);
+        s.stack.push(v);
+        for w in &s.graph[v] {
+            if !s.index.contains_key(w.as_str()) {
+                visit(s, w);
+                let l = s.low[w.as_str()].min(s.low[v]);
+                s.low.insert(v, l);
+            } else if s.stack.contains(&w.as_str()) {
+                let l = s.index[w.as_str()].min(s.low[v]);
+                s.low.insert(v, l);
+            }
+        }
+        if s.low[v] == s.index[v] {
+            let mut circle = Vec::new();
+            while let Some(w) = s.stack.pop() {
+                circle.push(w.to_string());
+                if w == v {
+                    break;
+                }
+            }
+            if circle.len() > 1 {
+                circle.sort();
+                s.circles.push(circle);
+            }
+        }
+    }
+    let mut s =
+        State { graph, index: Default::default(), low: Default::default(), stack: Vec::new(), circles: Vec::new() };
+    for v in graph.keys() {
+        if !s.index.contains_key(v.as_str()) {
+            visit(&mut s, v);
+        }
+    }
+    s.circles
+}
+
+/// No import circles between the files of a module folder, so that each file can be read after the ones it uses.
+/// Two remain, named with why: a type whose methods are split over two files, and the tolerance's trial and its
+/// per-material study, which share their error type both ways.
+#[test]
+fn module_folders_have_no_import_circles() {
+    let known: &[(&str, &[&str], &str)] = &[
+        ("src/scene", &["load", "load_mesh"], "the loader's methods are split over the two files"),
+        ("src/accuracy", &["material_study", "trial"], "the trial and its per-material study share TrialError"),
+    ];
+    for dir in
+        ["src/shading", "src/cli", "src/render", "src/gpu", "src/cpu", "src/visibility", "src/scene", "src/accuracy"]
+    {
+        let graph = import_graph(dir);
+        assert!(graph.len() > 3, "{dir}: only {} files seen", graph.len());
+        for circle in import_circles(&graph) {
+            let allowed = known.iter().any(|(d, c, _)| *d == dir && circle == *c);
+            assert!(allowed, "{dir}: an import circle between {circle:?}");
+        }
+    }
+    // The test sees a circle where there is one.
+    let mut g = std::collections::BTreeMap::new();
+    g.insert("a".to_string(), ["b".to_string()].into());
+    g.insert("b".to_string(), ["c".to_string()].into());
+    g.insert("c".to_string(), ["a".to_string()].into());
+    g.insert("d".to_string(), ["a".to_string()].into());
+    assert_eq!(import_circles(&g), vec![vec!["a".to_string(), "b".to_string(), "c".to_string()]]);
+}
+
 /// Names of the functions a GLSL file defines: a line at column 0 of a return type (any: a built-in, a struct,
 /// `void`), a name and an opening parenthesis, not ending a prototype (`;`). Bodies are indented, so no statement
 /// matches; `#define`s start with `#`.

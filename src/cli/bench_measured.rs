@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use glam::DVec3;
 
-use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
 use super::generated::{print_output, update_region};
 use super::CliError;
 use crate::authoring::chart::{self, ChartMaterial};

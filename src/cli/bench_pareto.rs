@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use super::bench::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{build, default_scenes, device_description, median, ms, warm_frames, BenchArgs};
 use super::bench_tolerance::{table_size, tolerance_rows, tolerance_table};
 use super::generated::{machine, publish, today};
 use super::sweep::{sweep, Relevance};
@@ -25,6 +25,15 @@ use crate::plot::{Canvas, LogLogChart, Point};
 use crate::scene::{self, LoadOptions};
 use crate::settings::{self, CameraOptions, SunOptions};
 use crate::shading::Shadows;
+
+/// The documentation region `bench --pareto --update` writes: `pareto` for the grid's truth, `pareto-slices` for
+/// the slices' (a separate table: the two truths leave different pixels out).
+pub fn pareto_region(rule: crate::shading::VisibilityRule) -> &'static str {
+    match rule {
+        crate::shading::VisibilityRule::Grid => "pareto",
+        crate::shading::VisibilityRule::Slices => "pareto-slices",
+    }
+}
 
 /// Max relative errors below this are drawn at it (a log axis has no zero); the table gives them as measured.
 const PLOT_ERROR_FLOOR: f64 = 1e-7;
@@ -230,7 +239,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     if let Some(plot) = &a.plot {
         write_plot(plot, &charts)?;
     }
-    publish(&out, a.json, &a.update, super::bench::pareto_region(a.visibility_rule))
+    publish(&out, a.json, &a.update, pareto_region(a.visibility_rule))
 }
 
 /// The tolerances of "what exactness costs".

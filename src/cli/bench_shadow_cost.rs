@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
 use super::generated::publish;
 use super::CliError;
 use crate::cpu;

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::bench::{bench_renderer, build, device_description, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{bench_renderer, build, device_description, median, ms, warm_frames, BenchArgs};
 use super::generated::{machine, publish, today};
 use super::CliError;
 use crate::compare::{self, DiffOptions};

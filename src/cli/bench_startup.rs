@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use super::bench::{build, default_scenes, median, median_f64, ms, phase_line, render_process, BenchArgs};
+use super::bench_common::{build, default_scenes, median, median_f64, ms, phase_line, render_process, BenchArgs};
 use super::generated::{machine, publish, today};
 use super::CliError;
 

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use super::bench::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
 use super::generated::publish;
 use super::CliError;
 use crate::compare::{self, DiffOptions};

@@ -11,7 +11,7 @@
 
 use std::time::Duration;
 
-use super::bench::{median, ms, warm_frames};
+use super::bench_common::{median, ms, warm_frames};
 use super::metadata::{lobe_model_line, sun_model_line};
 use super::CliError;
 use crate::accuracy::converged::Converged;

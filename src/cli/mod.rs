@@ -8,6 +8,7 @@ mod albedo;
 mod args;
 mod batch;
 mod bench;
+mod bench_common;
 mod bench_measured;
 mod bench_pareto;
 mod bench_shadow_cost;
@@ -94,7 +95,7 @@ enum Command {
     },
     /// Speed against error: GPU frame time, CPU reference time and their difference, per scene.
     #[command(allow_negative_numbers = true)]
-    Bench(Box<bench::BenchArgs>),
+    Bench(Box<bench_common::BenchArgs>),
     /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
     /// light integrals per sample count; with a scene, the albedo of its materials.
     Albedo(albedo::AlbedoArgs),
