@@ -13,8 +13,8 @@
 //! the image kept.
 
 use super::predicted::{predict_with_peak, Request};
+use super::promise::{TrialError, WithinTolerance};
 use super::refinement::{ladder, Ladder, LobeEstimate};
-use super::trial::{TrialError, WithinTolerance};
 use crate::compare::image_peak;
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;

@@ -31,5 +31,6 @@ pub mod material_study;
 pub mod pareto;
 pub mod penumbrae;
 pub mod predicted;
+pub mod promise;
 pub mod refinement;
 pub mod trial;
