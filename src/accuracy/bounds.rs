@@ -128,7 +128,7 @@ fn configurations(width: f64, angles: SunViewAngles, azimuths: &[f64]) -> Vec<(D
 /// The scan is a pure function of its arguments and costs ~10 ms a material; its results are kept for the
 /// process (a batch of renders, `--tolerance` trying grid after grid, asks the same questions again).
 pub fn lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f64) {
-    if matches!(brdf, Brdf::Lambert { .. }) {
+    if brdf.is_lambert() {
         return (0.0, 0.0);
     }
     kept_scan(format!("curvature {brdf:?}"), step, angles, || scan_lobe_curvature(brdf, step, angles))
@@ -161,7 +161,7 @@ const KEPT_SCANS: usize = 4096;
 
 /// The viewer azimuths [degrees] the scans take: three for an anisotropic lobe, one otherwise.
 fn view_azimuths(brdf: &Brdf) -> &'static [f64] {
-    let anisotropic = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x != alpha_y);
+    let anisotropic = !brdf.is_isotropic();
     if anisotropic {
         &[0.0, 45.0, 90.0]
     } else {
@@ -221,7 +221,7 @@ fn kink(brdf: &Brdf) -> Option<f64> {
 /// The relative error bound of the delta sun's lobe term against the disk sun's exact integral, for this BRDF
 /// under a sun of angular radius `r` \[rad\]: `(r²/8) max |∇²f|` (see the module's text), at most 1.
 pub fn sun_delta_bound(brdf: &Brdf, r: f64, angles: SunViewAngles) -> f64 {
-    if matches!(brdf, Brdf::Lambert { .. }) {
+    if brdf.is_lambert() {
         return 0.0;
     }
     let Some(jump) = kink(brdf) else { return 1.0 };
@@ -241,7 +241,7 @@ pub const MIN_GRID_FOR_BOUND: u32 = 4;
 /// The relative error bound of the disk sun's `k × k` grid: `(h²/24) max (|f₁₁| + |f₂₂|)` with `h = π r/k`
 /// (see the module's text), at most 1 (and 1 below [`MIN_GRID_FOR_BOUND`] cells a side).
 pub fn sun_grid_bound(brdf: &Brdf, r: f64, k: u32, angles: SunViewAngles) -> f64 {
-    if matches!(brdf, Brdf::Lambert { .. }) {
+    if brdf.is_lambert() {
         return 0.0;
     }
     let Some(jump) = kink(brdf) else { return 1.0 };
@@ -265,7 +265,7 @@ pub fn horizon_bound(r: f64) -> f64 {
 /// 1°): a scan of viewer polar angles and light azimuths, each step at most a quarter of the lobe's width (and 1°
 /// and 0.5°), three viewer azimuths for an anisotropic lobe. 0 without a lobe.
 pub fn horizon_lobe(brdf: &Brdf, angles: SunViewAngles) -> f64 {
-    if matches!(brdf, Brdf::Lambert { .. }) {
+    if brdf.is_lambert() {
         return 0.0;
     }
     kept_scan(format!("horizon {brdf:?}"), 0.0, angles, || (scan_horizon_lobe(brdf, angles), 0.0)).0

@@ -143,7 +143,7 @@ pub fn penumbrae_need_study(settings: &RenderSettings, can_occlude: bool) -> boo
 /// Whether every material some mesh uses is Lambertian at every pixel (no lobe: under disk lights and the sky
 /// the closed-form irradiance is then the whole of their light, exact).
 pub(crate) fn only_lambertian(scene: &Scene) -> bool {
-    !has_measured(scene) && scene_lobes(scene).iter().all(|l| matches!(l.brdf, Brdf::Lambert { .. }))
+    !has_measured(scene) && scene_lobes(scene).iter().all(|l| l.brdf.is_lambert())
 }
 
 /// Whether a material some mesh uses is measured.
@@ -170,7 +170,7 @@ struct SceneLobe {
 fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
     let mut v: Vec<SceneLobe> = Vec::new();
     for mesh in &scene.meshes {
-        if let Some(m) = scene.materials.get(mesh.material).filter(|m| !matches!(m.brdf, Brdf::Measured { .. })) {
+        if let Some(m) = scene.materials.get(mesh.material).filter(|m| !m.brdf.is_measured()) {
             let brdf = sharpest_brdf(m, scene);
             let largest = |c: [f32; 3]| c.iter().fold(0.0f64, |a, &x| a.max(x as f64));
             let (kd_max, ks_max) = match m.mapping {
@@ -193,7 +193,7 @@ fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
 /// The index in `lobes` (from [`scene_brdfs`]) of material `material`'s sharpest lobe; `None` for a measured
 /// material, which has none there.
 fn lobe_of(scene: &Scene, lobes: &[Brdf], material: usize) -> Option<usize> {
-    let m = scene.materials.get(material).filter(|m| !matches!(m.brdf, Brdf::Measured { .. }))?;
+    let m = scene.materials.get(material).filter(|m| !m.brdf.is_measured())?;
     let name = brdf_name(&sharpest_brdf(m, scene));
     lobes.iter().position(|b| brdf_name(b) == name)
 }

@@ -4,7 +4,7 @@
 //! shadow settings where nothing can occlude a light).
 
 use crate::gpu::Interpolation;
-use crate::scene::{Brdf, BrdfKind, Lights, Scene};
+use crate::scene::{BrdfKind, Lights, Scene};
 use crate::shading::{DiskModel, ShadingOptions, ShadowMapFilter, Shadows, SunModel};
 
 /// What in a scene the knobs act on.
@@ -23,10 +23,8 @@ pub struct Relevance {
 
 impl Relevance {
     pub fn of(scene: &Scene, lights: &Lights, can_occlude: bool, ray_queries: bool) -> Self {
-        let lobes = scene
-            .materials
-            .iter()
-            .any(|m| !matches!(m.brdf, Brdf::Lambert { .. }) || m.mapping.is_some_and(|k| k != BrdfKind::Lambert));
+        let lobes =
+            scene.materials.iter().any(|m| !m.brdf.is_lambert() || m.mapping.is_some_and(|k| k != BrdfKind::Lambert));
         Self {
             sun: lights.sun.is_some(),
             disks: !lights.disks.is_empty(),

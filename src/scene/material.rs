@@ -89,15 +89,47 @@ impl Brdf {
         }
     }
 
+    // The properties below match every model by name (no `_` arm, no `matches!`), so that a new model does not
+    // compile until each says where it stands.
+
+    /// Whether the model is Lambertian (no lobe).
     pub fn is_lambert(&self) -> bool {
-        matches!(self, Brdf::Lambert { .. })
+        match self {
+            Brdf::Lambert { .. } => true,
+            Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } | Brdf::Measured { .. } => false,
+        }
+    }
+
+    /// Whether the model is a measured table (its lobe read from the table, its parameters not checked here).
+    pub fn is_measured(&self) -> bool {
+        match self {
+            Brdf::Measured { .. } => true,
+            Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } => false,
+        }
+    }
+
+    /// Whether the lobe is sampled about the mirror direction of the viewer (Phong's cos-power lobe) rather than
+    /// about the normal (the half-vector lobes: Blinn-Phong, Ward, and a measured table through Ward's).
+    pub fn sampled_about_mirror(&self) -> bool {
+        match self {
+            Brdf::Phong { .. } => true,
+            Brdf::Lambert { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } | Brdf::Measured { .. } => false,
+        }
+    }
+
+    /// Whether the lobe is unchanged by a rotation about the normal (all but Ward with αx ≠ αy).
+    pub fn is_isotropic(&self) -> bool {
+        match *self {
+            Brdf::Ward { alpha_x, alpha_y, .. } => alpha_x == alpha_y,
+            Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Measured { .. } => true,
+        }
     }
 
     /// Checks the parameters: reflectances in [0, 1] with `kd + ks ≤ 1` per channel, exponent in [0, 1e7],
     /// Ward α in (0, 1]. The message names the offending parameter.
     pub fn validate(&self) -> Result<(), String> {
         // A measured table is what it is (its file was checked when read).
-        if matches!(self, Brdf::Measured { .. }) {
+        if self.is_measured() {
             return Ok(());
         }
         let (kd, ks) = (self.kd(), self.ks());

@@ -102,7 +102,11 @@ pub const GRAZING_FLOOR: f64 = 0.05;
 /// `sqrt(1 − ((n × v)·u)²)` with no normalization: a viewer head-on (n × v → 0, its direction all rounding) gives
 /// 1, continuously. Below the floor |n × v|² ≥ 1 − floor², so normalizing c is safe there.
 pub fn grazing_narrowing(brdf: &Brdf, p: &SurfacePoint, u: DVec3) -> f64 {
-    let isotropic_ward = matches!(*brdf, Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x == alpha_y);
+    // Every model by name, so that a new one says whether its lobe narrows.
+    let isotropic_ward = match *brdf {
+        Brdf::Ward { alpha_x, alpha_y, .. } => alpha_x == alpha_y,
+        Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Measured { .. } => false,
+    };
     if !isotropic_ward {
         return 1.0;
     }
@@ -136,7 +140,7 @@ pub fn sky_lune_blend(brdf: &Brdf, p: &SurfacePoint) -> f64 {
     let quarter = 0.25 * lobe_width(brdf).min(1.0);
     let (_, tilt) = up_across(n);
     // A measured table takes the upper lune wherever the surface is tilted (see `sky_lobe_integral_visible`).
-    let below = if matches!(brdf, Brdf::Measured { .. }) {
+    let below = if brdf.is_measured() {
         1.0
     } else {
         (0.5 - r.y / (2.0 * quarter)).clamp(0.0, 1.0).max(sky_beyond_lobe(brdf, p, r))
@@ -207,7 +211,7 @@ pub fn sky_lobe_in_lune(
         Lune::Above => (tilt - FRAC_PI_2, FRAC_PI_2),
     };
     // (A NaN normal compares unordered: nothing.)
-    if psi_hi.partial_cmp(&psi_lo) != Some(std::cmp::Ordering::Greater) || matches!(brdf, Brdf::Lambert { .. }) {
+    if psi_hi.partial_cmp(&psi_lo) != Some(std::cmp::Ordering::Greater) || brdf.is_lambert() {
         return [0.0; 3];
     }
     let b = if sin_t > 0.0 { across / sin_t } else { orthonormal_to(n) };

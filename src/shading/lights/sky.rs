@@ -61,7 +61,7 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
     let visible = |omega: DVec3| shadow.is_none_or(|s| omega.y <= 0.0 || s.visible_along(omega));
     let (n, v) = (p.normal, p.to_viewer);
     // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
-    let axis = if matches!(brdf, Brdf::Phong { .. }) { mirror(v, n) } else { n };
+    let axis = if brdf.sampled_about_mirror() { mirror(v, n) } else { n };
     let t = orthonormal_to(axis);
     let b = axis.cross(t);
     let k = per_axis as f64;
