@@ -322,10 +322,18 @@ fn shaders_compile_at_run_time_from_sunshade_shader_dir_and_errors_name_the_line
     let input = dir.write("scene.glb", &scene());
     let shaders = dir.path("shaders");
     std::fs::create_dir(&shaders).unwrap();
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    for e in std::fs::read_dir(&source).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), shaders.join(e.file_name())).unwrap();
+    // The whole tree (shaders/lights/ included), as a user's copy would be.
+    let mut folders = vec![(Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders"), shaders.clone())];
+    while let Some((from, to)) = folders.pop() {
+        for e in std::fs::read_dir(&from).unwrap() {
+            let e = e.unwrap();
+            if e.path().is_dir() {
+                std::fs::create_dir(to.join(e.file_name())).unwrap();
+                folders.push((e.path(), to.join(e.file_name())));
+            } else {
+                std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+            }
+        }
     }
     let out = dir.path("out.exr");
     let run = || {
@@ -353,6 +361,13 @@ fn shaders_compile_at_run_time_from_sunshade_shader_dir_and_errors_name_the_line
     assert_eq!(bad.status.code(), Some(1), "{err}");
     assert!(err.contains(&format!("math.glsl:{line}")), "{err}");
     assert!(!out.exists());
+    // A file in a subfolder is named by its path under the folder.
+    std::fs::write(&math, text).unwrap();
+    let sun = shaders.join("lights").join("sun.glsl");
+    let text = std::fs::read_to_string(&sun).unwrap();
+    std::fs::write(&sun, format!("{text}\nfloat broken = undefined_name;\n")).unwrap();
+    let err = stderr(&run());
+    assert!(err.contains(&format!("lights/sun.glsl:{}", text.lines().count() + 2)), "{err}");
 }
 
 #[test]
