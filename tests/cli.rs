@@ -560,6 +560,14 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     assert!(out.contains("settings as recorded (golden → now): Lights.sun.direction_towards_sun: ["), "{out}");
     assert!(!out.contains("Settings.width"), "only what differs is named: {out}");
     assert!(dir.path("report/golden.actual.exr").exists() && dir.path("report/golden.heatmap.png").exists());
+    // The report compares the failing case's golden and actual in place at full size (a slider, a zoom), open;
+    // the passing cases' comparisons are folded.
+    let html = std::fs::read_to_string(dir.path("report/index.html")).unwrap();
+    let failing = html.find("<details open>").expect("the failure's comparison is open");
+    let block = &html[failing..html[failing..].find("</details>").unwrap() + failing];
+    assert!(block.contains("type=\"range\"") && block.contains("onchange=\"zoom(this)\""), "{block}");
+    assert!(block.contains("src=\"golden.expected.png\"") && block.contains("class=\"top\" src=\"golden.actual.png\""));
+    assert_eq!(html.matches("<details>").count(), 2, "the passing cases fold theirs");
     let xml = std::fs::read_to_string(dir.path("j.xml")).unwrap();
     assert!(xml.contains("failures=\"1\"") && xml.contains("Lights.sun.direction_towards_sun"), "{xml}");
     // Shards: 1/3 runs only "ref".

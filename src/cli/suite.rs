@@ -382,6 +382,21 @@ fn previews(name: &str, expected: &Image, actual: &Image, results: &Path) -> Opt
     Some(files)
 }
 
+/// A row comparing the golden (left of the slider) and the actual image (right of it) in place, at full size and
+/// zoomed by whole factors without smoothing; open for a failure, folded for a pass.
+fn compare_row(expected: &str, actual: &str, open: bool) -> String {
+    let (e, a) = (escape(expected), escape(actual));
+    format!(
+        "<tr><td colspan=\"5\"><details{}><summary>golden and actual at full size, in place</summary>\
+         <div class=\"compare\"><p>golden ◀ <input type=\"range\" min=\"0\" max=\"100\" value=\"50\" \
+         oninput=\"slide(this)\" aria-label=\"golden and actual\"> ▶ actual &nbsp; zoom <select onchange=\"zoom(this)\" \
+         aria-label=\"zoom\"><option value=\"1\">1×</option><option value=\"2\">2×</option><option value=\"4\">4×</option>\
+         <option value=\"8\">8×</option></select></p><div class=\"cmp\"><img src=\"{e}\" alt=\"golden {e}\">\
+         <img class=\"top\" src=\"{a}\" alt=\"actual {a}\"></div></div></details></td></tr>\n",
+        if open { " open" } else { "" }
+    )
+}
+
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;").replace('\'', "&apos;")
 }
@@ -432,7 +447,12 @@ fn html(suite: &str, outcomes: &[Outcome]) -> String {
          .pass{{color:#1a7f37;font-weight:bold}} .fail{{color:#b42318;font-weight:bold}} \
          img{{image-rendering:pixelated;width:192px;background:repeating-conic-gradient(#ddd 0 25%,#fff 0 50%) 0 0/16px 16px}} \
          img.heatmap{{width:auto;max-width:480px;background:none}} \
-         code{{font-size:85%}}</style></head><body>\n<h1>sunshade test: {s}</h1>\n<p>{} passed, {failed} failed</p>\n\
+         .cmp{{position:relative;display:inline-block;line-height:0}} .cmp img{{width:auto;display:block}} \
+         .cmp img.top{{position:absolute;left:0;top:0;clip-path:inset(0 0 0 50%)}} \
+         code{{font-size:85%}}</style><script>\
+         function slide(e){{const c=e.closest('.compare');c.querySelector('img.top').style.clipPath='inset(0 0 0 '+e.value+'%)';}}\
+         function zoom(e){{const c=e.closest('.compare');c.querySelectorAll('.cmp img').forEach(i=>{{i.style.width=(i.naturalWidth*e.value)+'px';}});}}\
+         </script></head><body>\n<h1>sunshade test: {s}</h1>\n<p>{} passed, {failed} failed</p>\n\
          <table><tr><th>case</th><th>result</th><th>golden / reference</th><th>actual</th><th>heatmap (log<sub>10</sub> relative error)</th></tr>\n",
         outcomes.len() - failed,
         s = escape(suite)
@@ -464,6 +484,9 @@ fn html(suite: &str, outcomes: &[Outcome]) -> String {
             None => h += "<td colspan=\"3\">no images</td>",
         }
         h += "</tr>\n";
+        if let Some(files) = &o.previews {
+            h += &compare_row(&files[0], &files[1], o.status.is_failure());
+        }
     }
     h += "</table>\n</body></html>\n";
     h
