@@ -271,12 +271,9 @@ pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d
 
 #[cfg(test)]
 mod tests {
+    use super::super::rel;
     use super::*;
     use crate::shading::quadrature::integrate_composite as composite;
-
-    fn rel(a: f64, b: f64) -> f64 {
-        (a - b).abs() / b.abs()
-    }
 
     fn down_disk(height: f64, radius: f64) -> DiskGeometry {
         DiskGeometry { center: DVec3::new(0.0, height, 0.0), direction: -DVec3::Y, radius }

@@ -5,3 +5,9 @@
 pub mod disk;
 pub mod sky;
 pub mod sun;
+
+/// `|a − b| / |b|`, the lights' tests' relative difference.
+#[cfg(test)]
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}

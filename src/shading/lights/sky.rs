@@ -176,11 +176,8 @@ pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::rel;
     use super::*;
-
-    fn rel(a: f64, b: f64) -> f64 {
-        (a - b).abs() / b.abs()
-    }
 
     #[test]
     fn sky_irradiance_of_an_overcast_day() {

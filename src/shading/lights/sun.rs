@@ -130,13 +130,10 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
 
 #[cfg(test)]
 mod tests {
+    use super::super::rel;
     use super::*;
     use crate::shading::quadrature::integrate;
     use crate::shading::radiometry::*;
-
-    fn rel(a: f64, b: f64) -> f64 {
-        (a - b).abs() / b.abs()
-    }
 
     #[test]
     fn sun_solid_angle_and_radiance_give_1000_w_per_m2() {
