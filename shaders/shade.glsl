@@ -25,6 +25,9 @@ float sun_map_fraction = 1.0;
 // casts its lobe samples' rays only where it is strictly between 0 and 1 (see irradiance_and_sun_fraction).
 float sun_ray_fraction = 1.0;
 float disk_map_fraction[MAX_DISK_MAPS] = float[](1.0, 1.0, 1.0, 1.0);
+// Bit i: the rays of disk light i (the first 32) proven clear by irradiance_visible (disk_rays_proven_clear): its
+// lobe's samples then cast none, every one of them getting through.
+uint disk_rays_clear = 0u;
 
 #include "sky_lune.glsl"
 #include "lights/sky.glsl"
@@ -96,6 +99,11 @@ vec3 irradiance_visible(Frame p) {
                                                        d.center_radius.w, 4u * k * k);
                 }
 #endif
+                if (v < 0.0 && disk_rays_proven_clear(p.shadow_origin, position, normal, d.center_radius.xyz,
+                                                      d.direction.xyz, d.center_radius.w)) {
+                    v = 1.0;
+                    disk_rays_clear |= i < 32u ? 1u << i : 0u;
+                }
                 if (v < 0.0) {
                     v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
                                               d.direction.xyz, d.center_radius.w);
@@ -184,9 +192,10 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
                 integral = vec3(0.0);
             }
         } else {
-            // The grid's sum as it is (see disk_lobe_integral in the Rust).
+            // The grid's sum as it is (see disk_lobe_integral in the Rust); no rays where they are proven clear.
+            bool clear = i < 32u && (disk_rays_clear & (1u << i)) != 0u;
             integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
-                d.center_radius.w, pc.lobe_samples, SHADOWS_ON ? RAYS_TO_POINT : RAYS_NONE).lobe;
+                d.center_radius.w, pc.lobe_samples, SHADOWS_ON && !clear ? RAYS_TO_POINT : RAYS_NONE).lobe;
         }
         if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
             integral *= disk_map_fraction[i];

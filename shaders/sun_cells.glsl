@@ -45,14 +45,11 @@ uint sun_cell_of(vec3 origin) {
     return uint(ij.x) + sun_cells.dims.x * uint(ij.y);
 }
 
-// What the triangle (c0, c1, c2) does to the cone of half-angle asin(sin_sigma) about the unit l from `origin`:
-// SUN_CONE_MISSES (no ray of it above the horizon of the surface's normal n meets it: wholly below the tangent
-// plane, or outside), SUN_CONE_COVERED (every ray of the cone meets it at t > 0) or SUN_CONE_PARTIAL. The edge
-// planes' normals from the edge vectors, not from two long corner vectors (see the Rust).
-uint sun_triangle_class(vec3 origin, vec3 n, vec3 l, float sin_sigma, vec3 c0, vec3 c1, vec3 c2) {
-    if (dot(n, c0 - origin) <= 0.0 && dot(n, c1 - origin) <= 0.0 && dot(n, c2 - origin) <= 0.0) {
-        return SUN_CONE_MISSES;
-    }
+// What the triangle (c0, c1, c2) does to the cone of half-angle asin(sin_sigma) about the unit l from `origin`, its
+// rays of any length (no surface's horizon): SUN_CONE_MISSES, SUN_CONE_COVERED or SUN_CONE_PARTIAL; the edge
+// planes' normals from the edge vectors, not from two long corner vectors (see the Rust). sun_triangle_class after
+// its tangent plane; disk lights' cones use it too (disk_cone.glsl).
+uint cone_triangle_class(vec3 origin, vec3 l, float sin_sigma, vec3 c0, vec3 c1, vec3 c2) {
     float limit = sin_sigma + SUN_CONE_MARGIN;
     vec3 normal = cross(c1 - c0, c2 - c0);
     float h = dot(normal, origin - c0);
@@ -80,6 +77,15 @@ uint sun_triangle_class(vec3 origin, vec3 n, vec3 l, float sin_sigma, vec3 c0, v
         return SUN_CONE_MISSES;
     }
     return all(greaterThan(c, limit * lens)) ? SUN_CONE_COVERED : SUN_CONE_PARTIAL;
+}
+
+// The same for the rays above the horizon of the surface's normal n: SUN_CONE_MISSES also where the triangle lies
+// wholly below the tangent plane.
+uint sun_triangle_class(vec3 origin, vec3 n, vec3 l, float sin_sigma, vec3 c0, vec3 c1, vec3 c2) {
+    if (dot(n, c0 - origin) <= 0.0 && dot(n, c1 - origin) <= 0.0 && dot(n, c2 - origin) <= 0.0) {
+        return SUN_CONE_MISSES;
+    }
+    return cone_triangle_class(origin, l, sin_sigma, c0, c1, c2);
 }
 
 // The entries of origin's cell whose tops lie above its depth along the sun (the only triangles its sun rays can

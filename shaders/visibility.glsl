@@ -64,6 +64,9 @@ bool visible_to(vec3 origin, vec3 target) {
 }
 
 #include "sun_cells.glsl"
+#if defined(SUNSHADE_WALK) && defined(SUNSHADE_SHADOW_RAYS)
+#include "disk_cone.glsl"
+#endif
 
 // The point of the unit disk for (u, v) of the unit square (Shirley & Chiu's concentric map; equal-area).
 vec2 concentric_disk(float u, float v) {

@@ -239,6 +239,7 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
     ("ray_triangle.glsl", &["src/visibility/ray_triangle.rs"], ""),
     ("bvh.glsl", &["src/visibility/bvh.rs"], ""),
     ("sun_cells.glsl", &["src/visibility/sun_cells.rs"], ""),
+    ("disk_cone.glsl", &["src/visibility/disk_cone.rs"], ""),
     (
         "slices.glsl",
         &[
@@ -256,7 +257,14 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
 
 /// Functions a mirrored shader file defines with no Rust function of the name, and why.
 const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] =
-    &[("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods")];
+    &[
+        ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
+        (
+            "lights/disk.glsl",
+            "disk_rays_proven_clear",
+            "the GPU's shortcut before the grid (src/visibility/disk_cone.rs's walk); the reference casts its rays",
+        ),
+    ];
 
 /// Shader files with no Rust twin, and why.
 const GPU_ONLY_FILES: &[(&str, &str)] = &[

@@ -176,6 +176,16 @@ float disk_projected_solid_angle(vec3 x, vec3 n, vec3 center, vec3 direction, fl
     return partial_disk_projected_solid_angle(n, direction, q, r_perp, h, sqrt(rho2), radius);
 }
 
+// Whether every shadow ray of the disk light's grid and lobe from origin (moved off x, of normal n) is proven to get
+// through: the walk of disk_cone.glsl where the shader walks the occluders' tree; false elsewhere (the rays decide).
+bool disk_rays_proven_clear(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+#if defined(SUNSHADE_WALK) && defined(SUNSHADE_SHADOW_RAYS)
+    return disk_cone_clear(origin, x, n, center, d, radius);
+#else
+    return false;
+#endif
+}
+
 // The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
 float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     vec3 a = orthonormal_to(d);

@@ -22,6 +22,7 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("ray_triangle.glsl", include_str!("../../shaders/ray_triangle.glsl")),
     ("bvh.glsl", include_str!("../../shaders/bvh.glsl")),
     ("sun_cells.glsl", include_str!("../../shaders/sun_cells.glsl")),
+    ("disk_cone.glsl", include_str!("../../shaders/disk_cone.glsl")),
     ("slices.glsl", include_str!("../../shaders/slices.glsl")),
     ("shadow_map.glsl", include_str!("../../shaders/shadow_map.glsl")),
     ("transform.glsl", include_str!("../../shaders/transform.glsl")),

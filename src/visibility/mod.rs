@@ -6,6 +6,7 @@
 //! that both renderers share are in `shading::visibility`.
 
 pub mod bvh;
+pub mod disk_cone;
 pub mod occluders;
 pub mod ray_triangle;
 pub mod shadow_map;

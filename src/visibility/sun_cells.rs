@@ -300,11 +300,18 @@ pub fn sun_cell_range(cells: &SunCells, origin: DVec3) -> std::ops::Range<usize>
 /// and the lobes cast: their samples below it weigh nothing), holds it (every ray of it meets the triangle at
 /// `t > 0`), or neither.
 pub fn sun_triangle_class(origin: DVec3, n: DVec3, l: DVec3, sin_sigma: f64, corners: [DVec3; 3]) -> SunCone {
-    let limit = sin_sigma + SUN_CONE_MARGIN;
-    let [c0, c1, c2] = corners;
     if corners.iter().all(|c| n.dot(*c - origin) <= 0.0) {
         return SunCone::Misses;
     }
+    cone_triangle_class(origin, l, sin_sigma, corners)
+}
+
+/// What the triangle `corners` does to the cone of half-angle asin(`sin_sigma`) about the unit `l` from `origin`,
+/// its rays of any length and direction within it (no surface's horizon): [`sun_triangle_class`] after its
+/// tangent plane; disk lights' cones use it too (`visibility::disk_cone`).
+pub fn cone_triangle_class(origin: DVec3, l: DVec3, sin_sigma: f64, corners: [DVec3; 3]) -> SunCone {
+    let limit = sin_sigma + SUN_CONE_MARGIN;
+    let [c0, c1, c2] = corners;
     let normal = (c1 - c0).cross(c2 - c0);
     let h = normal.dot(origin - c0);
     let n_l = normal.dot(l);

@@ -1,0 +1,154 @@
+// A disk light's shadow rays proven clear before one is cast: a walk of the occluders' BVH with the cone from the
+// ray origin to the disk, stopping at the first triangle it cannot show apart from the rays. Clear: every ray of
+// the grid and of the lobe gets through, the visible fraction is exactly 1 and none is cast. Mirrors
+// src/visibility/disk_cone.rs name for name (see it for the derivation and the margins). Where the shader walks
+// the tree (SUNSHADE_WALK); included by visibility.glsl after sun_cells.glsl, whose classification it uses.
+#ifndef SUNSHADE_DISK_CONE_GLSL
+#define SUNSHADE_DISK_CONE_GLSL
+
+// The margin of the comparisons, relative to the largest coordinate involved: 2^-19 (DISK_CONE_MARGIN).
+#define DISK_CONE_MARGIN (1.0 / 524288.0)
+
+// The rays from an origin to a disk light (DiskCone in the Rust).
+struct DiskCone {
+    vec3 origin;
+    vec3 n;
+    vec3 plane;
+    vec3 axis;
+    vec3 u;
+    vec3 v;
+    float sin_half;
+    float cos_half;
+    vec3 center;
+    vec3 d;
+    vec3 lo;
+    vec3 hi;
+    float size;
+};
+
+float largest_coordinate(vec3 v) {
+    vec3 a = abs(v);
+    return max(max(a.x, a.y), a.z);
+}
+
+// The cone of the rays from origin (moved off the shading point x of normal n) to the disk light (centre [m], unit emission direction d,
+// radius [m]); false where the origin is not in front of the disk or within a radius (and 2^-10 of it) of its
+// centre.
+bool disk_cone(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius, out DiskCone c) {
+    vec3 to = center - origin;
+    float dist = length(to);
+    float h = dot(d, origin - center);
+    c.origin = origin;
+    c.n = n;
+    c.plane = dot(n, origin - x) < 0.0 ? origin : x;
+    c.center = center;
+    c.d = d;
+    if (!(h > 0.0 && radius >= 0.0 && dist * (1.0 - 1.0 / 1024.0) > radius)) {
+        return false;
+    }
+    c.sin_half = radius / dist;
+    c.cos_half = sqrt((1.0 - c.sin_half) * (1.0 + c.sin_half));
+    c.axis = to / dist;
+    c.u = orthonormal_to(c.axis);
+    c.v = cross(c.axis, c.u);
+    vec3 reach = radius * sqrt(max((vec3(1.0) - d) * (vec3(1.0) + d), vec3(0.0)));
+    c.lo = min(origin, center - reach);
+    c.hi = max(origin, center + reach);
+    c.size = max(largest_coordinate(origin), largest_coordinate(center) + radius);
+    return true;
+}
+
+// Whether the ball (centre [m], radius r [m]) lies outside the cone (its signed distance).
+bool disk_cone_apart_from_ball(DiskCone c, vec3 centre, float r) {
+    vec3 v = centre - c.origin;
+    float along = dot(v, c.axis);
+    float across = length(v - along * c.axis);
+    return across * c.cos_half - along * c.sin_half > r;
+}
+
+// Whether the box (centre, half sizes [m]) lies wholly outside one face of the square pyramid about the cone, by
+// margin [m].
+bool disk_cone_apart_from_pyramid(DiskCone c, vec3 centre, vec3 half_size, float margin) {
+    vec3 v = centre - c.origin;
+    vec3 m0 = c.cos_half * c.u - c.sin_half * c.axis;
+    vec3 m1 = -c.cos_half * c.u - c.sin_half * c.axis;
+    vec3 m2 = c.cos_half * c.v - c.sin_half * c.axis;
+    vec3 m3 = -c.cos_half * c.v - c.sin_half * c.axis;
+    return dot(m0, v) - dot(abs(m0), half_size) > margin || dot(m1, v) - dot(abs(m1), half_size) > margin
+           || dot(m2, v) - dot(abs(m2), half_size) > margin || dot(m3, v) - dot(abs(m3), half_size) > margin;
+}
+
+// Whether the box [lo, hi] [m] lies apart from the cone's rays: outside the hull's box, behind the disk's plane,
+// below the tangent plane or outside the cone (a face of its pyramid, or its ball), by the margin.
+bool disk_cone_apart_from_box(DiskCone c, vec3 lo, vec3 hi) {
+    float m = DISK_CONE_MARGIN * max(c.size, max(largest_coordinate(lo), largest_coordinate(hi)));
+    if (any(lessThan(hi, c.lo - m)) || any(greaterThan(lo, c.hi + m))) {
+        return true;
+    }
+    vec3 centre = 0.5 * (lo + hi);
+    vec3 half_size = 0.5 * (hi - lo);
+    if (dot(c.d, centre - c.center) + dot(abs(c.d), half_size) <= -m) {
+        return true;
+    }
+    if (dot(c.n, centre - c.plane) + dot(abs(c.n), half_size) <= -m) {
+        return true;
+    }
+    return disk_cone_apart_from_pyramid(c, centre, half_size, m) || disk_cone_apart_from_ball(c, centre, length(half_size) + m);
+}
+
+// Whether no ray of the cone can meet the triangle (world corners [m]).
+bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
+    vec3 lo = min(min(c0, c1), c2);
+    vec3 hi = max(max(c0, c1), c2);
+    float m = DISK_CONE_MARGIN * max(c.size, max(largest_coordinate(lo), largest_coordinate(hi)));
+    if (any(lessThan(hi, c.lo - m)) || any(greaterThan(lo, c.hi + m))) {
+        return true;
+    }
+    if ((dot(c.d, c0 - c.center) <= -m && dot(c.d, c1 - c.center) <= -m && dot(c.d, c2 - c.center) <= -m)
+        || (dot(c.n, c0 - c.plane) <= -m && dot(c.n, c1 - c.plane) <= -m && dot(c.n, c2 - c.plane) <= -m)) {
+        return true;
+    }
+    return cone_triangle_class(c.origin, c.axis, c.sin_half, c0, c1, c2) == SUN_CONE_MISSES;
+}
+
+// A leaf's triangle the cone's rays may meet ends the walk: not clear.
+#define DISK_CONE_LEAF(leaf) \
+    { \
+        uvec4 tri = WALK_RECORD((leaf).first); \
+        if (!disk_cone_misses_triangle(c, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z))) { \
+            return false; \
+        } \
+    }
+// Child `i` of an inner node: skipped where its box is apart; an inner node stacked, a leaf's triangle tested.
+#define DISK_CONE_CHILD(i) \
+    { \
+        BvhNode child = bvh_nodes[i]; \
+        if (!disk_cone_apart_from_box(c, child.lo, child.hi)) { \
+            if (child.count == 0u) { \
+                stack[top] = (i); \
+                top += 1u; \
+            } else DISK_CONE_LEAF(child) \
+        } \
+    }
+
+// Whether every shadow ray from origin (moved off x) to the disk light misses every occluder: the tree walked with the cone
+// (false also where there is no cone). One iteration of llvmpipe's loop budget an inner node entered, as the rays'
+// walk.
+bool disk_cone_clear(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+    DiskCone c;
+    if (!disk_cone(origin, x, n, center, d, radius, c)) {
+        return false;
+    }
+    BvhNode root = bvh_nodes[0];
+    if (root.count > 0u) {
+        DISK_CONE_LEAF(root)
+        return true;
+    }
+    if (disk_cone_apart_from_box(c, root.lo, root.hi)) {
+        return true;
+    }
+    BVH_WALK(DISK_CONE_CHILD)
+    return true;
+}
+
+#endif
