@@ -224,8 +224,9 @@ layout(std430, set = 0, binding = 15) readonly buffer SunCellsBuffer {
 #endif
 
 // The modules that walk the occluders' tree: for the shadow rays themselves without ray queries
-// (SUNSHADE_RAY_BVH), and for the lights' slices (SUNSHADE_SLICES, slices.glsl) with ray queries or without.
-#if defined(SUNSHADE_RAY_BVH) || defined(SUNSHADE_SLICES)
+// (SUNSHADE_RAY_BVH), for the disk lights' proof that their rays are clear (disk_cone.glsl) and the lights' slices
+// (SUNSHADE_SLICES, slices.glsl) with ray queries or without: every module with shadow rays.
+#ifdef SUNSHADE_SHADOW_RAYS
 #define SUNSHADE_WALK
 #endif
 

@@ -688,6 +688,96 @@ fn sun_rays_are_spent_only_in_penumbrae() {
     assert!((49.0..=85.0).contains(&per_penumbra), "{per_penumbra} rays a penumbra pixel: {blocks:?}");
 }
 
+/// A disk light of radius `radius` [m] at `center`, facing down.
+fn disk_lights(center: DVec3, radius: f32) -> Lights {
+    Lights {
+        disks: vec![sunshade::scene::DiskLight {
+            center: center.as_vec3(),
+            direction: Vec3::NEG_Y,
+            radius,
+            radiance: [1000.0; 3],
+        }],
+        ..Default::default()
+    }
+}
+
+#[test]
+fn disk_rays_are_spent_only_where_the_walk_cannot_prove_them_clear() {
+    // What the GPU's disk-light visibility casts (cpu::disk_costs, the shader's walk mirrored): a lit floor no ray
+    // at all (the walk proves every pixel's rays clear); with the box and the plate on it, only the pixels whose
+    // cone meets them cast the 6² grid's rays, and they are a small part of the floor.
+    let camera = camera_down(DVec3::new(1.5, 0.0, 0.0), 3.0, 10.0);
+    let s = settings(96, 96, camera, disk_lights(DVec3::new(0.0, 4.0, 0.0), 0.5), Shadows::Auto, 6);
+    let options = ReferenceOptions::default();
+    let lone = cpu::disk_costs::disk_ray_costs(&scene(&[floor(5.0)]), &s, &options).unwrap();
+    assert!(lone.covered > 9000 && lone.evaluated == lone.covered, "{lone:?}");
+    assert_eq!((lone.left_to_rays, lone.rays), (0, 0), "{lone:?}");
+    let blocks = cpu::disk_costs::disk_ray_costs(&blocks_scene(1.0, 5.0), &s, &options).unwrap();
+    eprintln!("lone floor {lone:?}; with the blocks {blocks:?}");
+    assert!(blocks.left_to_rays > 0 && blocks.left_to_rays * 5 < blocks.evaluated, "{blocks:?}");
+    let per_pixel = blocks.rays as f64 / blocks.left_to_rays as f64;
+    assert!((1.0..=85.0).contains(&per_pixel), "{per_pixel} rays a pixel left to them: {blocks:?}");
+}
+
+/// The default render's disk-light shadows (the walk's proof, then the grid's rays) against the default reference,
+/// as `render --check` compares them, at 96², each scene under a disk overhead and one low to the side: for each
+/// case, what it is, whether it passes (no coverage mismatch, over tolerance only fragile pixels, at most 0.05% of
+/// the compared ones) with the report, and whether the reference shows a shadow.
+fn disk_light_agreement(cases: &[(&str, f32)]) -> Vec<(String, bool, String, bool)> {
+    let mut gpu = common::shadow_ray_renderer();
+    let diff = DiffOptions::default();
+    let mut results = Vec::new();
+    for &(name, scale) in cases {
+        let sc = match name {
+            "icosphere" => scene(&[floor(3.0), icosphere(Vec3::new(0.0, 1.0, 0.0), 1.0, 1)]),
+            "head" => low_poly_head(scale),
+            _ => blocks_scene(scale, 5.0),
+        };
+        let m = scale as f64;
+        let centre = if name == "blocks" { DVec3::new(1.5, 0.0, 0.0) } else { DVec3::ZERO } * m;
+        let camera = camera_down(centre, 3.0 * m, 10.0 * m);
+        for (at, radius) in [(DVec3::new(0.3, 4.0, 0.2), 0.8), (DVec3::new(-3.0, 1.5, 1.0), 0.4)] {
+            let lights = disk_lights(at * m, radius * scale);
+            let s = settings(96, 96, camera, lights.clone(), Shadows::Auto, DEFAULT_SHADOW_SAMPLES_PER_AXIS);
+            let g = gpu.render(&sc, &s);
+            let (c, apart) = cpu::checked::checked_reference(&sc, &s, &gpu.reference_options());
+            let apart = apart.as_ref().map(|a| (a.mask.as_slice(), a.name, a.allowed_fraction));
+            let (report, _) = compare::diff_apart(&g, &c, &diff, apart).unwrap();
+            let none = cpu::render(&sc, &settings(96, 96, camera, lights, Shadows::None, 1), &gpu.reference_options());
+            let shadowed = c.pixels().iter().zip(none.pixels()).any(|(a, b)| a[0] < b[0]);
+            results.push((
+                format!("{name} at {scale} m, disk at {at}"),
+                report.pass && report.coverage_mismatches.total == 0,
+                report.text("gpu", "cpu"),
+                shadowed,
+            ));
+        }
+    }
+    results
+}
+
+#[test]
+fn gpu_disk_light_shadows_agree_with_the_reference_on_hard_meshes() {
+    // An 80-triangle icosphere and a coarse head on a floor (smooth normals over few facets), at 1 m and 1 mm.
+    let results = disk_light_agreement(&[("icosphere", 1.0), ("head", 1e-3), ("head", 1.0)]);
+    for (what, pass, report, _) in &results {
+        assert!(pass, "{what}:\n{report}");
+    }
+    // Every case shows a shadow (the test would pass vacuously otherwise).
+    assert!(results.iter().all(|r| r.3), "a case without a shadow");
+}
+
+#[test]
+#[ignore = "open (issue 45): under a wide disk light the blocks' penumbrae hold 1-2% fragile pixels, and up to 0.6% \
+            of the image is over tolerance among them, past the class's 0.05%"]
+fn gpu_disk_light_shadows_agree_with_the_reference_on_touching_blocks() {
+    // The 1 m box standing on the floor and the 1 mm plate, at 1 mm, 1 m and 10 km.
+    let results = disk_light_agreement(&[("blocks", 1e-3), ("blocks", 1.0), ("blocks", 1e4)]);
+    let failed: Vec<_> = results.iter().filter(|r| !r.1).map(|r| format!("{}:\n{}", r.0, r.2)).collect();
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    assert!(results.iter().all(|r| r.3), "a case without a shadow");
+}
+
 #[test]
 fn disk_light_maps_leave_a_lone_floor_bitwise_and_cut_the_room_s_shadow_error() {
     let mut gpu = CheckedRenderer::new();

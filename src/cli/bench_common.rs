@@ -86,8 +86,9 @@ pub struct BenchArgs {
     pub startup: bool,
     /// What the default render's shadows cost: teapot, cube, sunset and room (512 × 512 unless --width/--height are
     /// given) and the teapot on a floor under a delta sun at twice that, each GPU frame with the default shadows
-    /// against `--shadows none` and `--shadows map`, the CPU reference's render, the sun's penumbra fraction and
-    /// its rays a pixel (`cpu::sun_costs`). Its --update region is "shadow-cost".
+    /// against `--shadows none` and `--shadows map`, the CPU reference's render, and for the sun and the disk
+    /// lights the share of pixels left to the rays and the rays a pixel (`cpu::sun_costs`, `cpu::disk_costs`). Its
+    /// --update region is "shadow-cost".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto", "measured", "startup"])]
     pub shadow_cost: bool,
     /// With --startup: the same processes again with the whole shaders handed to the driver (diagnostics:

@@ -1,8 +1,9 @@
 //! `sunshade bench --shadow-cost`: what the default render's shadows cost on the models of models/ and on the
 //! teapot standing on a floor: each GPU frame with the default shadows (`auto`: shadow rays, the sun's through its
 //! cells) against the same frame unshadowed and by shadow maps, the CPU reference's render of the same image, and
-//! where the sun's rays go (`cpu::sun_costs`): the fraction of the evaluated pixels left to the rays (penumbrae),
-//! and the rays a covered pixel and a penumbra pixel cast.
+//! where each light's rays go (`cpu::sun_costs`, `cpu::disk_costs`): the fraction of the evaluated pixels left to
+//! the rays (penumbrae, umbrae, occluders near the rays), and the rays a covered pixel and a pixel left to them
+//! cast.
 
 use std::time::Instant;
 
@@ -24,8 +25,8 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         a.repeat,
         "frames are the render phase; the CPU reference renders the default image (f64 rays) on every core",
     );
-    out += "| scene | covered px | unshadowed frame [ms] | default frame [ms] | default / unshadowed | shadow maps frame [ms] | CPU reference [ms] | sun evaluated px | penumbra (left to rays) | sun rays / covered px | rays / penumbra px |\n";
-    out += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    out += "| scene | covered px | unshadowed frame [ms] | default frame [ms] | default / unshadowed | shadow maps frame [ms] | CPU reference [ms] | light | evaluated px | left to rays | rays / covered px | rays / px left to rays |\n";
+    out += "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n";
     let mut cases = Vec::new();
     for model in ["teapot.glb", "cube.glb", "sunset.glb", "room.gltf"] {
         let path = std::path::Path::new("models").join(model);
@@ -58,18 +59,16 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         let t = Instant::now();
         cpu::render(&scene, &with(Shadows::Auto), &reference);
         let cpu_time = t.elapsed();
-        let costs = cpu::sun_costs::sun_ray_costs(&scene, &with(Shadows::Ray), &reference);
-        let (evaluated, penumbra, per_pixel, per_penumbra) = match costs {
-            Some(c) => (
-                c.evaluated.to_string(),
-                format!("{} ({:.2}%)", c.penumbra, 100.0 * c.penumbra as f64 / c.evaluated.max(1) as f64),
-                format!("{:.2}", c.rays as f64 / c.covered.max(1) as f64),
-                if c.penumbra > 0 { format!("{:.1}", c.rays as f64 / c.penumbra as f64) } else { "–".into() },
-            ),
-            None => ("no sun".into(), "–".into(), "–".into(), "–".into()),
-        };
-        out += &format!(
-            "| {name} | {} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1} | {evaluated} | {penumbra} | {per_pixel} | {per_penumbra} |\n",
+        // Each light's costs: (light, covered, evaluated, left to the rays, rays).
+        let mut costs = Vec::new();
+        if let Some(c) = cpu::sun_costs::sun_ray_costs(&scene, &with(Shadows::Ray), &reference) {
+            costs.push(("sun", c.covered, c.evaluated, c.penumbra, c.rays));
+        }
+        if let Some(c) = cpu::disk_costs::disk_ray_costs(&scene, &with(Shadows::Ray), &reference) {
+            costs.push(("disk lights", c.covered, c.evaluated, c.left_to_rays, c.rays));
+        }
+        let frames = format!(
+            "{} | {:.1} | {:.1} | {:.2} | {:.1} | {:.1}",
             image.covered_count(),
             ms(none),
             ms(auto),
@@ -77,6 +76,19 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             ms(map),
             ms(cpu_time),
         );
+        if costs.is_empty() {
+            out += &format!("| {name} | {frames} | – | – | – | – | – |\n");
+        }
+        for (i, (light, covered, evaluated, left, rays)) in costs.into_iter().enumerate() {
+            let left_share = 100.0 * left as f64 / evaluated.max(1) as f64;
+            let per_left = if left > 0 { format!("{:.1}", rays as f64 / left as f64) } else { "–".into() };
+            out += &format!(
+                "| {} | {} | {light} | {evaluated} | {left} ({left_share:.2}%) | {:.2} | {per_left} |\n",
+                if i == 0 { name.as_str() } else { "" },
+                if i == 0 { frames.clone() } else { [""; 6].join(" | ") },
+                rays as f64 / covered.max(1) as f64,
+            );
+        }
         eprintln!("sunshade bench: {name} done");
     }
     publish(&out, a.json, &a.update, "shadow-cost")

@@ -25,6 +25,7 @@ pub mod interpolate;
 pub mod map_edges;
 mod occluders;
 pub mod raster;
+pub mod disk_costs;
 pub mod sun_costs;
 pub mod transform;
 pub mod viewport;

@@ -654,10 +654,12 @@ impl Renderer {
             }
         }
         // The walk's buffers, laid out when a render first walks: its rays without ray queries (unless every ray
-        // goes to the sun through complete cells), its slices.
+        // goes to the sun through complete cells), the disk lights' proof that their rays are clear
+        // (`visibility::disk_cone`), its slices.
         let lights = &settings.lights;
         let only_sun_cells = sun_cells == SUN_CELLS_COMPLETE && lights.disks.is_empty() && lights.sky.is_none();
         let walks = (self.pipeline.rays_walk_bvh() && !only_sun_cells)
+            || !lights.disks.is_empty()
             || settings.shading.visibility_rule == VisibilityRule::Slices;
         if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();

@@ -120,6 +120,17 @@ impl Bvh {
         self.nodes.iter().map(|n| (n.min, n.max, n.first, n.count))
     }
 
+    /// Node `i` as [`Bvh::nodes`] gives it.
+    pub fn node(&self, i: usize) -> (DVec3, DVec3, u32, u32) {
+        let n = &self.nodes[i];
+        (n.min, n.max, n.first, n.count)
+    }
+
+    /// The corners \[m\] of triangle `i` (as given to [`Bvh::new`]).
+    pub fn triangle(&self, i: usize) -> [DVec3; 3] {
+        self.triangles[i]
+    }
+
     /// Whether the ray hits any triangle with `t_min < t < t_max` (a shadow ray: the light is occluded).
     pub fn any_hit(&self, ray: &WatertightRay, t_min: f64, t_max: f64) -> bool {
         self.traverse(ray, t_min, t_max, true).is_some()

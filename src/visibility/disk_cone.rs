@@ -159,49 +159,40 @@ pub fn disk_cone_misses_triangle(c: &DiskCone, corners: [DVec3; 3]) -> bool {
     cone_triangle_class(c.origin, c.axis, c.sin_half, corners) == SunCone::Misses
 }
 
-/// Whether every shadow ray from `origin` (moved off `x`) to the disk light misses every triangle of `bvh` (built from
-/// `triangles`): the tree walked with the cone, stopping at the first triangle that cannot be shown apart. `false`
-/// also where there is no cone ([`disk_cone`]).
-pub fn disk_cone_clear(
-    bvh: &Bvh,
-    triangles: &[[DVec3; 3]],
-    origin: DVec3,
-    x: DVec3,
-    n: DVec3,
-    center: DVec3,
-    d: DVec3,
-    radius: f64,
-) -> bool {
+/// Whether every shadow ray from `origin` (moved off `x`) to the disk light misses every triangle of `bvh`: the
+/// tree walked with the cone, stopping at the first triangle that cannot be shown apart. `false` also where there
+/// is no cone ([`disk_cone`]).
+pub fn disk_cone_clear(bvh: &Bvh, origin: DVec3, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> bool {
     let Some(c) = disk_cone(origin, x, n, center, d, radius) else {
         return false;
     };
-    let nodes: Vec<_> = bvh.nodes().collect();
-    let order = bvh.order();
-    let Some(&(lo, hi, first, count)) = nodes.first() else {
+    if bvh.triangle_count() == 0 {
         return true;
-    };
-    if count > 0 {
-        return order[first as usize..(first + count) as usize]
+    }
+    let order = bvh.order();
+    let leaf_misses = |first: u32, count: u32| {
+        order[first as usize..(first + count) as usize]
             .iter()
-            .all(|&t| disk_cone_misses_triangle(&c, triangles[t as usize]));
+            .all(|&t| disk_cone_misses_triangle(&c, bvh.triangle(t as usize)))
+    };
+    let (lo, hi, first, count) = bvh.node(0);
+    if count > 0 {
+        return leaf_misses(first, count);
     }
     if disk_cone_apart_from_box(&c, lo, hi) {
         return true;
     }
     let mut stack = vec![0usize];
     while let Some(node) = stack.pop() {
-        let first = nodes[node].2 as usize;
+        let first = bvh.node(node).2 as usize;
         for child in [first, first + 1] {
-            let (lo, hi, first, count) = nodes[child];
+            let (lo, hi, first, count) = bvh.node(child);
             if disk_cone_apart_from_box(&c, lo, hi) {
                 continue;
             }
             if count == 0 {
                 stack.push(child);
-            } else if !order[first as usize..(first + count) as usize]
-                .iter()
-                .all(|&t| disk_cone_misses_triangle(&c, triangles[t as usize]))
-            {
+            } else if !leaf_misses(first, count) {
                 return false;
             }
         }
@@ -288,7 +279,7 @@ mod tests {
                     let x = DVec3::new(rng.range(-5.0, 5.0), rng.range(0.0, 2.0), rng.range(-5.0, 5.0));
                     (x, rng.point(-1.0, 1.0).normalize(), x + rng.point(-1e-3, 1e-3))
                 };
-                if disk_cone_clear(&bvh, &triangles, origin, x, n, center, d, radius) {
+                if disk_cone_clear(&bvh, origin, x, n, center, d, radius) {
                     clear += 1;
                     assert!(
                         !some_ray_blocked(&triangles, origin, x, n, &targets),
@@ -313,20 +304,20 @@ mod tests {
         let origin = DVec3::new(1.0, 5.0 / 65536.0, 1.0);
         let bvh = Bvh::new(floor.clone());
         let x = DVec3::new(1.0, 0.0, 1.0);
-        assert!(disk_cone_clear(&bvh, &floor, origin, x, DVec3::Y, center, d, radius));
+        assert!(disk_cone_clear(&bvh, origin, x, DVec3::Y, center, d, radius));
         // A plate halfway up, off the axis but within the cone's reach of the disk's rim.
         let mut scene = floor.clone();
         let p = DVec3::new(0.6, 1.2, 0.6);
         scene.push([p, p + DVec3::new(0.05, 0.0, 0.0), p + DVec3::new(0.0, 0.0, 0.05)]);
         let bvh = Bvh::new(scene.clone());
-        assert!(!disk_cone_clear(&bvh, &scene, origin, x, DVec3::Y, center, d, radius));
+        assert!(!disk_cone_clear(&bvh, origin, x, DVec3::Y, center, d, radius));
         // The same plate behind the disk's plane, or below the floor: apart.
         for y in [2.6, -1.0] {
             let mut scene = floor.clone();
             let p = DVec3::new(0.5, y, 0.5);
             scene.push([p, p + DVec3::new(0.3, 0.0, 0.0), p + DVec3::new(0.0, 0.0, 0.3)]);
             let bvh = Bvh::new(scene.clone());
-            assert!(disk_cone_clear(&bvh, &scene, origin, x, DVec3::Y, center, d, radius), "plate at y = {y}");
+            assert!(disk_cone_clear(&bvh, origin, x, DVec3::Y, center, d, radius), "plate at y = {y}");
         }
     }
 
@@ -341,12 +332,12 @@ mod tests {
         let scene = vec![[DVec3::new(3.0, 0.005, -1.0), DVec3::new(4.5, 0.005, 0.0), DVec3::new(3.0, 0.005, 1.0)]];
         assert!(some_ray_blocked(&scene, origin, x, n, &disk_points(center, d, radius)));
         let bvh = Bvh::new(scene.clone());
-        assert!(!disk_cone_clear(&bvh, &scene, origin, x, n, center, d, radius));
+        assert!(!disk_cone_clear(&bvh, origin, x, n, center, d, radius));
         // Below both planes it is apart.
         let below = vec![scene[0].map(|p| p - DVec3::new(0.0, 0.006, 0.0))];
         let bvh = Bvh::new(below.clone());
         assert!(!some_ray_blocked(&below, origin, x, n, &disk_points(center, d, radius)));
-        assert!(disk_cone_clear(&bvh, &below, origin, x, n, center, d, radius));
+        assert!(disk_cone_clear(&bvh, origin, x, n, center, d, radius));
     }
 
     #[test]
