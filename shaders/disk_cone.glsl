@@ -12,8 +12,11 @@
 // The rays from an origin to a disk light (DiskCone in the Rust).
 struct DiskCone {
     vec3 origin;
+    vec3 x;
     vec3 n;
-    vec3 plane;
+    float delta;
+    float lowest;
+    float inv_reach;
     vec3 axis;
     vec3 u;
     vec3 v;
@@ -31,16 +34,21 @@ float largest_coordinate(vec3 v) {
     return max(max(a.x, a.y), a.z);
 }
 
-// The cone of the rays from origin (moved off the shading point x of normal n) to the disk light (centre [m], unit emission direction d,
-// radius [m]); false where the origin is not in front of the disk or within a radius (and 2^-10 of it) of its
-// centre.
+// The cone of the rays from origin (moved off the shading point x of normal n) to the disk light (centre [m], unit
+// emission direction d, radius [m]); false where the origin is not in front of the disk or within a radius (and
+// 2^-10 of it) of its centre.
 bool disk_cone(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius, out DiskCone c) {
     vec3 to = center - origin;
     float dist = length(to);
     float h = dot(d, origin - center);
     c.origin = origin;
     c.n = n;
-    c.plane = dot(n, origin - x) < 0.0 ? origin : x;
+    // The floor under the rays (see the Rust): the origin's height above the tangent plane at x, the disk's
+    // lowest point's (at least 0).
+    c.x = x;
+    c.delta = dot(n, origin - x);
+    c.lowest = max(dot(n, center - x) - radius * length(n - dot(n, d) * d), 0.0);
+    c.inv_reach = 1.0 / (dist - radius);
     c.center = center;
     c.d = d;
     if (!(h > 0.0 && radius >= 0.0 && dist * (1.0 - 1.0 / 1024.0) > radius)) {
@@ -64,6 +72,15 @@ bool disk_cone_apart_from_ball(DiskCone c, vec3 centre, float r) {
     float along = dot(v, c.axis);
     float across = length(v - along * c.axis);
     return across * c.cos_half - along * c.sin_half > r;
+}
+
+// The height above the tangent plane at x [m] under which the rays meet nothing within r [m] of the origin.
+float disk_cone_floor(DiskCone c, float r) {
+    if (c.delta <= c.lowest) {
+        return c.delta;
+    }
+    float tau = min(r * c.inv_reach, 1.0);
+    return (1.0 - tau) * c.delta + tau * c.lowest;
 }
 
 // Whether the box (centre, half sizes [m]) lies wholly outside one face of the square pyramid about the cone, by
@@ -90,10 +107,12 @@ bool disk_cone_apart_from_box(DiskCone c, vec3 lo, vec3 hi) {
     if (dot(c.d, centre - c.center) + dot(abs(c.d), half_size) <= -m) {
         return true;
     }
-    if (dot(c.n, centre - c.plane) + dot(abs(c.n), half_size) <= -m) {
+    float reach = length(centre - c.origin) + length(half_size);
+    if (dot(c.n, centre - c.x) + dot(abs(c.n), half_size) <= disk_cone_floor(c, reach) - 0.25 * m) {
         return true;
     }
-    return disk_cone_apart_from_pyramid(c, centre, half_size, m) || disk_cone_apart_from_ball(c, centre, length(half_size) + m);
+    return disk_cone_apart_from_pyramid(c, centre, half_size, m)
+           || disk_cone_apart_from_ball(c, centre, length(half_size) + m);
 }
 
 // Whether no ray of the cone can meet the triangle (world corners [m]).
@@ -104,8 +123,13 @@ bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
     if (any(lessThan(hi, c.lo - m)) || any(greaterThan(lo, c.hi + m))) {
         return true;
     }
-    if ((dot(c.d, c0 - c.center) <= -m && dot(c.d, c1 - c.center) <= -m && dot(c.d, c2 - c.center) <= -m)
-        || (dot(c.n, c0 - c.plane) <= -m && dot(c.n, c1 - c.plane) <= -m && dot(c.n, c2 - c.plane) <= -m)) {
+    if (dot(c.d, c0 - c.center) <= -m && dot(c.d, c1 - c.center) <= -m && dot(c.d, c2 - c.center) <= -m) {
+        return true;
+    }
+    float reach = max(max(length(c0 - c.origin), length(c1 - c.origin)), length(c2 - c.origin));
+    float floor_height = disk_cone_floor(c, reach) - 0.25 * m;
+    if (dot(c.n, c0 - c.x) <= floor_height && dot(c.n, c1 - c.x) <= floor_height
+        && dot(c.n, c2 - c.x) <= floor_height) {
         return true;
     }
     return cone_triangle_class(c.origin, c.axis, c.sin_half, c0, c1, c2) == SUN_CONE_MISSES;
@@ -131,9 +155,9 @@ bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
         } \
     }
 
-// Whether every shadow ray from origin (moved off x) to the disk light misses every occluder: the tree walked with the cone
-// (false also where there is no cone). One iteration of llvmpipe's loop budget an inner node entered, as the rays'
-// walk.
+// Whether every shadow ray from origin (moved off x) to the disk light misses every occluder: the tree walked with
+// the cone (false also where there is no cone). One iteration of llvmpipe's loop budget an inner node entered, as
+// the rays' walk.
 bool disk_cone_clear(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     DiskCone c;
     if (!disk_cone(origin, x, n, center, d, radius, c)) {

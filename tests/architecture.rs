@@ -256,15 +256,14 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
 ];
 
 /// Functions a mirrored shader file defines with no Rust function of the name, and why.
-const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] =
-    &[
-        ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
-        (
-            "lights/disk.glsl",
-            "disk_rays_proven_clear",
-            "the GPU's shortcut before the grid (src/visibility/disk_cone.rs's walk); the reference casts its rays",
-        ),
-    ];
+const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
+    ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
+    (
+        "lights/disk.glsl",
+        "disk_rays_proven_clear",
+        "the GPU's shortcut before the grid (src/visibility/disk_cone.rs's walk); the reference casts its rays",
+    ),
+];
 
 /// Shader files with no Rust twin, and why.
 const GPU_ONLY_FILES: &[(&str, &str)] = &[

@@ -20,12 +20,12 @@
 pub mod barycentric;
 pub mod checked;
 pub mod clip;
+pub mod disk_costs;
 mod fragment;
 pub mod interpolate;
 pub mod map_edges;
 mod occluders;
 pub mod raster;
-pub mod disk_costs;
 pub mod sun_costs;
 pub mod transform;
 pub mod viewport;

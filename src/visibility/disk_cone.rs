@@ -16,18 +16,24 @@
 //! 3. stays in the box of `o` and the disk: along a unit axis `e` the disk spans `c·e ± R √(1 − (d·e)²)`;
 //! 4. and is cast only where its sample weighs something, which holds `n·(y − x) > 0` (the grid's samples and the
 //!    lobe's are weighed from the shading point `x` with its normal `n`; the ray starts at `o`, moved off `x`):
-//!    along the ray `n·(p − x)` runs from `n·(o − x)` to `n·(y − x) > 0`, so it meets no point with
-//!    `n·(p − x) ≤ min(0, n·(o − x))`: nothing at or below the lower of the tangent planes through `x` and `o`.
+//!    along the ray `n·(p − x)` runs linearly from `δ = n·(o − x)` at `t = 0` to `n·(y − x)` at `t = 1`, which is
+//!    positive and at least `g = n·(c − x) − R |n − (n·d) d|` (the disk's lowest point above the tangent plane at
+//!    `x`). A point within `r` of `o` is reached at `t ≤ τ = min(1, r/(D − R))` (`|y − o| ≥ D − R`), where the ray
+//!    is at least `f(r) = δ` if `δ ≤ g⁺`, else `(1 − τ) δ + τ g⁺` (`g⁺ = max(g, 0)`): an object within `r` of the
+//!    origin lying wholly at or below `f(r)` above the tangent plane at `x` is not met. Near the origin that is the
+//!    tangent plane through the origin (the ray starts there); far from it, through the disk's lowest visible
+//!    point. Its margin is `2⁻²¹ M`: the clearance it leaves is `(1 − τ) δ`, the origin's offset (`2⁻¹⁶` of its
+//!    triangle's coordinates) scaled, far above the rounding of `n·(q − x)`.
 //!
 //! **Apart.** A box (a node's) is apart from the rays where it lies wholly on the far side of one of these: outside
-//! the hull's box along a coordinate axis (3); wholly behind the disk's plane (2); wholly below that tangent plane
-//! (4); outside the cone (1): outside a face of the square pyramid about the cone (the planes through `o` of
-//! normals `cos σ e − sin σ a`, `e = ±u, ±v` across the axis), or, for the ball about the box's centre through its
-//! corners, by the signed distance `f(v) = |v⊥| cos σ − (v·a) sin σ` of `v = p − o`: `f` is 1-Lipschitz (the map
-//! `v → (|v⊥|, v·a)` is) and positive outside the cone, so `f(centre) > r` puts the whole ball outside. A triangle
-//! is apart where its box is by (3), where all its corners are behind the disk's plane (2) or below the tangent plane (4), or where the
-//! classification of a cone against a triangle ([`cone_triangle_class`], the sun's: the triangle's own plane, its
-//! edges' planes) finds that the cone (1), as rays of any length, misses it.
+//! the hull's box along a coordinate axis (3); wholly behind the disk's plane (2); wholly below the floor `f` (4);
+//! outside the cone (1): outside a face of the square pyramid about the cone (the planes through `o` of normals
+//! `cos σ e − sin σ a`, `e = ±u, ±v` across the axis), or, for the ball about the box's centre through its corners,
+//! by the signed distance `s(v) = |v⊥| cos σ − (v·a) sin σ` of `v = p − o`: `s` is 1-Lipschitz (the map
+//! `v → (|v⊥|, v·a)` is) and positive outside the cone, so `s(centre) > r` puts the whole ball outside. A triangle
+//! is apart where its box is by (3), where all its corners are behind the disk's plane (2) or below the floor (4),
+//! or where the classification of a cone against a triangle ([`cone_triangle_class`], the sun's: the triangle's own
+//! plane, its edges' planes) finds that the cone (1), as rays of any length, misses it.
 //!
 //! **Margins.** The GPU computes in f32, its rays included; a few roundings of `2⁻²⁴` relative on coordinates up
 //! to the larger of the cone's and the object's magnitudes `M`. Every comparison but the sun's classification
@@ -46,11 +52,15 @@ pub const DISK_CONE_MARGIN: f64 = 1.0 / 524_288.0;
 /// The rays from an origin to a disk light, as the walk tests them (module text).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiskCone {
-    /// The ray origin \[m\], the shading normal (unit, or 0: then no tangent plane helps) and the lower of the
-    /// points `x`, `o` along it, whose tangent plane bounds the cast rays from below.
+    /// The ray origin \[m\], the shading point \[m\] and its unit normal (or 0: then no tangent plane helps).
     pub origin: DVec3,
+    pub x: DVec3,
     pub n: DVec3,
-    pub plane: DVec3,
+    /// The floor under the rays (module text, 4): the origin's height `δ` above the tangent plane at `x` and the
+    /// disk's lowest point's `g⁺` \[m\], and `1/(D − R)` \[1/m\].
+    pub delta: f64,
+    pub lowest: f64,
+    pub inv_reach: f64,
     /// The unit axis towards the disk's centre and the sine and cosine of the cone's half-angle.
     pub axis: DVec3,
     /// Two unit vectors across the axis, for the faces of the square pyramid about the cone.
@@ -72,9 +82,9 @@ fn largest_coordinate(v: DVec3) -> f64 {
     v.abs().max_element()
 }
 
-/// The cone of the rays from `origin` (moved off the shading point `x` of normal `n`) to the disk light of `center` \[m\], unit emission
-/// direction `d` and `radius` \[m\]; `None` where the origin is not in front of the disk or lies within a
-/// radius (and 2⁻¹⁰ of it) of its centre, where no cone narrower than a half-space holds the disk.
+/// The cone of the rays from `origin` (moved off the shading point `x` of normal `n`) to the disk light of `center`
+/// \[m\], unit emission direction `d` and `radius` \[m\]; `None` where the origin is not in front of the disk or
+/// lies within a radius (and 2⁻¹⁰ of it) of its centre, where no cone narrower than a half-space holds the disk.
 pub fn disk_cone(origin: DVec3, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> Option<DiskCone> {
     let to = center - origin;
     let dist = to.length();
@@ -87,12 +97,17 @@ pub fn disk_cone(origin: DVec3, x: DVec3, n: DVec3, center: DVec3, d: DVec3, rad
     // nearly along d keeps its small extent.
     let spread = |de: f64| radius * ((1.0 - de) * (1.0 + de)).max(0.0).sqrt();
     let reach = DVec3::new(spread(d.x), spread(d.y), spread(d.z));
+    // The disk's lowest point above the tangent plane at x: g = n·(c − x) − R |n − (n·d) d|.
+    let lowest = n.dot(center - x) - radius * (n - n.dot(d) * d).length();
     let axis = to / dist;
     let u = crate::shading::orthonormal_to(axis);
     Some(DiskCone {
         origin,
         n,
-        plane: if n.dot(origin - x) < 0.0 { origin } else { x },
+        x,
+        delta: n.dot(origin - x),
+        lowest: lowest.max(0.0),
+        inv_reach: 1.0 / (dist - radius),
         axis,
         u,
         v: axis.cross(u),
@@ -112,6 +127,16 @@ pub fn disk_cone_apart_from_ball(c: &DiskCone, centre: DVec3, r: f64) -> bool {
     let along = v.dot(c.axis);
     let across = (v - along * c.axis).length();
     across * c.cos_half - along * c.sin_half > r
+}
+
+/// The height above the tangent plane at `x` \[m\] under which the rays meet nothing within `r` \[m\] of the
+/// origin (module text, 4).
+pub fn disk_cone_floor(c: &DiskCone, r: f64) -> f64 {
+    if c.delta <= c.lowest {
+        return c.delta;
+    }
+    let tau = (r * c.inv_reach).min(1.0);
+    (1.0 - tau) * c.delta + tau * c.lowest
 }
 
 /// Whether the box (`centre`, `half` sizes \[m\]) lies wholly outside one face of the square pyramid about the
@@ -138,7 +163,8 @@ pub fn disk_cone_apart_from_box(c: &DiskCone, lo: DVec3, hi: DVec3) -> bool {
     if c.d.dot(centre - c.center) + c.d.abs().dot(half) <= -m {
         return true;
     }
-    if c.n.dot(centre - c.plane) + c.n.abs().dot(half) <= -m {
+    let reach = (centre - c.origin).length() + half.length();
+    if c.n.dot(centre - c.x) + c.n.abs().dot(half) <= disk_cone_floor(c, reach) - m / 4.0 {
         return true;
     }
     disk_cone_apart_from_pyramid(c, centre, half, m) || disk_cone_apart_from_ball(c, centre, half.length() + m)
@@ -153,7 +179,12 @@ pub fn disk_cone_misses_triangle(c: &DiskCone, corners: [DVec3; 3]) -> bool {
     if hi.cmplt(c.lo - m).any() || lo.cmpgt(c.hi + m).any() {
         return true;
     }
-    if corners.iter().all(|p| c.d.dot(*p - c.center) <= -m) || corners.iter().all(|p| c.n.dot(*p - c.plane) <= -m) {
+    if corners.iter().all(|p| c.d.dot(*p - c.center) <= -m) {
+        return true;
+    }
+    let reach = corners.iter().map(|p| (*p - c.origin).length()).fold(0.0, f64::max);
+    let floor = disk_cone_floor(c, reach) - m / 4.0;
+    if corners.iter().all(|p| c.n.dot(*p - c.x) <= floor) {
         return true;
     }
     cone_triangle_class(c.origin, c.axis, c.sin_half, corners) == SunCone::Misses
