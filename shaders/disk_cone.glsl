@@ -1,13 +1,16 @@
 // A disk light's shadow rays proven clear before one is cast: a walk of the occluders' BVH with the cone from the
-// ray origin to the disk, stopping at the first triangle it cannot show apart from the rays. Clear: every ray of
-// the grid and of the lobe gets through, the visible fraction is exactly 1 and none is cast. Mirrors
-// src/visibility/disk_cone.rs name for name (see it for the derivation and the margins). Where the shader walks
-// the tree (SUNSHADE_WALK); included by visibility.glsl after sun_cells.glsl, whose classification it uses.
+// ray origin to the disk, listing the few triangles it cannot show apart from the rays. None: every ray of the grid
+// and of the lobe gets through, the visible fraction is exactly 1 and none is cast; a few: the grid's rays test
+// those alone. Mirrors src/visibility/disk_cone.rs name for name (see it for the derivation and the margins).
+// Where the shader walks the tree (SUNSHADE_WALK); included by visibility.glsl after sun_cells.glsl, whose
+// classification it uses.
 #ifndef SUNSHADE_DISK_CONE_GLSL
 #define SUNSHADE_DISK_CONE_GLSL
 
 // The margin of the comparisons, relative to the largest coordinate involved: 2^-19 (DISK_CONE_MARGIN).
 #define DISK_CONE_MARGIN (1.0 / 524288.0)
+// The most triangles a walk lists (DISK_CONE_LISTED); past them the rays take the traversal.
+#define DISK_CONE_LISTED 16u
 
 // The rays from an origin to a disk light (DiskCone in the Rust).
 struct DiskCone {
@@ -135,12 +138,20 @@ bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
     return cone_triangle_class(c.origin, c.axis, c.sin_half, c0, c1, c2) == SUN_CONE_MISSES;
 }
 
-// A leaf's triangle the cone's rays may meet ends the walk: not clear.
+// The triangles (occluder records) the last walk listed, for disk_cone_occluded.
+uvec4 disk_cone_listed[DISK_CONE_LISTED];
+uint disk_cone_listed_count = 0u;
+
+// A leaf's triangle the cone's rays may meet is listed; one past DISK_CONE_LISTED ends the walk.
 #define DISK_CONE_LEAF(leaf) \
     { \
         uvec4 tri = WALK_RECORD((leaf).first); \
         if (!disk_cone_misses_triangle(c, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z))) { \
-            return false; \
+            if (disk_cone_listed_count == DISK_CONE_LISTED) { \
+                return DISK_CONE_UNKNOWN; \
+            } \
+            disk_cone_listed[disk_cone_listed_count] = tri; \
+            disk_cone_listed_count += 1u; \
         } \
     }
 // Child `i` of an inner node: skipped where its box is apart; an inner node stacked, a leaf's triangle tested.
@@ -155,24 +166,41 @@ bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
         } \
     }
 
-// Whether every shadow ray from origin (moved off x) to the disk light misses every occluder: the tree walked with
-// the cone (false also where there is no cone). One iteration of llvmpipe's loop budget an inner node entered, as
-// the rays' walk.
-bool disk_cone_clear(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+// The occluders the shadow rays from origin (moved off x) to the disk light may meet: the tree walked with the cone,
+// the triangles it cannot show apart listed (disk_cone_listed): DISK_CONE_CLEAR where there are none (every ray
+// gets through), DISK_CONE_LIST, or DISK_CONE_UNKNOWN where there is no cone or more than DISK_CONE_LISTED. One
+// iteration of llvmpipe's loop budget an inner node entered, as the rays' walk.
+uint disk_cone_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+    disk_cone_listed_count = 0u;
     DiskCone c;
     if (!disk_cone(origin, x, n, center, d, radius, c)) {
-        return false;
+        return DISK_CONE_UNKNOWN;
     }
     BvhNode root = bvh_nodes[0];
     if (root.count > 0u) {
         DISK_CONE_LEAF(root)
-        return true;
+    } else if (!disk_cone_apart_from_box(c, root.lo, root.hi)) {
+        BVH_WALK(DISK_CONE_CHILD)
     }
-    if (disk_cone_apart_from_box(c, root.lo, root.hi)) {
-        return true;
+    return disk_cone_listed_count == 0u ? DISK_CONE_CLEAR : DISK_CONE_LIST;
+}
+
+// Whether the ray from origin along direction meets, with 0 < t < t_max, a listed triangle that blocks it: where the
+// walk listed the triangles, occluded's answer (every other triangle misses every ray to the disk).
+bool disk_cone_occluded(vec3 origin, vec3 direction, float t_max) {
+    if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
+        return false;
     }
-    BVH_WALK(DISK_CONE_CHILD)
-    return true;
+    WatertightRay r = watertight_ray(origin, direction);
+    for (uint i = 0u; i < disk_cone_listed_count; ++i) {
+        uvec4 tri = disk_cone_listed[i];
+        vec2 bary;
+        if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary)
+            && blocks(tri, bary)) {
+            return true;
+        }
+    }
+    return false;
 }
 
 #endif

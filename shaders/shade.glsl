@@ -99,14 +99,16 @@ vec3 irradiance_visible(Frame p) {
                                                        d.center_radius.w, 4u * k * k);
                 }
 #endif
-                if (v < 0.0 && disk_rays_proven_clear(p.shadow_origin, position, normal, d.center_radius.xyz,
-                                                      d.direction.xyz, d.center_radius.w)) {
-                    v = 1.0;
-                    disk_rays_clear |= i < 32u ? 1u << i : 0u;
-                }
                 if (v < 0.0) {
-                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
-                                              d.direction.xyz, d.center_radius.w);
+                    uint gathered = disk_rays_gather(p.shadow_origin, position, normal, d.center_radius.xyz,
+                                                     d.direction.xyz, d.center_radius.w);
+                    if (gathered == DISK_CONE_CLEAR) {
+                        v = 1.0;
+                        disk_rays_clear |= i < 32u ? 1u << i : 0u;
+                    } else {
+                        v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
+                                                  d.direction.xyz, d.center_radius.w, gathered == DISK_CONE_LIST);
+                    }
                 }
             }
         }

@@ -63,6 +63,12 @@ bool visible_to(vec3 origin, vec3 target) {
     return !occluded(origin, target - origin, SEGMENT_T_MAX);
 }
 
+// What a disk light's walk (disk_cone.glsl's disk_cone_gather; DiskConeGather in the Rust) found: no triangle near
+// its rays, a list of them, or too many (or no walk on this module).
+#define DISK_CONE_CLEAR 0u
+#define DISK_CONE_LIST 1u
+#define DISK_CONE_UNKNOWN 2u
+
 #include "sun_cells.glsl"
 #if defined(SUNSHADE_WALK) && defined(SUNSHADE_SHADOW_RAYS)
 #include "disk_cone.glsl"
@@ -132,6 +138,8 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
 #define GRID_LIGHT_SKY 2u
 // The sun, its rays tested against its cell's triangles (sun_cells.glsl) instead of taking occluded.
 #define GRID_LIGHT_SUN_CELLS 3u
+// A disk light, its rays tested against the triangles its walk listed (disk_cone.glsl) instead of taking occluded.
+#define GRID_LIGHT_DISK_LISTED 4u
 // grid_fraction's stages at a corner: its own ray, the bisection along v to the corner below, along u to the one
 // before.
 #define GRID_CORNER 0u
@@ -201,6 +209,11 @@ bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
 #ifdef SUNSHADE_SHADOW_RAYS
     if (ONLY_SUN_CELL_RAYS || L.kind == GRID_LIGHT_SUN_CELLS) {
         return !sun_cells_occluded(origin, L.n, ray);
+    }
+#endif
+#if defined(SUNSHADE_WALK) && defined(SUNSHADE_SHADOW_RAYS)
+    if (L.kind == GRID_LIGHT_DISK_LISTED) {
+        return !disk_cone_occluded(origin, ray - origin, SEGMENT_T_MAX);
     }
 #endif
     bool to_point = L.kind == GRID_LIGHT_DISK;

@@ -260,7 +260,7 @@ const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
     ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
     (
         "lights/disk.glsl",
-        "disk_rays_proven_clear",
+        "disk_rays_gather",
         "the GPU's shortcut before the grid (src/visibility/disk_cone.rs's walk); the reference casts its rays",
     ),
 ];

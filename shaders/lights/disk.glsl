@@ -176,20 +176,24 @@ float disk_projected_solid_angle(vec3 x, vec3 n, vec3 center, vec3 direction, fl
     return partial_disk_projected_solid_angle(n, direction, q, r_perp, h, sqrt(rho2), radius);
 }
 
-// Whether every shadow ray of the disk light's grid and lobe from origin (moved off x, of normal n) is proven to get
-// through: the walk of disk_cone.glsl where the shader walks the occluders' tree; false elsewhere (the rays decide).
-bool disk_rays_proven_clear(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+// What the occluders do to the disk light's shadow rays from origin (moved off x, of normal n): the walk of
+// disk_cone.glsl where the shader walks the occluders' tree (DISK_CONE_CLEAR: every ray of the grid and the lobe
+// gets through; DISK_CONE_LIST: only the listed triangles can meet them); elsewhere unknown (the rays decide).
+uint disk_rays_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
 #if defined(SUNSHADE_WALK) && defined(SUNSHADE_SHADOW_RAYS)
-    return disk_cone_clear(origin, x, n, center, d, radius);
+    return disk_cone_gather(origin, x, n, center, d, radius);
 #else
-    return false;
+    return DISK_CONE_UNKNOWN;
 #endif
 }
 
-// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n.
-float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
+// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n; its rays test
+// only the triangles the walk listed where `listed` (disk_rays_gather).
+float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius,
+                            bool listed) {
     vec3 a = orthonormal_to(d);
-    VisibilityLight L = VisibilityLight(GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a), radius, 0.0);
+    VisibilityLight L = VisibilityLight(listed ? GRID_LIGHT_DISK_LISTED : GRID_LIGHT_DISK, x, n, center, d, a,
+                                        cross(d, a), radius, 0.0);
     return grid_fraction(origin, k, L);
 }
 

@@ -1,8 +1,9 @@
 //! A disk light's shadow rays proven clear before one is cast: a walk of the occluders' BVH with the cone from the
 //! ray origin to the disk. Where every node and triangle it meets is shown apart from the rays, every ray of the
 //! light's grid and lobe gets through, so the visible fraction is exactly 1 (the grid's sums would be the same
-//! additions) and the pixel casts none. Only where the walk meets a triangle it cannot show apart (a penumbra, an
-//! umbra, or a triangle close to the rays) does the grid cast its rays. The GPU runs it where the shader walks the
+//! additions) and the pixel casts none. Only where the walk meets triangles it cannot show apart (a penumbra, an
+//! umbra, or a triangle close to the rays) does the grid cast its rays, and where those are few
+//! ([`DISK_CONE_LISTED`]) the rays test them alone: every other triangle misses every ray. The GPU runs it where the shader walks the
 //! tree (shaders/disk_cone.glsl mirrors this file name for name); the reference casts its f64 rays regardless,
 //! an independent computation of the same fractions.
 //!
@@ -44,10 +45,25 @@
 use glam::DVec3;
 
 use super::bvh::Bvh;
+use super::ray_triangle::WatertightRay;
 use super::sun_cells::{cone_triangle_class, SunCone};
 
 /// The margin of the comparisons, relative to the largest coordinate involved: `2⁻¹⁹`.
 pub const DISK_CONE_MARGIN: f64 = 1.0 / 524_288.0;
+
+/// The most triangles a walk lists for the rays to test alone; past them the rays take the traversal.
+pub const DISK_CONE_LISTED: usize = 16;
+
+/// What the walk found (`DISK_CONE_*` in shaders/visibility.glsl).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DiskConeGather {
+    /// No triangle can meet a ray: the whole disk is visible.
+    Clear,
+    /// Only these triangles (indices as given to the BVH) can.
+    List(Vec<u32>),
+    /// No cone, or more than [`DISK_CONE_LISTED`] triangles near the rays.
+    Unknown,
+}
 
 /// The rays from an origin to a disk light, as the walk tests them (module text).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -190,52 +206,81 @@ pub fn disk_cone_misses_triangle(c: &DiskCone, corners: [DVec3; 3]) -> bool {
     cone_triangle_class(c.origin, c.axis, c.sin_half, corners) == SunCone::Misses
 }
 
-/// Whether every shadow ray from `origin` (moved off `x`) to the disk light misses every triangle of `bvh`: the
-/// tree walked with the cone, stopping at the first triangle that cannot be shown apart. `false` also where there
-/// is no cone ([`disk_cone`]).
-pub fn disk_cone_clear(bvh: &Bvh, origin: DVec3, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> bool {
+/// The triangles of `bvh` the shadow rays from `origin` (moved off `x`) to the disk light may meet: the tree walked
+/// with the cone, each triangle it cannot show apart listed, up to [`DISK_CONE_LISTED`].
+pub fn disk_cone_gather(
+    bvh: &Bvh,
+    origin: DVec3,
+    x: DVec3,
+    n: DVec3,
+    center: DVec3,
+    d: DVec3,
+    radius: f64,
+) -> DiskConeGather {
     let Some(c) = disk_cone(origin, x, n, center, d, radius) else {
-        return false;
+        return DiskConeGather::Unknown;
     };
     if bvh.triangle_count() == 0 {
-        return true;
+        return DiskConeGather::Clear;
     }
     let order = bvh.order();
-    let leaf_misses = |first: u32, count: u32| {
-        order[first as usize..(first + count) as usize]
-            .iter()
-            .all(|&t| disk_cone_misses_triangle(&c, bvh.triangle(t as usize)))
+    let mut listed = Vec::new();
+    // A leaf's triangles near the rays are listed; false once there are too many.
+    let mut list = |first: u32, count: u32| {
+        for &t in &order[first as usize..(first + count) as usize] {
+            if !disk_cone_misses_triangle(&c, bvh.triangle(t as usize)) {
+                if listed.len() == DISK_CONE_LISTED {
+                    return false;
+                }
+                listed.push(t);
+            }
+        }
+        true
     };
     let (lo, hi, first, count) = bvh.node(0);
     if count > 0 {
-        return leaf_misses(first, count);
-    }
-    if disk_cone_apart_from_box(&c, lo, hi) {
-        return true;
-    }
-    let mut stack = vec![0usize];
-    while let Some(node) = stack.pop() {
-        let first = bvh.node(node).2 as usize;
-        for child in [first, first + 1] {
-            let (lo, hi, first, count) = bvh.node(child);
-            if disk_cone_apart_from_box(&c, lo, hi) {
-                continue;
-            }
-            if count == 0 {
-                stack.push(child);
-            } else if !leaf_misses(first, count) {
-                return false;
+        if !list(first, count) {
+            return DiskConeGather::Unknown;
+        }
+    } else if !disk_cone_apart_from_box(&c, lo, hi) {
+        let mut stack = vec![0usize];
+        while let Some(node) = stack.pop() {
+            let first = bvh.node(node).2 as usize;
+            for child in [first, first + 1] {
+                let (lo, hi, first, count) = bvh.node(child);
+                if disk_cone_apart_from_box(&c, lo, hi) {
+                    continue;
+                }
+                if count == 0 {
+                    stack.push(child);
+                } else if !list(first, count) {
+                    return DiskConeGather::Unknown;
+                }
             }
         }
     }
-    true
+    if listed.is_empty() {
+        DiskConeGather::Clear
+    } else {
+        DiskConeGather::List(listed)
+    }
+}
+
+/// Whether every shadow ray from `origin` (moved off `x`) to the disk light misses every triangle of `bvh`.
+pub fn disk_cone_clear(bvh: &Bvh, origin: DVec3, x: DVec3, n: DVec3, center: DVec3, d: DVec3, radius: f64) -> bool {
+    disk_cone_gather(bvh, origin, x, n, center, d, radius) == DiskConeGather::Clear
+}
+
+/// Whether the ray meets, with `0 < t < t_max`, one of the `listed` triangles of `bvh`: where the walk listed them,
+/// what testing every triangle would answer.
+pub fn disk_cone_occluded(bvh: &Bvh, listed: &[u32], ray: &WatertightRay, t_max: f64) -> bool {
+    listed.iter().any(|&t| ray.intersect(bvh.triangle(t as usize), 0.0, t_max).is_some())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::shading::visibility::SEGMENT_T_MAX;
-    use crate::visibility::WatertightRay;
 
     struct Lcg(u64);
     impl Lcg {
@@ -323,6 +368,35 @@ mod tests {
         }
         // The walk proves most of the floor clear, and the scenes do block rays (so that the assertion is tested).
         assert!(clear > 1000 && blocked > 300, "clear {clear}, blocked {blocked} of 4000");
+    }
+
+    #[test]
+    fn the_listed_triangles_answer_every_ray_as_all_the_triangles_do() {
+        let mut rng = Lcg(11);
+        let (center, d, radius) = (DVec3::new(0.0, 2.5, 0.0), DVec3::NEG_Y, 0.6);
+        let targets = disk_points(center, d, radius);
+        let (mut lists, mut blocked) = (0, 0);
+        for _ in 0..20 {
+            let triangles = furnished_room(&mut rng);
+            let bvh = Bvh::new(triangles.clone());
+            for _ in 0..100 {
+                let x = DVec3::new(rng.range(-5.0, 5.0), 0.0, rng.range(-5.0, 5.0));
+                let origin = x + DVec3::new(0.0, 5.0 / 65536.0, 0.0);
+                let DiskConeGather::List(listed) = disk_cone_gather(&bvh, origin, x, DVec3::Y, center, d, radius)
+                else {
+                    continue;
+                };
+                assert!(!listed.is_empty() && listed.len() <= DISK_CONE_LISTED);
+                lists += 1;
+                for &y in &targets {
+                    let ray = WatertightRay::new(origin, y - origin).unwrap();
+                    let all = triangles.iter().any(|&t| ray.intersect(t, 0.0, SEGMENT_T_MAX).is_some());
+                    assert_eq!(disk_cone_occluded(&bvh, &listed, &ray, SEGMENT_T_MAX), all, "{origin} to {y}");
+                    blocked += usize::from(all);
+                }
+            }
+        }
+        assert!(lists > 100 && blocked > 1000, "{lists} lists, {blocked} rays blocked");
     }
 
     #[test]
