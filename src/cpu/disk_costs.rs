@@ -5,16 +5,13 @@
 //! counting occluder. The reference's own rays and arithmetic, so the counts are the GPU's up to rays that graze
 //! an edge.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-
-use glam::DVec3;
-
 use super::fragment::ray_frame;
+use super::occluders::Counting;
 use super::{render_inner, Occluders, Prepared, ReferenceOptions};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::lights::disk::{disk_geometry, disk_projected_solid_angle, disk_visible_fraction};
-use crate::shading::{DiskModel, Occlusion, ShadowedLights, Shadowing};
+use crate::shading::{DiskModel, ShadowedLights, Shadowing};
 use crate::visibility::disk_cone::disk_cone_clear;
 
 /// The disk lights' visibility over an image, summed over the lights.
@@ -30,19 +27,6 @@ pub struct DiskRayCosts {
     pub rays: u64,
 }
 
-/// A counting occluder: every ray passes to `inner` and is counted.
-struct Counting<'a> {
-    inner: &'a Occluders<'a>,
-    rays: AtomicU64,
-}
-
-impl Occlusion for Counting<'_> {
-    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
-        self.rays.fetch_add(1, Ordering::Relaxed);
-        self.inner.occluded(origin, direction, t_max)
-    }
-}
-
 /// The costs of the disk lights' visibility in a render with `settings` (what shadow rays would cast), `None`
 /// without a disk light. A small-source disk is one ray a pixel, never proven clear.
 pub fn disk_ray_costs(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Option<DiskRayCosts> {
@@ -50,8 +34,8 @@ pub fn disk_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Refere
     if disks.is_empty() {
         return None;
     }
-    let bvh = crate::visibility::occluder_bvh(scene);
     let occluders = Occluders::new(scene);
+    let bvh = &occluders.bvh;
     let k = settings.shading.shadow_samples_per_axis;
     let exact = settings.shading.disk == DiskModel::Exact;
     // Each pixel's (lights evaluated, lights left to the rays, rays), as an image's channels.
@@ -68,10 +52,10 @@ pub fn disk_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Refere
                 counts[2] += 1.0;
                 continue;
             }
-            if disk_cone_clear(&bvh, f.origin, f.position, f.normal, g.center, g.direction, g.radius) {
+            if disk_cone_clear(bvh, f.origin, f.position, f.normal, g.center, g.direction, g.radius) {
                 continue;
             }
-            let counting = Counting { inner: &occluders, rays: AtomicU64::new(0) };
+            let counting = Counting::new(&occluders);
             let s = Shadowing {
                 origin: f.origin,
                 occluders: &counting,
@@ -81,7 +65,7 @@ pub fn disk_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Refere
             };
             disk_visible_fraction(&s, f.position, f.normal, g.center, g.direction, g.radius);
             counts[1] += 1.0;
-            counts[2] += counting.rays.load(Ordering::Relaxed) as f64;
+            counts[2] += counting.count() as f64;
         }
         (counts, false)
     });

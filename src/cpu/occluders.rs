@@ -97,3 +97,27 @@ impl Occlusion for Occluders<'_> {
         self.masked.is_empty() && self.bvh.slice_triangles(reach, visit)
     }
 }
+
+/// Occluders that count the rays they are asked about (what the GPU's visibility costs: `sun_costs`, `disk_costs`).
+pub(super) struct Counting<'a> {
+    inner: &'a Occluders<'a>,
+    rays: std::sync::atomic::AtomicU64,
+}
+
+impl<'a> Counting<'a> {
+    pub fn new(inner: &'a Occluders<'a>) -> Self {
+        Self { inner, rays: std::sync::atomic::AtomicU64::new(0) }
+    }
+
+    /// The rays counted so far.
+    pub fn count(&self) -> u64 {
+        self.rays.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+impl Occlusion for Counting<'_> {
+    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
+        self.rays.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.inner.occluded(origin, direction, t_max)
+    }
+}

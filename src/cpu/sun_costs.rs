@@ -4,16 +4,13 @@
 //! cell's bound) casts the located grid's rays, counted by running the reference's grid through a counting
 //! occluder. The reference's own rays and arithmetic, so the counts are the GPU's up to rays that graze an edge.
 
-use std::sync::atomic::{AtomicU64, Ordering};
-
-use glam::DVec3;
-
 use super::fragment::ray_frame;
+use super::occluders::Counting;
 use super::{render_inner, Occluders, Prepared, ReferenceOptions};
 use crate::scene::{AlphaMode, Scene};
 use crate::settings::RenderSettings;
 use crate::shading::lights::sun::sun_visible_fraction;
-use crate::shading::{Occlusion, ShadowedLights, Shadowing, SunModel};
+use crate::shading::{ShadowedLights, Shadowing, SunModel};
 use crate::visibility::sun_cells::{
     sun_cell_range, sun_cone_class, SunCells, SunCone, MAX_SUN_CELL_ENTRIES, SUN_CONE_MARGIN,
 };
@@ -32,19 +29,6 @@ pub struct SunRayCosts {
     pub rays: u64,
     /// Triangles classified in all (those above each evaluated point in its cell).
     pub tested: u64,
-}
-
-/// A counting occluder: every ray passes to `inner` and is counted.
-struct Counting<'a> {
-    inner: &'a Occluders<'a>,
-    rays: AtomicU64,
-}
-
-impl Occlusion for Counting<'_> {
-    fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
-        self.rays.fetch_add(1, Ordering::Relaxed);
-        self.inner.occluded(origin, direction, t_max)
-    }
 }
 
 /// The costs of the sun's visibility in a render with `settings` (any technique: what shadow rays would cast),
@@ -82,7 +66,7 @@ pub fn sun_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Referen
             SunCone::Misses => ([1.0, 0.0, tested], false),
             SunCone::Covered if f.normal.dot(l) > sin_sigma + SUN_CONE_MARGIN => ([1.0, 0.0, tested], false),
             _ => {
-                let counting = Counting { inner: &occluders, rays: AtomicU64::new(0) };
+                let counting = Counting::new(&occluders);
                 let s = Shadowing {
                     origin: f.origin,
                     occluders: &counting,
@@ -91,7 +75,7 @@ pub fn sun_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Referen
                     slices: false,
                 };
                 sun_visible_fraction(&s, f.normal, l, diameter);
-                ([2.0, counting.rays.load(Ordering::Relaxed) as f64, tested], false)
+                ([2.0, counting.count() as f64, tested], false)
             }
         }
     });
