@@ -3,9 +3,10 @@
 //! light's grid and lobe gets through, so the visible fraction is exactly 1 (the grid's sums would be the same
 //! additions) and the pixel casts none. Only where the walk meets triangles it cannot show apart (a penumbra, an
 //! umbra, or a triangle close to the rays) does the grid cast its rays, and where those are few
-//! ([`DISK_CONE_LISTED`]) the rays test them alone: every other triangle misses every ray. The GPU runs it where the shader walks the
-//! tree (shaders/disk_cone.glsl mirrors this file name for name); the reference casts its f64 rays regardless,
-//! an independent computation of the same fractions.
+//! ([`DISK_CONE_LISTED`]) and the shader walks the BVH for its rays (no ray queries), the rays test them alone:
+//! every other triangle misses every ray. The GPU runs the walk on every device with shadow rays
+//! (shaders/disk_cone.glsl mirrors this file name for name); the reference casts its f64 rays regardless, an
+//! independent computation of the same fractions.
 //!
 //! **Where the rays go.** A disk light of centre `c`, unit emission direction `d` and radius `R` is sampled at
 //! points `y` of its disk; a ray runs from the origin `o` (in front of the disk: `h = d·(o − c) > 0`) towards
