@@ -6,12 +6,12 @@
 //! an edge.
 
 use super::fragment::ray_frame;
-use super::occluders::Counting;
+use super::occluders::count_rays;
 use super::{render_inner, Occluders, Prepared, ReferenceOptions};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::lights::disk::{disk_geometry, disk_projected_solid_angle, disk_visible_fraction};
-use crate::shading::{DiskModel, ShadowedLights, Shadowing};
+use crate::shading::DiskModel;
 use crate::visibility::disk_cone::disk_cone_clear;
 
 /// The disk lights' visibility over an image, summed over the lights.
@@ -55,17 +55,11 @@ pub fn disk_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Refere
             if disk_cone_clear(bvh, f.origin, f.position, f.normal, g.center, g.direction, g.radius) {
                 continue;
             }
-            let counting = Counting::new(&occluders);
-            let s = Shadowing {
-                origin: f.origin,
-                occluders: &counting,
-                samples_per_axis: k,
-                lights: ShadowedLights::ALL,
-                slices: false,
-            };
-            disk_visible_fraction(&s, f.position, f.normal, g.center, g.direction, g.radius);
+            let rays = count_rays(&occluders, f.origin, k, |s| {
+                disk_visible_fraction(s, f.position, f.normal, g.center, g.direction, g.radius);
+            });
             counts[1] += 1.0;
-            counts[2] += counting.count() as f64;
+            counts[2] += rays as f64;
         }
         (counts, false)
     });

@@ -11,7 +11,7 @@ use glam::DVec3;
 use crate::scene::{AlphaMode, Scene};
 use crate::shading::surface::{masked_hit_blocks, SurfaceSample};
 use crate::shading::visibility::SliceReach;
-use crate::shading::Occlusion;
+use crate::shading::{Occlusion, ShadowedLights, Shadowing};
 use crate::visibility::{occluder_bvh, Bvh, WatertightRay};
 
 /// A masked triangle's material, corners [m], texture coordinates per set, and vertex alphas (if the mesh has
@@ -98,21 +98,23 @@ impl Occlusion for Occluders<'_> {
     }
 }
 
-/// Occluders that count the rays they are asked about (what the GPU's visibility costs: `sun_costs`, `disk_costs`).
-pub(super) struct Counting<'a> {
-    inner: &'a Occluders<'a>,
-    rays: std::sync::atomic::AtomicU64,
+/// The shadow rays `cast` sends from `origin` through `occluders` with the located grid of `samples_per_axis`
+/// (every light shadowed, no slices): what the GPU's visibility costs (`sun_costs`, `disk_costs`).
+pub(super) fn count_rays(
+    occluders: &Occluders,
+    origin: DVec3,
+    samples_per_axis: u32,
+    cast: impl FnOnce(&Shadowing),
+) -> u64 {
+    let counting = Counting { inner: occluders, rays: std::sync::atomic::AtomicU64::new(0) };
+    cast(&Shadowing { origin, occluders: &counting, samples_per_axis, lights: ShadowedLights::ALL, slices: false });
+    counting.rays.into_inner()
 }
 
-impl<'a> Counting<'a> {
-    pub fn new(inner: &'a Occluders<'a>) -> Self {
-        Self { inner, rays: std::sync::atomic::AtomicU64::new(0) }
-    }
-
-    /// The rays counted so far.
-    pub fn count(&self) -> u64 {
-        self.rays.load(std::sync::atomic::Ordering::Relaxed)
-    }
+/// Occluders that count the rays they are asked about.
+struct Counting<'a> {
+    inner: &'a Occluders<'a>,
+    rays: std::sync::atomic::AtomicU64,
 }
 
 impl Occlusion for Counting<'_> {

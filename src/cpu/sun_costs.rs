@@ -5,12 +5,12 @@
 //! occluder. The reference's own rays and arithmetic, so the counts are the GPU's up to rays that graze an edge.
 
 use super::fragment::ray_frame;
-use super::occluders::Counting;
+use super::occluders::count_rays;
 use super::{render_inner, Occluders, Prepared, ReferenceOptions};
 use crate::scene::{AlphaMode, Scene};
 use crate::settings::RenderSettings;
 use crate::shading::lights::sun::sun_visible_fraction;
-use crate::shading::{ShadowedLights, Shadowing, SunModel};
+use crate::shading::SunModel;
 use crate::visibility::sun_cells::{
     sun_cell_range, sun_cone_class, SunCells, SunCone, MAX_SUN_CELL_ENTRIES, SUN_CONE_MARGIN,
 };
@@ -66,16 +66,10 @@ pub fn sun_ray_costs(scene: &Scene, settings: &RenderSettings, options: &Referen
             SunCone::Misses => ([1.0, 0.0, tested], false),
             SunCone::Covered if f.normal.dot(l) > sin_sigma + SUN_CONE_MARGIN => ([1.0, 0.0, tested], false),
             _ => {
-                let counting = Counting::new(&occluders);
-                let s = Shadowing {
-                    origin: f.origin,
-                    occluders: &counting,
-                    samples_per_axis: k,
-                    lights: ShadowedLights::ALL,
-                    slices: false,
-                };
-                sun_visible_fraction(&s, f.normal, l, diameter);
-                ([2.0, counting.count() as f64, tested], false)
+                let rays = count_rays(&occluders, f.origin, k, |s| {
+                    sun_visible_fraction(s, f.normal, l, diameter);
+                });
+                ([2.0, rays as f64, tested], false)
             }
         }
     });
