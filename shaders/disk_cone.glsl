@@ -11,6 +11,14 @@
 #define DISK_CONE_MARGIN (1.0 / 524288.0)
 // The most triangles a walk lists (DISK_CONE_LISTED); past them the rays take the traversal.
 #define DISK_CONE_LISTED 16u
+// The most this module's walk lists: where the shader walks the BVH for its rays, which then test the list alone
+// (visibility.glsl's sample_visible); with ray queries none (the rays stay the device's), so the walk ends at the
+// first triangle it cannot show apart.
+#ifdef SUNSHADE_RAY_BVH
+const uint DISK_CONE_LIST_LIMIT = DISK_CONE_LISTED;
+#else
+const uint DISK_CONE_LIST_LIMIT = 0u;
+#endif
 
 // The rays from an origin to a disk light (DiskCone in the Rust).
 struct DiskCone {
@@ -142,12 +150,12 @@ bool disk_cone_misses_triangle(DiskCone c, vec3 c0, vec3 c1, vec3 c2) {
 uvec4 disk_cone_listed[DISK_CONE_LISTED];
 uint disk_cone_listed_count = 0u;
 
-// A leaf's triangle the cone's rays may meet is listed; one past DISK_CONE_LISTED ends the walk.
+// A leaf's triangle the cone's rays may meet is listed; one past DISK_CONE_LIST_LIMIT ends the walk.
 #define DISK_CONE_LEAF(leaf) \
     { \
         uvec4 tri = WALK_RECORD((leaf).first); \
         if (!disk_cone_misses_triangle(c, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z))) { \
-            if (disk_cone_listed_count == DISK_CONE_LISTED) { \
+            if (disk_cone_listed_count == DISK_CONE_LIST_LIMIT) { \
                 return DISK_CONE_UNKNOWN; \
             } \
             disk_cone_listed[disk_cone_listed_count] = tri; \
@@ -168,8 +176,8 @@ uint disk_cone_listed_count = 0u;
 
 // The occluders the shadow rays from origin (moved off x) to the disk light may meet: the tree walked with the cone,
 // the triangles it cannot show apart listed (disk_cone_listed): DISK_CONE_CLEAR where there are none (every ray
-// gets through), DISK_CONE_LIST, or DISK_CONE_UNKNOWN where there is no cone or more than DISK_CONE_LISTED. One
-// iteration of llvmpipe's loop budget an inner node entered, as the rays' walk.
+// gets through), DISK_CONE_LIST, or DISK_CONE_UNKNOWN where there is no cone or more than DISK_CONE_LIST_LIMIT.
+// One iteration of llvmpipe's loop budget an inner node entered, as the rays' walk.
 uint disk_cone_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     disk_cone_listed_count = 0u;
     DiskCone c;

@@ -139,7 +139,7 @@ float disk_sample(vec3 x, vec3 n, vec3 center, vec3 d, vec3 a, vec3 b, float rad
 // The sun, its rays tested against its cell's triangles (sun_cells.glsl) instead of taking occluded.
 #define GRID_LIGHT_SUN_CELLS 3u
 // A disk light, its rays tested against the triangles its walk listed (disk_cone.glsl) instead of taking occluded
-// where the shader walks the BVH for its rays (with ray queries: occluded, as GRID_LIGHT_DISK).
+// (only where the shader walks the BVH for its rays: with ray queries the walk lists none).
 #define GRID_LIGHT_DISK_LISTED 4u
 // grid_fraction's stages at a corner: its own ray, the bisection along v to the corner below, along u to the one
 // before.
@@ -214,12 +214,12 @@ bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
 #endif
 #ifdef SUNSHADE_RAY_BVH
     // The listed triangles by the walk's own test (the one the BVH's walk would apply to them); with ray queries
-    // the rays stay the device's, whose answers at an edge's rounding are its own.
+    // the walk lists none (disk_cone.glsl's DISK_CONE_LIST_LIMIT): the rays stay the device's.
     if (L.kind == GRID_LIGHT_DISK_LISTED) {
         return !disk_cone_occluded(origin, ray - origin, SEGMENT_T_MAX);
     }
 #endif
-    bool to_point = L.kind == GRID_LIGHT_DISK || L.kind == GRID_LIGHT_DISK_LISTED;
+    bool to_point = L.kind == GRID_LIGHT_DISK;
     return !occluded(origin, to_point ? ray - origin : ray, to_point ? SEGMENT_T_MAX : RAY_T_INFINITE);
 }
 
