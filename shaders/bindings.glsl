@@ -197,8 +197,8 @@ layout(std430, set = 0, binding = 9) readonly buffer SurfaceVertexBuffer {
     float surface_data[];
 };
 
-// Per triangle of the acceleration structure (its primitive order; with SUNSHADE_RAY_BVH, the tree's leaf order):
-// global vertex indices, and the material (bit 31: the mesh has vertex colours); read by shadow rays.
+// Per triangle of the acceleration structure (its primitive order): global vertex indices, and the material
+// (bit 31: the mesh has vertex colours); read by ray queries' masked hits (the walks read WALK_RECORD).
 layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
     uvec4 occluder_triangles[];
 };
@@ -214,13 +214,15 @@ layout(std430, set = 0, binding = 10) readonly buffer OccluderTriangles {
 // u and v, z where the entries start in data, w unused (VARIANT_SUN_CELLS says what the cells answer).
 // data, four words a vec4: each cell's first entry and one past the last cell's last (dims.x dims.y + 1 of them),
 // then from word dims.z (a multiple of four) the entries, sixteen words each (sun_cells.glsl).
-layout(std430, set = 0, binding = 15) readonly buffer SunCellsBuffer {
-    vec4 u;
-    vec4 v;
-    vec4 l;
-    uvec4 dims;
-    uvec4 data[];
-} sun_cells;
+// Read as a uniform texel buffer of RGBA32UI (floats by their bits), one texel a vec4: texels 0 to 3 the header
+// (u, v, l, dims), data from texel 4 (SUN_CELLS_DATA; llvmpipe fetches a texel as one gather where it loads a
+// storage buffer's words lane by lane).
+layout(set = 0, binding = 15) uniform usamplerBuffer sun_cells_texels;
+#define SUN_CELLS_U uintBitsToFloat(texelFetch(sun_cells_texels, 0))
+#define SUN_CELLS_V uintBitsToFloat(texelFetch(sun_cells_texels, 1))
+#define SUN_CELLS_L uintBitsToFloat(texelFetch(sun_cells_texels, 2))
+#define SUN_CELLS_DIMS texelFetch(sun_cells_texels, 3)
+#define SUN_CELLS_DATA(i) texelFetch(sun_cells_texels, int(4u + (i)))
 #endif
 
 // The modules that walk the occluders' tree: for the shadow rays themselves without ray queries
@@ -240,9 +242,18 @@ struct BvhNode {
     vec3 hi;
     uint count;
 };
-layout(std430, set = 0, binding = 12) readonly buffer BvhNodes {
-    BvhNode bvh_nodes[];
-};
+// Read as a uniform texel buffer of RGBA32UI, two texels a node (its lo and first, its hi and count; the box's
+// floats by their bits): llvmpipe loads a storage buffer's element lane by lane with a bounds test each, a texel
+// fetch as one gather (docs/platform.md, "Loads in the walk").
+layout(set = 0, binding = 12) uniform usamplerBuffer bvh_node_texels;
+// Every vertex's world position [m] (the vertex buffer's f32 by their bits), one RGBA32UI texel a vertex (w unused):
+// the occluders' corners, read by the walks and the sun's cells (OCCLUDER_CORNER, occluders.glsl).
+layout(set = 0, binding = 17) uniform usamplerBuffer occluder_corners;
+BvhNode bvh_node(uint i) {
+    uvec4 a = texelFetch(bvh_node_texels, int(2u * i));
+    uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));
+    return BvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+}
 // The lights' visible fractions at each pixel, summed by the renderer from their passes of slices
 // (gpu::slice_passes): a layer a light (ROWS_OF_*), each row-major (pc.framebuffer_size.x a row), read where
 // lights.light_rows.w has the light's READ_* bit; or one unused value. Negative where the pixel's slices could not
@@ -254,16 +265,11 @@ layout(std430, set = 0, binding = 13) readonly buffer LightFractions {
 #define PASSED_FRACTION(layer) \
     light_fractions[((layer) * uint(pc.framebuffer_size.y) + uint(gl_FragCoord.y)) * uint(pc.framebuffer_size.x) \
                     + uint(gl_FragCoord.x)]
-#ifdef SUNSHADE_RAY_QUERY
-// With ray queries OccluderTriangles is in the acceleration structure's order (its masked hits read it by
-// primitive index), so the walk's records, in the tree's leaf order, are a buffer of their own.
-layout(std430, set = 0, binding = 14) readonly buffer WalkTriangles {
-    uvec4 walk_triangles[];
-};
-#define WALK_RECORD(i) walk_triangles[i]
-#else
-#define WALK_RECORD(i) occluder_triangles[i]
-#endif
+// The walk's records (vertex indices and material, as OccluderTriangles) in the tree's leaf order, one RGBA32UI
+// texel each: a buffer of their own, since with ray queries OccluderTriangles is in the acceleration structure's
+// order (its masked hits read it by primitive index).
+layout(set = 0, binding = 14) uniform usamplerBuffer walk_triangles;
+#define WALK_RECORD(i) texelFetch(walk_triangles, int(i))
 #endif
 
 // Every measured BRDF table the scene's materials use, one after another, each 90 x 90 x 180 samples of rho

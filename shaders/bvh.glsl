@@ -23,7 +23,7 @@
         stack[0] = 0u; \
         while (top > 0u) { \
             top -= 1u; \
-            BvhNode node = bvh_nodes[stack[top]]; \
+            BvhNode node = bvh_node(stack[top]); \
             VISIT(node.first) \
             VISIT(node.first + 1u) \
         } \
@@ -66,7 +66,7 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
 // The triangle of the leaf node `leaf`: where the ray meets it and it blocks the ray, any_hit returns true.
 #define LEAF_TEST(leaf) \
     { \
-        uvec4 tri = occluder_triangles[(leaf).first]; \
+        uvec4 tri = WALK_RECORD((leaf).first); \
         vec2 bary; \
         if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary) \
             && blocks(tri, bary)) { \
@@ -76,7 +76,7 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
 // Child `c` of an inner node, if the ray meets its box: a leaf tested at once, an inner node stacked.
 #define VISIT_CHILD(c) \
     { \
-        BvhNode child = bvh_nodes[c]; \
+        BvhNode child = bvh_node(c); \
         if (slab(child, r.origin, d, inv, t_max)) { \
             if (child.count == 0u) { \
                 stack[top] = (c); \
@@ -94,7 +94,7 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
 bool any_hit(WatertightRay r, float t_max) {
     vec3 d = r.direction;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 0.0, d.y != 0.0 ? 1.0 / d.y : 0.0, d.z != 0.0 ? 1.0 / d.z : 0.0);
-    BvhNode root = bvh_nodes[0];
+    BvhNode root = bvh_node(0u);
     if (!slab(root, r.origin, d, inv, t_max)) {
         return false;
     }

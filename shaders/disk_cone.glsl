@@ -165,7 +165,7 @@ uint disk_cone_listed_count = 0u;
 // Child `i` of an inner node: skipped where its box is apart; an inner node stacked, a leaf's triangle tested.
 #define DISK_CONE_CHILD(i) \
     { \
-        BvhNode child = bvh_nodes[i]; \
+        BvhNode child = bvh_node(i); \
         if (!disk_cone_apart_from_box(c, child.lo, child.hi)) { \
             if (child.count == 0u) { \
                 stack[top] = (i); \
@@ -184,7 +184,7 @@ uint disk_cone_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float ra
     if (!disk_cone(origin, x, n, center, d, radius, c)) {
         return DISK_CONE_UNKNOWN;
     }
-    BvhNode root = bvh_nodes[0];
+    BvhNode root = bvh_node(0u);
     if (root.count > 0u) {
         DISK_CONE_LEAF(root)
     } else if (!disk_cone_apart_from_box(c, root.lo, root.hi)) {

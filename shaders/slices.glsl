@@ -264,7 +264,7 @@ bool within_reach(BvhNode node, SliceReach r) {
     }
 #define GATHER_CHILD(ch) \
     { \
-        BvhNode child = bvh_nodes[ch]; \
+        BvhNode child = bvh_node(ch); \
         if (within_reach(child, r)) { \
             if (child.count == 0u) { \
                 stack[top] = (ch); \
@@ -277,7 +277,7 @@ bool within_reach(BvhNode node, SliceReach r) {
 // the stack is one iteration of the budget, as in any_hit.
 int gather(SliceReach r) {
     int count = 0;
-    BvhNode root = bvh_nodes[0];
+    BvhNode root = bvh_node(0u);
     if (!within_reach(root, r)) {
         return 0;
     }
@@ -673,7 +673,7 @@ uint row_leaves[MAX_SLICE_TRIANGLES];
 // meeting more leaves than row_leaves holds sets slices_overflowed (the renderer refuses the image).
 #define SKY_ROW_CHILD(ch) \
     { \
-        BvhNode child = bvh_nodes[ch]; \
+        BvhNode child = bvh_node(ch); \
         if (within_row(child, origin, n, p, m)) { \
             if (child.count == 0u) { \
                 stack[top] = (ch); \
@@ -722,7 +722,7 @@ vec2 sky_rows_weights(vec3 origin, vec3 n, uint rows, uint first, uint count) {
     float n_c = dot(n, c);
     float visible = 0.0;
     float total = 0.0;
-    BvhNode root = bvh_nodes[0];
+    BvhNode root = bvh_node(0u);
     for (uint i = first; i < first + count; ++i) {
         float psi = (float(i) + 0.5) * step;
         vec3 p = cos(psi) * p1 + sin(psi) * p2;

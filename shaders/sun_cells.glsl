@@ -28,21 +28,21 @@
 #define SUN_CELL_ENTRY_WORDS 16u
 // Word w of entry i, and its vec4 q (0 to 2) as floats.
 // Vec4 q (0 to 3) of entry i, as words (one 16-byte load) and as floats; word w of the starts.
-#define SUN_CELL_UVEC4(i, q) sun_cells.data[sun_cells.dims.z / 4u + (SUN_CELL_ENTRY_WORDS / 4u) * (i) + (q)]
+#define SUN_CELL_UVEC4(i, q) SUN_CELLS_DATA(SUN_CELLS_DIMS.z / 4u + (SUN_CELL_ENTRY_WORDS / 4u) * (i) + (q))
 #define SUN_CELL_VEC4(i, q) uintBitsToFloat(SUN_CELL_UVEC4(i, q))
 #define SUN_CELL_RECORD(i) SUN_CELL_UVEC4(i, 3u)
-#define SUN_CELL_START(c) sun_cells.data[(c) / 4u][(c) % 4u]
+#define SUN_CELL_START(c) SUN_CELLS_DATA((c) / 4u)[(c) % 4u]
 
 // The cell whose triangles the sun rays from `origin` can meet, or NO_SUN_CELL outside every cell (nothing
 // blocks the sun there).
 uint sun_cell_of(vec3 origin) {
-    vec2 at = (vec2(dot(origin, sun_cells.u.xyz), dot(origin, sun_cells.v.xyz)) - vec2(sun_cells.u.w, sun_cells.v.w))
-            * sun_cells.l.w;
+    vec2 at = (vec2(dot(origin, SUN_CELLS_U.xyz), dot(origin, SUN_CELLS_V.xyz)) - vec2(SUN_CELLS_U.w, SUN_CELLS_V.w))
+            * SUN_CELLS_L.w;
     vec2 ij = floor(at);
-    if (!(ij.x >= 0.0 && ij.y >= 0.0 && ij.x < float(sun_cells.dims.x) && ij.y < float(sun_cells.dims.y))) {
+    if (!(ij.x >= 0.0 && ij.y >= 0.0 && ij.x < float(SUN_CELLS_DIMS.x) && ij.y < float(SUN_CELLS_DIMS.y))) {
         return NO_SUN_CELL;
     }
-    return uint(ij.x) + sun_cells.dims.x * uint(ij.y);
+    return uint(ij.x) + SUN_CELLS_DIMS.x * uint(ij.y);
 }
 
 // What the triangle (c0, c1, c2) does to the cone of half-angle asin(sin_sigma) about the unit l from `origin`, its
@@ -95,7 +95,7 @@ uvec2 sun_cell_range(vec3 origin) {
     if (c == NO_SUN_CELL) {
         return uvec2(0u);
     }
-    float depth = dot(origin, sun_cells.l.xyz);
+    float depth = dot(origin, SUN_CELLS_L.xyz);
     uint lo = SUN_CELL_START(c);
     uint hi = SUN_CELL_START(c + 1u);
     uint start = lo;

@@ -94,6 +94,13 @@ impl TexelBuffer {
         name: &str,
         fill: impl FnOnce(&mut [T]),
     ) -> Result<Self, GpuError> {
+        let limit = dev.info.max_texel_buffer_elements as usize;
+        if count > limit {
+            return Err(GpuError::TooLarge(format!(
+                "the {name} take {count} texels; {} reads at most {limit} from one texel buffer",
+                dev.info.name
+            )));
+        }
         let bytes = (count * std::mem::size_of::<T>()) as u64;
         let mut buffer =
             Buffer::new(dev, bytes, vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER, MemoryLocation::CpuToGpu, name)?;

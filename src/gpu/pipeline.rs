@@ -116,14 +116,16 @@ impl ScenePipeline {
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
             // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table, 9 the surface
-            // vertices, 10 the occluder triangles, 11 the measured BRDF tables (storage buffers); 7 the f32 texels and
-            // 16 the 8-bit ones (uniform texel buffers: lavapipe's storage buffers stop at 128 MiB, a texel buffer
-            // holds maxTexelBufferElements texels); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps
-            // until a shadow pass ran); 4 the scene's top-level acceleration structure, on devices with ray queries,
-            // and 12 the occluders' BVH nodes and 13 the sky's fractions from its passes of slices (storage buffers) on
-            // every device with shadow rays (the slices walk the tree), 14 the walk's records in the tree's leaf order
-            // with ray queries (binding 10 holds them without), 15 the sun's cells on every device with shadow rays.
-            // All read by the fragment shader. The descriptor pool is sized from the same table.
+            // vertices, 10 the occluder triangles in the acceleration structure's order, 11 the measured BRDF tables
+            // (storage buffers); 7 the f32 texels and 16 the 8-bit ones (uniform texel buffers: lavapipe's storage
+            // buffers stop at 128 MiB, a texel buffer holds maxTexelBufferElements texels); 5 the sun's shadow map
+            // and 6 the first disks' (always bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level
+            // acceleration structure, on devices with ray queries; on every device with shadow rays, 13 the
+            // lights' fractions from their passes of slices (a storage buffer), and what the walks and the sun's
+            // cells read, as uniform texel buffers (llvmpipe fetches a texel in one gather where it loads a storage
+            // buffer's words lane by lane: docs/platform.md): 12 the occluders' BVH nodes, 14 their records in the
+            // tree's leaf order, 15 the sun's cells, 17 the occluders' corners. All read by the fragment shader.
+            // The descriptor pool is sized from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),
@@ -141,15 +143,18 @@ impl ScenePipeline {
             match ray_spirv {
                 Some((_, _, ShadowRays::Query)) => {
                     table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
-                    table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
-                    table.push((14, vk::DescriptorType::STORAGE_BUFFER, 1));
-                    table.push((15, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                 }
                 Some((_, _, ShadowRays::Bvh)) => {
-                    table.push((12, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
-                    table.push((15, vk::DescriptorType::STORAGE_BUFFER, 1));
+                    table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                 }
                 None => {}
             }

@@ -92,12 +92,16 @@ pub struct GpuScene {
     surface_vertices: Buffer,
     /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
     occluder_triangles: Buffer,
+    /// Every vertex's position as a texel (binding 17), the corners the walks read.
+    occluder_corners: TexelBuffer,
     /// One dummy BVH node (binding 12 until the walk is laid out).
-    bvh_nodes: Buffer,
-    /// Without ray queries: what the walk is laid out from, and, once a render has cast rays, its buffers (the
-    /// nodes, and the occluder records in leaf order), which then take bindings 12 and 10.
+    bvh_nodes: TexelBuffer,
+    /// Where the pipelines have shadow rays: what the walk is laid out from, and, once a render walks, its
+    /// buffers (the nodes, and the occluder records in leaf order), which then take bindings 12 and 14.
     walk_source: Option<WalkSource>,
-    walk: std::cell::OnceCell<(Buffer, Buffer)>,
+    walk: std::cell::OnceCell<(TexelBuffer, TexelBuffer)>,
+    /// One dummy record (binding 14 until the walk is laid out).
+    no_walk_records: TexelBuffer,
     /// The measured BRDF tables (`layout::measured_tables`).
     measured: Buffer,
     draws: Vec<Draw>,
@@ -150,8 +154,8 @@ pub struct Renderer {
     no_light_fractions: Buffer,
     /// The sun's cells of the last frame with shadow rays and a sun (`sun_cells`), and the header bound at 15 where
     /// a frame has none.
-    sun_cells: Option<Buffer>,
-    no_sun_cells: Buffer,
+    sun_cells: Option<TexelBuffer>,
+    no_sun_cells: TexelBuffer,
     sun_map: DepthMap,
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
@@ -243,7 +247,7 @@ impl Renderer {
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
         let no_light_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "light fractions (unused)")?;
-        let no_sun_cells = Buffer::storage(&dev, &super::sun_cells::absent(), "sun cells (none)")?;
+        let no_sun_cells = super::sun_cells::texels(&dev, &super::sun_cells::absent(), "sun cells (none)")?;
         let renderer = Self {
             target: None,
             lights: None,
@@ -441,6 +445,20 @@ impl Renderer {
         } else {
             vk::BufferUsageFlags::empty()
         };
+        // The occluders' corners for the walks (binding 17): each vertex's position, one RGBA32UI texel (its floats'
+        // bits, w unused), so that a walk fetches a corner as one texel instead of three storage-buffer loads.
+        let occluder_corners = TexelBuffer::filled(
+            &self.dev,
+            vertices.len().max(1),
+            vk::Format::R32G32B32A32_UINT,
+            "occluder corners",
+            |out: &mut [[u32; 4]]| {
+                for (o, v) in out.iter_mut().zip(&vertices) {
+                    let [x, y, z] = v.position.map(f32::to_bits);
+                    *o = [x, y, z, 0];
+                }
+            },
+        )?;
         let vertices = (!vertices.is_empty())
             .then(|| {
                 Buffer::with_data(
@@ -479,7 +497,8 @@ impl Renderer {
         // (`walk`).
         let records = occluder_records(scene, &vertex_offsets, rq && masked);
         let occluder_triangles = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder triangles")?;
-        let bvh_nodes = Buffer::storage(&self.dev, bytemuck::bytes_of(&BvhNodeGpu::zeroed()), "occluder BVH nodes")?;
+        let bvh_nodes = node_texels(&self.dev, &[BvhNodeGpu::zeroed()])?;
+        let no_walk_records = record_texels(&self.dev, &[[0; 4]])?;
         // The walk's source where the pipelines have shadow rays: their walk without ray queries, the slices' with.
         let walk_source = (bvh || rq).then(|| WalkSource::new(scene, &vertex_offsets));
         Ok(GpuScene {
@@ -493,7 +512,9 @@ impl Renderer {
             texture_table,
             surface_vertices,
             occluder_triangles,
+            occluder_corners,
             bvh_nodes,
+            no_walk_records,
             walk_source,
             walk: std::cell::OnceCell::new(),
             measured: Buffer::storage(&self.dev, bytemuck::cast_slice(&measured), "measured BRDFs")?,
@@ -645,10 +666,12 @@ impl Renderer {
         if let (SHADOWS_RAY, Some(sun), Some(source)) = (shadows, &settings.lights.sun, &scene.walk_source) {
             let (triangles, records) = source.triangles_and_records();
             let half_angle = 0.5 * sun.angular_diameter as f64;
-            let max_entries = super::sun_cells::max_entries(self.dev.info.max_storage_buffer_range);
+            // The cells' bytes within a storage buffer's range and a texel buffer's texels (16 bytes each).
+            let texel_bytes = (self.dev.info.max_texel_buffer_elements as u64 * 16).min(u32::MAX as u64) as u32;
+            let max_entries = super::sun_cells::max_entries(self.dev.info.max_storage_buffer_range.min(texel_bytes));
             if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle, max_entries) {
                 let bytes = super::sun_cells::bytes(&cells, triangles, records);
-                self.sun_cells = Some(Buffer::storage(&self.dev, &bytes, "sun cells")?);
+                self.sun_cells = Some(super::sun_cells::texels(&self.dev, &bytes, "sun cells")?);
                 sun_cells =
                     if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
             }
@@ -663,8 +686,8 @@ impl Renderer {
             || settings.shading.visibility_rule == VisibilityRule::Slices;
         if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();
-            let nodes = Buffer::storage(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
-            let records = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
+            let nodes = node_texels(&self.dev, &nodes)?;
+            let records = record_texels(&self.dev, &records)?;
             let _ = scene.walk.set((nodes, records));
         }
         let shadow_setup = t_shadow_setup.elapsed();
@@ -935,18 +958,10 @@ impl Renderer {
                     (9, scene.surface_vertices.buffer),
                     (11, scene.measured.buffer),
                 ];
-                // The walk's records: binding 10 without ray queries; with them, 14, beside the acceleration
-                // structure's own order at 10.
-                let walk_records = scene.walk.get().map_or(scene.occluder_triangles.buffer, |(_, r)| r.buffer);
-                let nodes = scene.walk.get().map_or(scene.bvh_nodes.buffer, |(nodes, _)| nodes.buffer);
-                let walks = self.pipeline.rays_walk_bvh();
-                buffers.push((10, if walks { walk_records } else { scene.occluder_triangles.buffer }));
+                // 10: the occluder records in the acceleration structure's order (ray queries' masked hits).
+                buffers.push((10, scene.occluder_triangles.buffer));
                 if self.pipeline.has_shadow_rays() {
-                    let sun_cells = self.sun_cells.as_ref().unwrap_or(&self.no_sun_cells);
-                    buffers.extend([(12, nodes), (13, light_fractions.buffer), (15, sun_cells.buffer)]);
-                }
-                if self.pipeline.has_ray_queries() {
-                    buffers.push((14, walk_records));
+                    buffers.push((13, light_fractions.buffer));
                 }
                 let infos: Vec<_> = buffers
                     .into_iter()
@@ -964,14 +979,33 @@ impl Renderer {
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
                 // 7: the f32 texels, 16: the 8-bit codes; uniform texel buffers.
-                let views = [[scene.texels.view], [scene.texel_codes.view]];
-                let writes = [(7, &views[0]), (16, &views[1])].map(|(binding, view)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(self.pipeline.descriptor_set)
-                        .dst_binding(binding)
-                        .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
-                        .texel_buffer_view(view)
-                });
+                // 12, 14, 17: the walks' tree, records (leaf order) and corners, and 15 the sun's cells, for the
+                // pipelines with shadow rays.
+                let (nodes, walk_records) =
+                    scene.walk.get().map_or((&scene.bvh_nodes, &scene.no_walk_records), |(n, r)| (n, r));
+                let sun_cells = self.sun_cells.as_ref().unwrap_or(&self.no_sun_cells);
+                let views = [
+                    [scene.texels.view],
+                    [scene.texel_codes.view],
+                    [nodes.view],
+                    [walk_records.view],
+                    [sun_cells.view],
+                    [scene.occluder_corners.view],
+                ];
+                let mut bindings = vec![(7, &views[0]), (16, &views[1])];
+                if self.pipeline.has_shadow_rays() {
+                    bindings.extend([(12, &views[2]), (14, &views[3]), (15, &views[4]), (17, &views[5])]);
+                }
+                let writes: Vec<_> = bindings
+                    .into_iter()
+                    .map(|(binding, view)| {
+                        vk::WriteDescriptorSet::default()
+                            .dst_set(self.pipeline.descriptor_set)
+                            .dst_binding(binding)
+                            .descriptor_type(vk::DescriptorType::UNIFORM_TEXEL_BUFFER)
+                            .texel_buffer_view(view)
+                    })
+                    .collect();
                 d.update_descriptor_sets(&writes, &[]);
             }
             // Binding 5: the sun's shadow map, 6: the first disks' (valid images in every frame; read only by
@@ -1272,4 +1306,25 @@ fn interpolation_define(interpolation: Interpolation) -> &'static str {
         Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
         Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
     }
+}
+
+/// The occluders' BVH nodes as a uniform texel buffer of RGBA32UI, two texels a node (binding 12, read by
+/// `bvh_node` in shaders/bindings.glsl).
+fn node_texels(dev: &Arc<Device>, nodes: &[BvhNodeGpu]) -> Result<TexelBuffer, GpuError> {
+    let words: &[[u32; 4]] = bytemuck::cast_slice(nodes);
+    TexelBuffer::filled(
+        dev,
+        words.len(),
+        vk::Format::R32G32B32A32_UINT,
+        "occluder BVH nodes",
+        |out: &mut [[u32; 4]]| out.copy_from_slice(words),
+    )
+}
+
+/// The walk's occluder records (vertex indices and material) as a uniform texel buffer of RGBA32UI, one texel a
+/// record (binding 14, `WALK_RECORD` in shaders/bindings.glsl).
+fn record_texels(dev: &Arc<Device>, records: &[[u32; 4]]) -> Result<TexelBuffer, GpuError> {
+    TexelBuffer::filled(dev, records.len(), vk::Format::R32G32B32A32_UINT, "occluder records, leaf order", |out| {
+        out.copy_from_slice(records)
+    })
 }

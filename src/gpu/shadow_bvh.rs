@@ -1,9 +1,9 @@
 //! Shadow rays on devices without ray queries: the occluders' BVH (`visibility::occluder_bvh`, the tree the
 //! reference's rays walk) laid out for the fragment shader, which walks it in software (shaders/bvh.glsl,
-//! defined `SUNSHADE_RAY_BVH`). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 10 the occluder records
+//! defined `SUNSHADE_RAY_BVH`). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 14 the occluder records
 //! (`layout::occluder_records`) in the tree's leaf order, so that a leaf's `first..first + count` indexes them
-//! directly; the triangles' corners are read from the vertex buffer (binding 3) by the records' global indices,
-//! the same f32 world positions the reference's f64 rays are cast against.
+//! directly; the triangles' corners are read from binding 17 (each vertex's position) by the records' global
+//! indices, the same f32 world positions the reference's f64 rays are cast against. All three are texel buffers.
 //!
 //! **Padding for f32.** The tree's boxes are built in f64 and padded by 1e-9 relative; the shader's slab test
 //! runs in f32, and must never cut a box the ray touches (a box only decides what is tested, so padding costs time,

@@ -1,4 +1,4 @@
-//! The sun's cells on the device (binding 15, `SunCellsBuffer` in shaders/bindings.glsl): the header, each cell's
+//! The sun's cells on the device (binding 15, `sun_cells_texels` in shaders/bindings.glsl, a texel a vec4): the header, each cell's
 //! first entry, then every entry's corners, top and occluder record (`layout::occluder_records`), so that the
 //! shader reads a cell's triangles in one place, without an indirection. Built by `visibility::sun_cells` for each
 //! frame's sun.
@@ -7,7 +7,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::visibility::sun_cells::SunCells;
 
-/// The buffer's header (std430, 64 bytes): see `SunCellsBuffer`.
+/// The buffer's header (four texels, 64 bytes): see `sun_cells_texels`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct SunCellsHeader {
@@ -28,10 +28,22 @@ pub fn absent() -> Vec<u8> {
 /// Words an entry takes: its corners and top as `(c0, top), (c1, 0), (c2, 0)` in f32, then its occluder record.
 pub const ENTRY_WORDS: usize = 16;
 
-/// The most entries a storage buffer of `max_storage_buffer_range` bytes holds beside the header and the cells'
-/// starts: seven eighths of it (at most 1024² cells, 4 MiB of starts: an eighth of lavapipe's 128 MiB).
-pub fn max_entries(max_storage_buffer_range: u32) -> usize {
-    max_storage_buffer_range as usize / 8 * 7 / (ENTRY_WORDS * 4)
+/// The most entries a buffer of `max_bytes` holds beside the header and the cells' starts: seven eighths of it
+/// (at most 1024² cells, 4 MiB of starts: an eighth of lavapipe's 128 MiB of storage-buffer range, the bound the
+/// renderer takes with the device's texel-buffer size).
+pub fn max_entries(max_bytes: u32) -> usize {
+    max_bytes as usize / 8 * 7 / (ENTRY_WORDS * 4)
+}
+
+/// `bytes` (the header, then the data: a multiple of 16) as a uniform texel buffer of RGBA32UI, one texel a vec4.
+pub(crate) fn texels(
+    dev: &std::sync::Arc<super::context::Device>,
+    bytes: &[u8],
+    name: &str,
+) -> Result<super::memory::TexelBuffer, super::GpuError> {
+    super::memory::TexelBuffer::filled(dev, bytes.len() / 16, ash::vk::Format::R32G32B32A32_UINT, name, |out| {
+        bytemuck::cast_slice_mut::<[u32; 4], u8>(out).copy_from_slice(bytes)
+    })
 }
 
 /// The buffer of `cells`, whose triangle indices point into `triangles` (world corners \[m\], the vertex buffer's
@@ -69,15 +81,18 @@ mod tests {
     use super::*;
     use glam::DVec3;
 
-    /// The header's offsets are the shader's (vec4, vec4, vec4, uvec4, then the data), the records follow the
-    /// starts, and a cell's entries are its triangles' records.
+    /// The header's texels are the shader's (vec4, vec4, vec4, uvec4, then the data from texel 4), the records
+    /// follow the starts, and a cell's entries are its triangles' records.
     #[test]
     fn the_buffer_holds_the_starts_then_each_entrys_record() {
         assert_eq!(std::mem::size_of::<SunCellsHeader>(), 64);
         let glsl = include_str!("../../shaders/bindings.glsl");
-        assert!(
-            glsl.contains("    vec4 u;\n    vec4 v;\n    vec4 l;\n    uvec4 dims;\n    uvec4 data[];\n} sun_cells;")
-        );
+        for (i, field) in ["U", "V", "L"].iter().enumerate() {
+            let fetch = format!("#define SUN_CELLS_{field} uintBitsToFloat(texelFetch(sun_cells_texels, {i}))\n");
+            assert!(glsl.contains(&fetch), "{fetch}");
+        }
+        assert!(glsl.contains("#define SUN_CELLS_DIMS texelFetch(sun_cells_texels, 3)\n"));
+        assert!(glsl.contains("#define SUN_CELLS_DATA(i) texelFetch(sun_cells_texels, int(4u + (i)))\n"));
         let triangles = vec![
             [DVec3::ZERO, DVec3::X, DVec3::Z],
             [DVec3::new(5.0, 1.0, 0.0), DVec3::new(6.0, 1.0, 0.0), DVec3::new(5.0, 1.0, 1.0)],
