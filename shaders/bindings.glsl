@@ -249,6 +249,15 @@ layout(set = 0, binding = 12) uniform usamplerBuffer bvh_node_texels;
 // Every vertex's world position [m] (the vertex buffer's f32 by their bits), one RGBA32UI texel a vertex (w unused):
 // the occluders' corners, read by the walks and the sun's cells (OCCLUDER_CORNER, occluders.glsl).
 layout(set = 0, binding = 17) uniform usamplerBuffer occluder_corners;
+// The same tree in depth-first order for the shadow rays' walk without a stack (gpu::shadow_bvh::threaded): a
+// node's first is where the walk goes past its subtree, its count a leaf's record or THREADED_INNER.
+layout(set = 0, binding = 18) uniform usamplerBuffer threaded_node_texels;
+#define THREADED_INNER 0xffffffffu
+BvhNode threaded_node(uint i) {
+    uvec4 a = texelFetch(threaded_node_texels, int(2u * i));
+    uvec4 b = texelFetch(threaded_node_texels, int(2u * i + 1u));
+    return BvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+}
 BvhNode bvh_node(uint i) {
     uvec4 a = texelFetch(bvh_node_texels, int(2u * i));
     uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));

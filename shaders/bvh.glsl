@@ -1,21 +1,22 @@
 // The occluders' BVH for devices without ray queries (SUNSHADE_RAY_BVH) and for the slices' walks (SUNSHADE_WALK):
-// the same tree as src/visibility/bvh.rs (gpu::shadow_bvh lays it out, its boxes padded for f32), walked with an
-// explicit stack. Mirrors src/visibility/bvh.rs (see it for the derivations). Included by occluders.glsl after
-// `blocks` and the watertight test, which a leaf's test calls.
+// the same tree as src/visibility/bvh.rs (gpu::shadow_bvh lays it out, its boxes padded for f32): the slices' and
+// the disk lights' walks take it with an explicit stack, the shadow rays in depth-first order without one. Mirrors
+// src/visibility/bvh.rs (see it for the derivations). Included by occluders.glsl after `blocks` and the watertight
+// test, which a leaf's test calls.
 #ifndef SUNSHADE_BVH_GLSL
 #define SUNSHADE_BVH_GLSL
 
 #ifdef SUNSHADE_WALK
-// What the shadow rays' walk (devices without ray queries) and the slices' walks (shaders/slices.glsl, on every
-// device with shadow rays) share: the tree, the walk.
-// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which LEAF_TEST assumes.
+// What the walks of the slices (shaders/slices.glsl) and of the disk lights' cones (disk_cone.glsl), on every
+// device with shadow rays, share: the tree, the walk.
+// The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which the walks' leaf tests assume.
 #define BVH_LEAF_SIZE 1u
 // The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).
 #define BVH_STACK_SIZE 96
 // The walk below an inner root: nodes taken from an explicit stack (at most one pending sibling a level of a tree
 // fewer than 78 levels deep), each visiting its two children with VISIT(child), which stacks an inner child it
 // enters (`stack`, `top`) and may return from the caller. One iteration of llvmpipe's budget a node taken
-// (gpu::loop_budget). Shared by any_hit and the slices' gather (slices.glsl).
+// (gpu::loop_budget).
 #define BVH_WALK(VISIT) \
     { \
         uint stack[BVH_STACK_SIZE]; \
@@ -63,47 +64,43 @@ bool slab(BvhNode node, vec3 origin, vec3 direction, vec3 inv, float t_max) {
     return !outside && !(lo > hi);
 }
 
-// The triangle of the leaf node `leaf`: where the ray meets it and it blocks the ray, any_hit returns true.
-#define LEAF_TEST(leaf) \
+// One node of the shadow rays' walk (any_hit): a leaf whose triangle the ray meets and which blocks it returns
+// true; a box the ray misses, or a leaf, is passed over to the node after its subtree (first); an inner node whose
+// box the ray meets goes on to its first child, the next node.
+#define THREADED_STEP \
     { \
-        uvec4 tri = WALK_RECORD((leaf).first); \
-        vec2 bary; \
-        if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, bary) \
-            && blocks(tri, bary)) { \
-            return true; \
+        BvhNode node = threaded_node(i); \
+        uint next = node.first; \
+        if (slab(node, r.origin, d, inv, t_max)) { \
+            if (node.count == THREADED_INNER) { \
+                next = i + 1u; \
+            } else { \
+                uvec4 tri = WALK_RECORD(node.count); \
+                vec2 bary; \
+                if (intersect(r, OCCLUDER_CORNER(tri.x), OCCLUDER_CORNER(tri.y), OCCLUDER_CORNER(tri.z), t_max, \
+                              bary) && blocks(tri, bary)) { \
+                    return true; \
+                } \
+            } \
         } \
-    }
-// Child `c` of an inner node, if the ray meets its box: a leaf tested at once, an inner node stacked.
-#define VISIT_CHILD(c) \
-    { \
-        BvhNode child = bvh_node(c); \
-        if (slab(child, r.origin, d, inv, t_max)) { \
-            if (child.count == 0u) { \
-                stack[top] = (c); \
-                top += 1u; \
-            } else LEAF_TEST(child) \
-        } \
+        i = next; \
     }
 
-// Whether the ray meets, with 0 < t < t_max, a triangle that blocks it: the tree walked from the root with an
-// explicit stack (at most one pending sibling a level of a tree fewer than 78 levels deep). Each node taken from
-// the stack is one iteration of llvmpipe's budget (gpu::loop_budget), so an inner node tests its children's boxes,
-// tests at once the triangle of a child leaf the ray meets, and stacks only the inner children it meets: the
-// walk's iterations are the inner nodes it enters, not the boxes or triangles it tests. (One triangle a leaf:
-// on lavapipe a SIMD group runs a leaf's tests whenever one lane is at a leaf; visibility::bvh's LEAF_SIZE.)
+// Whether the ray meets, with 0 < t < t_max, a triangle that blocks it: the tree in depth-first order walked
+// without a stack (the Rust walks it with one; a shadow ray may take its hits in any order, so both test the same
+// triangles' boxes and return the same answer). On lavapipe a stack is a local array indexed differently in
+// each lane, which llvmpipe reads and writes lane by lane; here a lane holds one index. Two nodes a loop iteration:
+// llvmpipe's loop budget (gpu::loop_budget) counts iterations, and the walk with a stack took one for each inner
+// node it entered, testing its two children.
 bool any_hit(WatertightRay r, float t_max) {
     vec3 d = r.direction;
     vec3 inv = vec3(d.x != 0.0 ? 1.0 / d.x : 0.0, d.y != 0.0 ? 1.0 / d.y : 0.0, d.z != 0.0 ? 1.0 / d.z : 0.0);
-    BvhNode root = bvh_node(0u);
-    if (!slab(root, r.origin, d, inv, t_max)) {
-        return false;
+    uint end = threaded_node(0u).first;
+    uint i = 0u;
+    while (i < end) {
+        THREADED_STEP
+        if (i < end) THREADED_STEP
     }
-    if (root.count > 0u) {
-        // A tree of one leaf (a scene of one triangle, or none: gpu::shadow_bvh's degenerate record).
-        LEAF_TEST(root)
-        return false;
-    }
-    BVH_WALK(VISIT_CHILD)
     return false;
 }
 

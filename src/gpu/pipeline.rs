@@ -124,7 +124,8 @@ impl ScenePipeline {
             // lights' fractions from their passes of slices (a storage buffer), and what the walks and the sun's
             // cells read, as uniform texel buffers (llvmpipe fetches a texel in one gather where it loads a storage
             // buffer's words lane by lane: docs/platform.md): 12 the occluders' BVH nodes, 14 their records in the
-            // tree's leaf order, 15 the sun's cells, 17 the occluders' corners. All read by the fragment shader.
+            // tree's leaf order, 15 the sun's cells, 17 the occluders' corners, 18 the nodes in depth-first order (the
+            // shadow rays' walk without ray queries). All read by the fragment shader.
             // The descriptor pool is sized from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
@@ -146,6 +147,7 @@ impl ScenePipeline {
                     table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                 }
@@ -153,6 +155,7 @@ impl ScenePipeline {
                     table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                    table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                 }

@@ -97,9 +97,10 @@ pub struct GpuScene {
     /// One dummy BVH node (binding 12 until the walk is laid out).
     bvh_nodes: TexelBuffer,
     /// Where the pipelines have shadow rays: what the walk is laid out from, and, once a render walks, its
-    /// buffers (the nodes, and the occluder records in leaf order), which then take bindings 12 and 14.
+    /// buffers (the nodes, the occluder records in leaf order, the nodes in depth-first order), which then take
+    /// bindings 12, 14 and 18.
     walk_source: Option<WalkSource>,
-    walk: std::cell::OnceCell<(TexelBuffer, TexelBuffer)>,
+    walk: std::cell::OnceCell<(TexelBuffer, TexelBuffer, TexelBuffer)>,
     /// One dummy record (binding 14 until the walk is laid out).
     no_walk_records: TexelBuffer,
     /// The measured BRDF tables (`layout::measured_tables`).
@@ -686,9 +687,10 @@ impl Renderer {
             || settings.shading.visibility_rule == VisibilityRule::Slices;
         if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();
+            let threaded = node_texels(&self.dev, &super::shadow_bvh::threaded(&nodes))?;
             let nodes = node_texels(&self.dev, &nodes)?;
             let records = record_texels(&self.dev, &records)?;
-            let _ = scene.walk.set((nodes, records));
+            let _ = scene.walk.set((nodes, records, threaded));
         }
         let shadow_setup = t_shadow_setup.elapsed();
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
@@ -979,10 +981,12 @@ impl Renderer {
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
                 // 7: the f32 texels, 16: the 8-bit codes; uniform texel buffers.
-                // 12, 14, 17: the walks' tree, records (leaf order) and corners, and 15 the sun's cells, for the
-                // pipelines with shadow rays.
-                let (nodes, walk_records) =
-                    scene.walk.get().map_or((&scene.bvh_nodes, &scene.no_walk_records), |(n, r)| (n, r));
+                // 12, 14, 17, 18: the walks' tree, records (leaf order), corners and the tree in depth-first order,
+                // and 15 the sun's cells, for the pipelines with shadow rays.
+                let (nodes, walk_records, threaded) = scene
+                    .walk
+                    .get()
+                    .map_or((&scene.bvh_nodes, &scene.no_walk_records, &scene.bvh_nodes), |(n, r, t)| (n, r, t));
                 let sun_cells = self.sun_cells.as_ref().unwrap_or(&self.no_sun_cells);
                 let views = [
                     [scene.texels.view],
@@ -991,10 +995,17 @@ impl Renderer {
                     [walk_records.view],
                     [sun_cells.view],
                     [scene.occluder_corners.view],
+                    [threaded.view],
                 ];
                 let mut bindings = vec![(7, &views[0]), (16, &views[1])];
                 if self.pipeline.has_shadow_rays() {
-                    bindings.extend([(12, &views[2]), (14, &views[3]), (15, &views[4]), (17, &views[5])]);
+                    bindings.extend([
+                        (12, &views[2]),
+                        (14, &views[3]),
+                        (15, &views[4]),
+                        (17, &views[5]),
+                        (18, &views[6]),
+                    ]);
                 }
                 let writes: Vec<_> = bindings
                     .into_iter()

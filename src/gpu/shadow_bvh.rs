@@ -1,6 +1,7 @@
 //! Shadow rays on devices without ray queries: the occluders' BVH (`visibility::occluder_bvh`, the tree the
 //! reference's rays walk) laid out for the fragment shader, which walks it in software (shaders/bvh.glsl,
-//! defined `SUNSHADE_RAY_BVH`). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 14 the occluder records
+//! defined `SUNSHADE_RAY_BVH`; its shadow rays take the nodes in depth-first order without a stack, [`threaded`],
+//! binding 18). Binding 12 holds the nodes ([`BvhNodeGpu`]); binding 14 the occluder records
 //! (`layout::occluder_records`) in the tree's leaf order, so that a leaf's `first..first + count` indexes them
 //! directly; the triangles' corners are read from binding 17 (each vertex's position) by the records' global
 //! indices, the same f32 world positions the reference's f64 rays are cast against. All three are texel buffers.
@@ -78,6 +79,36 @@ impl WalkSource {
     }
 }
 
+/// A leaf's `count` in [`threaded`]'s nodes marks an inner node.
+pub const THREADED_INNER: u32 = u32::MAX;
+
+/// The tree's nodes in depth-first order for a walk without a stack (Smits, "Efficiency issues for ray tracing",
+/// 1998): an inner node's first child follows it, and each node's `first` is where the walk goes when the ray
+/// misses its box (the node after its subtree); `count` is a leaf's record (its `first`) or [`THREADED_INNER`].
+pub fn threaded(nodes: &[BvhNodeGpu]) -> Vec<BvhNodeGpu> {
+    let mut out: Vec<BvhNodeGpu> = Vec::with_capacity(nodes.len());
+    // (node, whether its subtree is done): a node is written when first met, its skip when its subtree is done.
+    let mut todo = vec![(0usize, false)];
+    let mut at: Vec<usize> = Vec::with_capacity(nodes.len());
+    while let Some((i, done)) = todo.pop() {
+        let n = nodes[i];
+        if done {
+            let k = at.pop().expect("a node's place");
+            out[k].first = out.len() as u32;
+            continue;
+        }
+        at.push(out.len());
+        let inner = n.count == 0;
+        out.push(BvhNodeGpu { first: 0, count: if inner { THREADED_INNER } else { n.first }, ..n });
+        todo.push((i, true));
+        if inner {
+            todo.push((n.first as usize + 1, false));
+            todo.push((n.first as usize, false));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -120,5 +151,31 @@ mod tests {
             let idx = &scene.meshes[0].indices[3 * t as usize..3 * t as usize + 3];
             assert_eq!(records[k], [idx[0], idx[1], idx[2], 3]);
         }
+        check_threaded(&nodes);
+        check_threaded(&empty);
+    }
+
+    /// The threaded nodes are the tree's in depth-first order: each node's box, an inner node's first child right
+    /// after it, its skip the node after its subtree, a leaf its record; the root's skip is past the last node.
+    fn check_threaded(nodes: &[BvhNodeGpu]) {
+        let threaded = threaded(nodes);
+        assert_eq!(threaded.len(), nodes.len());
+        fn visit(nodes: &[BvhNodeGpu], threaded: &[BvhNodeGpu], n: usize, k: &mut usize) {
+            let (orig, here) = (nodes[n], threaded[*k]);
+            assert_eq!((here.min, here.max), (orig.min, orig.max), "node {n} at {k}");
+            let at = *k;
+            *k += 1;
+            if orig.count == 0 {
+                assert_eq!(here.count, THREADED_INNER);
+                visit(nodes, threaded, orig.first as usize, k);
+                visit(nodes, threaded, orig.first as usize + 1, k);
+            } else {
+                assert_eq!(here.count, orig.first, "a leaf's record");
+            }
+            assert_eq!(threaded[at].first as usize, *k, "node {n}'s skip");
+        }
+        let mut k = 0;
+        visit(nodes, &threaded, 0, &mut k);
+        assert_eq!((k, threaded[0].first as usize), (nodes.len(), nodes.len()));
     }
 }
