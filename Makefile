@@ -22,7 +22,7 @@ test: setup
 	CARGO=$(CARGO) ./scripts/cargo-test-or-backtrace.sh --release --workspace
 	@if rt="$$(./scripts/lavapipe-rt.sh)"; then \
 		eval "$$rt"; echo "make test: the ray-query tests on $$VK_ICD_FILENAMES"; \
-		SUNSHADE_REQUIRE_RAY_QUERIES=1 CARGO=$(CARGO) ./scripts/cargo-test-or-backtrace.sh --release --test shadows \
+		SUNSHADE_REQUIRE_RAY_QUERIES=1 SUNSHADE_RAY_QUERIES=1 CARGO=$(CARGO) ./scripts/cargo-test-or-backtrace.sh --release --test shadows \
 			--test cli --test measured --test startup -- gpu_ ray_quer; \
 	else \
 		echo "make test: SKIPPED the ray-query tests: scripts/lavapipe-rt.sh could not install Mesa 25's lavapipe (above)"; \

@@ -1297,10 +1297,10 @@ fn gpu_disk_slices_agree_with_the_reference() {
         apart.max_rel, timings.lights_in_passes
     );
     assert!(apart.max_rel <= 1e-5, "{}", apart.text("gpu", "reference"));
-    // Mesa 22.3.6's lavapipe (no ray queries) has the loop limiter; Mesa 25.0.7's (ray queries) did not cut these
-    // loops short (docs/platform.md), so its frame keeps the disk's slices.
+    // Mesa 22.3.6's lavapipe has the loop limiter; Mesa 25.0.7's did not cut these loops short (docs/platform.md),
+    // so its frame keeps the disk's slices.
     let info = gpu.renderer().device_info();
-    if info.name.contains("llvmpipe") && !info.ray_query {
+    if sunshade::gpu::frame_probe::probes(info) {
         assert_eq!(timings.lights_in_passes, sunshade::gpu::layout::READ_DISKS, "the disk's slices fit the frame here");
     }
     assert_eq!(timings.probe, None, "a frame of fewer than 128 rows is not probed");
@@ -1323,10 +1323,10 @@ fn gpu_disk_slices_agree_with_the_reference() {
     assert!(apart.max_rel <= 1e-5, "{}", apart.text("gpu", "reference"));
     assert_eq!(common::bits(&probed), common::bits(&again), "the probed frame is the frame drawn again");
     let info = renderer.device_info();
-    // llvmpipe before Mesa 25 probes (25.0.7 cuts nothing short); Mesa 22.3.6 has no ray queries.
+    // llvmpipe before Mesa 25 probes (25.0.7 cuts nothing short).
     let probed = sunshade::gpu::frame_probe::probes(info);
     assert_eq!(first.probe.is_some(), probed, "{first:?}");
-    if probed && !info.ray_query {
+    if probed {
         assert!(first.probe.is_some_and(|p| p.ran_out && p.blocks == 64), "{first:?}");
         assert_eq!(first.lights_in_passes, sunshade::gpu::layout::READ_DISKS);
         assert_eq!((second.probe, second.lights_in_passes), (None, first.lights_in_passes), "{second:?}");

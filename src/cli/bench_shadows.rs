@@ -108,7 +108,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         if info.ray_query {
             ""
         } else {
-            " (no ray queries: the sun's rays through its cells, the disk light's by the BVH walk)"
+            " (without ray queries: the sun's rays through its cells, the disk light's by the BVH walk)"
         },
         build(),
         width,

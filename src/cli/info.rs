@@ -3,7 +3,7 @@
 use clap::Args;
 
 use super::CliError;
-use crate::gpu::{list_devices, ContextOptions};
+use crate::gpu::{casts_ray_queries, list_devices, ContextOptions};
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
@@ -36,6 +36,7 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
                     "max_push_constants_size": d.max_push_constants_size,
                     "shader_float64": d.shader_float64,
                     "ray_query": d.ray_query,
+                    "shadow_rays": if casts_ray_queries(d, options.ray_queries) { "ray queries" } else { "shader walk" },
                     "unusable": d.unusable,
                 })
             })
@@ -84,8 +85,13 @@ pub fn run(a: &InfoArgs) -> Result<(), CliError> {
             if d.shader_float64 { "f64" } else { "f32" }
         );
         println!(
-            "      ray queries (VK_KHR_ray_query + acceleration structures): {}",
-            if d.ray_query { "yes" } else { "no (--shadows ray walks the scene's BVH in the fragment shader)" }
+            "      ray queries (VK_KHR_ray_query + acceleration structures): {}; shadow rays {}",
+            if d.ray_query { "yes" } else { "no" },
+            if casts_ray_queries(d, options.ray_queries) {
+                "by ray queries"
+            } else {
+                "by the fragment shader's walk of the scene's BVH"
+            }
         );
         if let Some(why) = &d.unusable {
             println!("      not usable: {why}");

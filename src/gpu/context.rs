@@ -67,6 +67,9 @@ pub struct ContextOptions {
     /// the module specialized for the pipeline (`sunshade_glsl::specialize`): for measuring what that saves and
     /// checking that images do not change (`SUNSHADE_WHOLE_SHADERS=1`, tests/startup.rs).
     pub whole_shaders: bool,
+    /// Shadow rays by ray queries: `None` where the device has them and is a GPU (`device_info::casts_ray_queries`,
+    /// which `SUNSHADE_RAY_QUERIES` overrides), `Some(true)` wherever the device has them, `Some(false)` never.
+    pub ray_queries: Option<bool>,
 }
 
 impl ContextOptions {
@@ -250,7 +253,8 @@ impl Device {
     pub fn new(options: &ContextOptions) -> Result<Arc<Self>, GpuError> {
         let instance = Instance::new(options.validation)?;
         let devices = instance.devices()?;
-        let (physical, info) = device_info::choose(&devices, options.device.as_deref())?;
+        let (physical, mut info) = device_info::choose(&devices, options.device.as_deref())?;
+        info.ray_query = device_info::casts_ray_queries(&info, options.ray_queries);
         let queue_family = info.graphics_queue_family.expect("chosen devices have a graphics queue");
         // SAFETY: valid physical device; the create info only enables features the device reported.
         unsafe {
@@ -263,7 +267,7 @@ impl Device {
             // shaderFloat64 where present: the fragment shader's barycentrics in f64.
             let features =
                 vk::PhysicalDeviceFeatures::default().geometry_shader(true).shader_float64(info.shader_float64);
-            // Ray queries (shadow rays) where the device has them: the extensions, their features and buffer
+            // Ray queries (shadow rays) where the renderer casts them: the extensions, their features and buffer
             // device addresses (acceleration structures are built from buffer addresses).
             let rq = info.ray_query;
             let mut features12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(rq);

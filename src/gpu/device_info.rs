@@ -37,7 +37,8 @@ pub struct DeviceInfo {
     /// Why sunshade cannot use this device, if it cannot.
     pub unusable: Option<String>,
     /// `VK_KHR_ray_query`, `VK_KHR_acceleration_structure` (with `VK_KHR_deferred_host_operations`) and their
-    /// features, and `bufferDeviceAddress`: shadow rays on the GPU possible (sunshade enables them all then).
+    /// features, and `bufferDeviceAddress`: shadow rays by ray queries possible. In a renderer's
+    /// (`Renderer::device_info`): whether it casts them so ([`casts_ray_queries`]; it enables them all then).
     pub ray_query: bool,
     /// `minAccelerationStructureScratchOffsetAlignment` (0 without acceleration structures).
     pub min_acceleration_structure_scratch_offset_alignment: u32,
@@ -46,6 +47,24 @@ pub struct DeviceInfo {
     pub device_id: u32,
     pub driver_version: u32,
     pub pipeline_cache_uuid: [u8; 16],
+}
+
+/// The environment variable that overrides where ray queries are used (`1`: wherever the device has them, `0`:
+/// nowhere), for tests and measurements.
+pub const RAY_QUERIES_VAR: &str = "SUNSHADE_RAY_QUERIES";
+
+/// Whether a renderer on this device casts its shadow rays by ray queries rather than by the fragment shader's walk
+/// of the occluders' BVH: where the device has them, on a GPU. On a CPU device (lavapipe) both are software, and the
+/// shader's walk is the faster (on Mesa 25's lavapipe, overcast.glb's sky 1.3 s against 3.8 s by ray queries,
+/// docs/platform.md) and gives the same image on every lavapipe, Mesa 22.3's included, which has none. `choice`
+/// (`ContextOptions::ray_queries`), else [`RAY_QUERIES_VAR`], overrides the device's type.
+pub fn casts_ray_queries(info: &DeviceInfo, choice: Option<bool>) -> bool {
+    let from_env = || match std::env::var(RAY_QUERIES_VAR).as_deref() {
+        Ok("1") => Some(true),
+        Ok("0") => Some(false),
+        _ => None,
+    };
+    info.ray_query && choice.or_else(from_env).unwrap_or(info.device_type != vk::PhysicalDeviceType::CPU)
 }
 
 impl DeviceInfo {

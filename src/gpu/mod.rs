@@ -35,7 +35,7 @@ pub mod sun_cells;
 pub mod texture_buffers;
 
 pub use context::{list_devices, ContextOptions, Interpolation, ValidationLog};
-pub use device_info::DeviceInfo;
+pub use device_info::{casts_ray_queries, DeviceInfo, RAY_QUERIES_VAR};
 pub use error::{GpuError, VULKAN_PACKAGES};
 pub use pipeline::CreatedPipeline;
 pub use renderer::{FrameTimings, GpuScene, Renderer, SetupTimings};

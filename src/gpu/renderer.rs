@@ -570,7 +570,7 @@ impl Renderer {
             }
             if !lights.disks.is_empty() || lights.sky.is_some() {
                 let by = if self.pipeline.rays_walk_bvh() {
-                    "the fragment shader's walk of the occluders' BVH (no ray queries)"
+                    "the fragment shader's walk of the occluders' BVH (without ray queries: the device has none, or is a CPU)"
                 } else {
                     "ray queries"
                 };

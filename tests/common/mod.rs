@@ -72,15 +72,16 @@ pub fn bits(image: &Image) -> Vec<u32> {
     image.pixels().iter().flatten().map(|v| v.to_bits()).collect()
 }
 
-/// A renderer that casts shadow rays: by ray queries where the device has them, else by the fragment shader's walk
-/// of the occluders' BVH (`gpu::shadow_bvh`). With `SUNSHADE_REQUIRE_RAY_QUERIES=1` (`make test`'s stage on Mesa
-/// 25's lavapipe) the device must have ray queries, so that stage tests them and not the walk.
+/// A renderer that casts shadow rays: by ray queries where it uses them (`gpu::casts_ray_queries`), else by the
+/// fragment shader's walk of the occluders' BVH (`gpu::shadow_bvh`). With `SUNSHADE_REQUIRE_RAY_QUERIES=1`
+/// (`make test`'s stage on Mesa 25's lavapipe, which also sets `SUNSHADE_RAY_QUERIES=1`, since a CPU device walks
+/// by default) it must cast them, so that stage tests them and not the walk.
 pub fn shadow_ray_renderer() -> CheckedRenderer {
     let mut gpu = CheckedRenderer::new();
     let info = gpu.renderer().device_info();
     assert!(
         info.ray_query || std::env::var("SUNSHADE_REQUIRE_RAY_QUERIES").map_or(true, |v| v != "1"),
-        "SUNSHADE_REQUIRE_RAY_QUERIES=1 but {} has no ray queries",
+        "SUNSHADE_REQUIRE_RAY_QUERIES=1 but {} casts no ray queries (SUNSHADE_RAY_QUERIES=1 uses a CPU device's)",
         info.name
     );
     gpu
