@@ -177,15 +177,18 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
     uint indices[];
 };
 
-// FLOATS_PER_VERTEX floats per vertex: position xyz [m], normal xyz, tangent xyz and handedness (world space);
-// the offsets below (gpu::layout::Vertex).
+// The vertex buffer's FLOATS_PER_VERTEX floats per vertex (the vertex shader's input): position xyz [m], normal
+// xyz, tangent xyz and handedness (world space); the offsets below (gpu::layout::Vertex).
 #define FLOATS_PER_VERTEX 10u
 #define VERTEX_POSITION 0u
 #define VERTEX_NORMAL 3u
 #define VERTEX_TANGENT 6u
-layout(std430, set = 0, binding = 3) readonly buffer VertexBuffer {
-    float vertex_data[];
-};
+// The same vertices as RGBA32UI texels, three a vertex (floats by their bits): position [m] and 0, normal and 0,
+// tangent and handedness (texel offset / 3 of the offsets above). What the fragment shader reads of its triangle's corners and the walks of the
+// occluders': llvmpipe fetches a texel in one gather where it loads a storage buffer's words lane by lane
+// (docs/platform.md, "Loads in the walks"). Texel k of vertex i as floats:
+layout(set = 0, binding = 17) uniform usamplerBuffer vertex_texels;
+#define VERTEX_TEXEL(i, k) uintBitsToFloat(texelFetch(vertex_texels, int(3u * (i) + (k))))
 
 // FLOATS_PER_SURFACE_VERTEX floats per vertex, read only by textured materials: TEXCOORD_0 uv, TEXCOORD_1 uv,
 // COLOR_0 rgba (gpu::layout::SurfaceVertex).
@@ -246,9 +249,6 @@ struct BvhNode {
 // floats by their bits): llvmpipe loads a storage buffer's element lane by lane with a bounds test each, a texel
 // fetch as one gather (docs/platform.md, "Loads in the walk").
 layout(set = 0, binding = 12) uniform usamplerBuffer bvh_node_texels;
-// Every vertex's world position [m] (the vertex buffer's f32 by their bits), one RGBA32UI texel a vertex (w unused):
-// the occluders' corners, read by the walks and the sun's cells (OCCLUDER_CORNER, occluders.glsl).
-layout(set = 0, binding = 17) uniform usamplerBuffer occluder_corners;
 // The same tree in depth-first order for the shadow rays' walk without a stack (gpu::shadow_bvh::threaded): a
 // node's first is where the walk goes past its subtree, its count a leaf's record or THREADED_INNER.
 layout(set = 0, binding = 18) uniform usamplerBuffer threaded_node_texels;

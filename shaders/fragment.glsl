@@ -24,8 +24,7 @@ float coverage_alpha() {
 }
 
 vec3 fragment_vertex_position(uint index) {
-    uint base = index * FLOATS_PER_VERTEX + VERTEX_POSITION;
-    return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
+    return VERTEX_TEXEL(index, 0u).xyz;
 }
 
 vec2 surface_vec2(uint index, uint offset) {

@@ -48,7 +48,7 @@ bool blocks(uvec4 tri, vec2 b) {
 #ifdef SUNSHADE_SHADOW_RAYS
 // A corner of an occluder triangle: the world position [m] of global vertex i (the vertex buffer's f32, which the
 // reference's rays meet as f64). Read by the walks and by the sun's cells (sun_cells.glsl).
-#define OCCLUDER_CORNER(i) uintBitsToFloat(texelFetch(occluder_corners, int(i)).xyz)
+#define OCCLUDER_CORNER(i) VERTEX_TEXEL(i, 0u).xyz
 #endif
 
 

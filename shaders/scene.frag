@@ -20,14 +20,13 @@ layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec4 v_tangent;
 #endif
 
+// A vertex's position (offset VERTEX_POSITION, 0), normal (3) or tangent (6, a vec4): its texel offset / 3.
 vec3 vertex_vec3(uint index, uint offset) {
-    uint base = index * FLOATS_PER_VERTEX + offset;
-    return vec3(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u]);
+    return VERTEX_TEXEL(index, offset / 3u).xyz;
 }
 
 vec4 vertex_vec4(uint index, uint offset) {
-    uint base = index * FLOATS_PER_VERTEX + offset;
-    return vec4(vertex_data[base], vertex_data[base + 1u], vertex_data[base + 2u], vertex_data[base + 3u]);
+    return VERTEX_TEXEL(index, offset / 3u);
 }
 
 // The part of t orthogonal to the unit normal n, normalised; the default tangent (world +X projected, else +Z)

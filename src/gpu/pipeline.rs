@@ -115,29 +115,29 @@ impl ScenePipeline {
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
-            // The binding table: 0 materials, 1 lights, 2 indices, 3 vertices, 8 the texture table, 9 the surface
-            // vertices, 10 the occluder triangles in the acceleration structure's order, 11 the measured BRDF tables
-            // (storage buffers); 7 the f32 texels and 16 the 8-bit ones (uniform texel buffers: lavapipe's storage
-            // buffers stop at 128 MiB, a texel buffer holds maxTexelBufferElements texels); 5 the sun's shadow map
-            // and 6 the first disks' (always bound: 1 × 1 maps until a shadow pass ran); 4 the scene's top-level
-            // acceleration structure, on devices with ray queries; on every device with shadow rays, 13 the
-            // lights' fractions from their passes of slices (a storage buffer), and what the walks and the sun's
-            // cells read, as uniform texel buffers (llvmpipe fetches a texel in one gather where it loads a storage
-            // buffer's words lane by lane: docs/platform.md): 12 the occluders' BVH nodes, 14 their records in the
-            // tree's leaf order, 15 the sun's cells, 17 the occluders' corners, 18 the nodes in depth-first order (the
-            // shadow rays' walk without ray queries). All read by the fragment shader.
-            // The descriptor pool is sized from the same table.
+            // The binding table: 0 materials, 1 lights, 2 indices, 8 the texture table, 9 the surface vertices, 10 the
+            // occluder triangles in the acceleration structure's order, 11 the measured BRDF tables (storage
+            // buffers); 7 the f32 texels, 16 the 8-bit ones and 17 the vertices, three texels each (uniform texel
+            // buffers: lavapipe's storage buffers stop at 128 MiB, a texel buffer holds maxTexelBufferElements
+            // texels, and llvmpipe fetches a texel in one gather where it loads a storage buffer's words lane by
+            // lane: docs/platform.md); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps until a
+            // shadow pass ran); 4 the scene's top-level acceleration structure, on devices with ray queries; on every
+            // device with shadow rays, 13 the lights' fractions from their passes of slices (a storage buffer), and
+            // what the walks and the sun's cells read, as uniform texel buffers: 12 the occluders' BVH nodes, 14
+            // their records in the tree's leaf order, 15 the sun's cells, 18 the nodes in depth-first order (the
+            // shadow rays' walk without ray queries). All read by the fragment shader. The descriptor pool is sized
+            // from the same table.
             let mut table = vec![
                 (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (2, vk::DescriptorType::STORAGE_BUFFER, 1),
-                (3, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (8, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (9, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (10, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (11, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (7, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (16, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
+                (17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];
@@ -146,7 +146,6 @@ impl ScenePipeline {
                     table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
                     table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
@@ -154,7 +153,6 @@ impl ScenePipeline {
                 Some((_, _, ShadowRays::Bvh)) => {
                     table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                     table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
                     table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));

@@ -92,8 +92,9 @@ pub struct GpuScene {
     surface_vertices: Buffer,
     /// Per acceleration-structure triangle: vertex indices and material, for alpha-masked shadow-ray hits.
     occluder_triangles: Buffer,
-    /// Every vertex's position as a texel (binding 17), the corners the walks read.
-    occluder_corners: TexelBuffer,
+    /// Every vertex as three texels (binding 17): what the fragment shader reads of its triangle, and the walks
+    /// of the occluders' corners.
+    vertex_texels: TexelBuffer,
     /// One dummy BVH node (binding 12 until the walk is laid out).
     bvh_nodes: TexelBuffer,
     /// Where the pipelines have shadow rays: what the walk is laid out from, and, once a render walks, its
@@ -446,17 +447,18 @@ impl Renderer {
         } else {
             vk::BufferUsageFlags::empty()
         };
-        // The occluders' corners for the walks (binding 17): each vertex's position, one RGBA32UI texel (its floats'
-        // bits, w unused), so that a walk fetches a corner as one texel instead of three storage-buffer loads.
-        let occluder_corners = TexelBuffer::filled(
+        // The vertices as texels (binding 17): position, normal and tangent, one RGBA32UI texel each (the floats'
+        // bits), which the fragment shader and the walks fetch instead of the storage buffer's words.
+        let vertex_texels = TexelBuffer::filled(
             &self.dev,
-            vertices.len().max(1),
+            3 * vertices.len().max(1),
             vk::Format::R32G32B32A32_UINT,
-            "occluder corners",
+            "vertex texels",
             |out: &mut [[u32; 4]]| {
-                for (o, v) in out.iter_mut().zip(&vertices) {
-                    let [x, y, z] = v.position.map(f32::to_bits);
-                    *o = [x, y, z, 0];
+                for (o, v) in out.chunks_exact_mut(3).zip(&vertices) {
+                    let bits = |a: [f32; 3], w: f32| [a[0], a[1], a[2], w].map(f32::to_bits);
+                    let [t0, t1, t2, t3] = v.tangent;
+                    o.copy_from_slice(&[bits(v.position, 0.0), bits(v.normal, 0.0), bits([t0, t1, t2], t3)]);
                 }
             },
         )?;
@@ -465,7 +467,7 @@ impl Renderer {
                 Buffer::with_data(
                     &self.dev,
                     bytemuck::cast_slice(&vertices),
-                    vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER | accel_usage,
+                    vk::BufferUsageFlags::VERTEX_BUFFER | accel_usage,
                     "vertices",
                 )
             })
@@ -513,7 +515,7 @@ impl Renderer {
             texture_table,
             surface_vertices,
             occluder_triangles,
-            occluder_corners,
+            vertex_texels,
             bvh_nodes,
             no_walk_records,
             walk_source,
@@ -942,20 +944,19 @@ impl Renderer {
         Ok(())
     }
 
-    /// Bindings 0 materials, 1 lights, 2 indices, 3 vertices, 4 the acceleration structure, 5 the sun's map.
+    /// Bindings 0 materials, 1 lights, 2 indices, 4 the acceleration structure, 5 the sun's map.
     unsafe fn write_descriptors(&self, scene: &GpuScene, lights: &Buffer, light_fractions: &Buffer) {
         let d = &self.dev.device;
         // SAFETY: the caller guarantees the GPU is idle; every handle belongs to this renderer.
         unsafe {
-            // Bindings 0 materials, 1 lights, 2 indices, 3 vertices (only bound when there is geometry).
-            if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
+            // Bindings 0 materials, 1 lights, 2 indices, 17 the vertices (only bound when there is geometry).
+            if let (Some(_), Some(ib)) = (&scene.vertices, &scene.indices) {
                 // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
                 // 12 the occluders' BVH and 13 the lights' fractions for the pipelines with shadow rays.
                 let mut buffers = vec![
                     (0, scene.materials.buffer),
                     (1, lights.buffer),
                     (2, ib.buffer),
-                    (3, vb.buffer),
                     (8, scene.texture_table.buffer),
                     (9, scene.surface_vertices.buffer),
                     (11, scene.measured.buffer),
@@ -980,9 +981,9 @@ impl Renderer {
                     })
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
-                // 7: the f32 texels, 16: the 8-bit codes; uniform texel buffers.
-                // 12, 14, 17, 18: the walks' tree, records (leaf order), corners and the tree in depth-first order,
-                // and 15 the sun's cells, for the pipelines with shadow rays.
+                // 7: the f32 texels, 16: the 8-bit codes, 17: the vertices; uniform texel buffers.
+                // 12, 14, 18: the walks' tree, records (leaf order) and the tree in depth-first order, and 15 the
+                // sun's cells, for the pipelines with shadow rays.
                 let (nodes, walk_records, threaded) = scene
                     .walk
                     .get()
@@ -994,18 +995,12 @@ impl Renderer {
                     [nodes.view],
                     [walk_records.view],
                     [sun_cells.view],
-                    [scene.occluder_corners.view],
+                    [scene.vertex_texels.view],
                     [threaded.view],
                 ];
-                let mut bindings = vec![(7, &views[0]), (16, &views[1])];
+                let mut bindings = vec![(7, &views[0]), (16, &views[1]), (17, &views[5])];
                 if self.pipeline.has_shadow_rays() {
-                    bindings.extend([
-                        (12, &views[2]),
-                        (14, &views[3]),
-                        (15, &views[4]),
-                        (17, &views[5]),
-                        (18, &views[6]),
-                    ]);
+                    bindings.extend([(12, &views[2]), (14, &views[3]), (15, &views[4]), (18, &views[6])]);
                 }
                 let writes: Vec<_> = bindings
                     .into_iter()
