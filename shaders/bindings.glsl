@@ -148,9 +148,34 @@ struct DiskGpu {
     vec4 radiance;      // rgb: L0 [W/(m^2 sr)]; w unused
 };
 
-layout(std430, set = 0, binding = 0) readonly buffer MaterialBuffer {
-    MaterialGpu materials[];
-};
+// The materials (gpu::layout::MaterialGpu, 304 bytes) as RGBA32UI texels, nineteen a material (floats by their
+// bits): kd, ks, params, kind, base, pbr, emission, then each texture reference's row0, row1, texture. Read by
+// material_at: llvmpipe loads a storage buffer's words lane by lane even where every lane reads the same, and
+// fetches a texel in one gather (docs/platform.md, "Loads in the walks").
+layout(set = 0, binding = 0) uniform usamplerBuffer material_texels;
+#define MATERIAL_TEXELS 19u
+MaterialGpu material_at(uint m) {
+    int at = int(MATERIAL_TEXELS * m);
+    MaterialGpu g;
+    g.kd = uintBitsToFloat(texelFetch(material_texels, at));
+    g.ks = uintBitsToFloat(texelFetch(material_texels, at + 1));
+    g.params = uintBitsToFloat(texelFetch(material_texels, at + 2));
+    g.kind = texelFetch(material_texels, at + 3);
+    g.base = uintBitsToFloat(texelFetch(material_texels, at + 4));
+    g.pbr = uintBitsToFloat(texelFetch(material_texels, at + 5));
+    g.emission = uintBitsToFloat(texelFetch(material_texels, at + 6));
+    // The four references written out, not looped over: llvmpipe's loop budget counts a loop's iterations.
+#define MATERIAL_TEXTURE_REF(k) \
+    g.tex[k].row0 = uintBitsToFloat(texelFetch(material_texels, at + 7 + 3 * k)); \
+    g.tex[k].row1 = uintBitsToFloat(texelFetch(material_texels, at + 8 + 3 * k)); \
+    g.tex[k].texture = texelFetch(material_texels, at + 9 + 3 * k);
+    MATERIAL_TEXTURE_REF(0)
+    MATERIAL_TEXTURE_REF(1)
+    MATERIAL_TEXTURE_REF(2)
+    MATERIAL_TEXTURE_REF(3)
+#undef MATERIAL_TEXTURE_REF
+    return g;
+}
 
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;

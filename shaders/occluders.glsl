@@ -17,7 +17,7 @@ bool blocks(uvec4 tri, vec2 b) {
     if (VARIANT_OCCLUDERS_MASKED == 0u) {
         return true;
     }
-    MaterialGpu material = materials[tri.w & 0x7fffffffu];
+    MaterialGpu material = material_at(tri.w & 0x7fffffffu);
     if (material.kind.z == 0u) {
         return true;
     }

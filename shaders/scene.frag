@@ -41,7 +41,7 @@ vec3 orthonormal_tangent(vec3 t, vec3 n) {
 }
 
 void main() {
-    MaterialGpu material = materials[pc.material];
+    MaterialGpu material = material_at(pc.material);
 #ifdef SUNSHADE_DEVICE_INTERPOLATION
     vec3 position = v_position;
     vec3 normal = safe_normalize(v_normal);

@@ -10,7 +10,7 @@
 #include "fragment.glsl"
 
 void main() {
-    MaterialGpu material = materials[pc.material];
+    MaterialGpu material = material_at(pc.material);
     SurfaceSample s = surface_sample();
     if (!alpha_covers(material, base_color(material, s).a)) {
         discard;

@@ -128,7 +128,7 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     for (uint i = range.x; i < range.y; ++i) {
         uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
                                       SUN_CELL_VEC4(i, 2u).xyz);
-        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || materials[SUN_CELL_RECORD(i).w & 0x7fffffffu].kind.z == 0u;
+        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || material_at(SUN_CELL_RECORD(i).w & 0x7fffffffu).kind.z == 0u;
         if (cls == SUN_CONE_COVERED && opaque) {
             return SUN_CONE_COVERED;
         }

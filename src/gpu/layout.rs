@@ -570,6 +570,25 @@ mod tests {
         assert_eq!(std::mem::size_of::<MaterialGpu>(), 304);
         assert_eq!(std::mem::offset_of!(MaterialGpu, tex), 112);
         assert_eq!(std::mem::size_of::<TextureRefGpu>(), 48);
+        // The shader reads a material as texels of 16 bytes, its fields in this order (material_at).
+        let glsl = include_str!("../../shaders/bindings.glsl");
+        assert!(glsl.contains(&format!("#define MATERIAL_TEXELS {}u\n", std::mem::size_of::<MaterialGpu>() / 16)));
+        for (field, texel) in [
+            ("kd", std::mem::offset_of!(MaterialGpu, kd)),
+            ("ks", std::mem::offset_of!(MaterialGpu, ks)),
+            ("params", std::mem::offset_of!(MaterialGpu, params)),
+            ("base", std::mem::offset_of!(MaterialGpu, base)),
+            ("pbr", std::mem::offset_of!(MaterialGpu, pbr)),
+            ("emission", std::mem::offset_of!(MaterialGpu, emission)),
+        ] {
+            let at = if texel == 0 { "at".to_string() } else { format!("at + {}", texel / 16) };
+            let read = format!("g.{field} = uintBitsToFloat(texelFetch(material_texels, {at}));");
+            assert!(glsl.contains(&read), "{read}");
+        }
+        assert!(glsl.contains(&format!(
+            "g.kind = texelFetch(material_texels, at + {});",
+            std::mem::offset_of!(MaterialGpu, kind) / 16
+        )));
         assert_eq!(std::mem::size_of::<LightsHeader>(), 496);
         assert_eq!(std::mem::offset_of!(LightsHeader, light_rows), 480);
         assert_eq!(std::mem::offset_of!(LightsHeader, disk_map_from_world), 160);

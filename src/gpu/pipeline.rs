@@ -115,9 +115,9 @@ impl ScenePipeline {
         };
         // SAFETY: valid device and create infos; on error, Drop destroys what exists so far.
         unsafe {
-            // The binding table: 0 materials, 1 lights, 2 indices, 8 the texture table, 9 the surface vertices, 10 the
+            // The binding table: 1 lights, 2 indices, 8 the texture table, 9 the surface vertices, 10 the
             // occluder triangles in the acceleration structure's order, 11 the measured BRDF tables (storage
-            // buffers); 7 the f32 texels, 16 the 8-bit ones and 17 the vertices, three texels each (uniform texel
+            // buffers); 0 the materials, 7 the f32 texels, 16 the 8-bit ones and 17 the vertices (uniform texel
             // buffers: lavapipe's storage buffers stop at 128 MiB, a texel buffer holds maxTexelBufferElements
             // texels, and llvmpipe fetches a texel in one gather where it loads a storage buffer's words lane by
             // lane: docs/platform.md); 5 the sun's shadow map and 6 the first disks' (always bound: 1 × 1 maps until a
@@ -128,7 +128,6 @@ impl ScenePipeline {
             // shadow rays' walk without ray queries). All read by the fragment shader. The descriptor pool is sized
             // from the same table.
             let mut table = vec![
-                (0, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (1, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (2, vk::DescriptorType::STORAGE_BUFFER, 1),
                 (8, vk::DescriptorType::STORAGE_BUFFER, 1),
@@ -138,6 +137,7 @@ impl ScenePipeline {
                 (7, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (16, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (17, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
+                (0, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1),
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];

@@ -82,7 +82,7 @@ pub struct GpuScene {
     accel: Option<SceneAccel>,
     vertices: Option<Buffer>,
     indices: Option<Buffer>,
-    materials: Buffer,
+    materials: TexelBuffer,
     /// Every texture's levels (`texture_buffers`): linear RGBA f32 after the code tables, 8-bit codes, and the
     /// texture table (headers and level records).
     texels: TexelBuffer,
@@ -509,7 +509,13 @@ impl Renderer {
             accel,
             vertices,
             indices,
-            materials: Buffer::storage(&self.dev, materials_bytes, "materials")?,
+            materials: TexelBuffer::filled(
+                &self.dev,
+                materials_bytes.len() / 16,
+                vk::Format::R32G32B32A32_UINT,
+                "materials",
+                |out: &mut [[u32; 4]]| bytemuck::cast_slice_mut::<[u32; 4], u8>(out).copy_from_slice(materials_bytes),
+            )?,
             texels,
             texel_codes,
             texture_table,
@@ -954,7 +960,6 @@ impl Renderer {
                 // 8 the texture table, 9 the surface vertices, 10 the occluder triangles, 11 the measured BRDFs, and
                 // 12 the occluders' BVH and 13 the lights' fractions for the pipelines with shadow rays.
                 let mut buffers = vec![
-                    (0, scene.materials.buffer),
                     (1, lights.buffer),
                     (2, ib.buffer),
                     (8, scene.texture_table.buffer),
@@ -981,7 +986,7 @@ impl Renderer {
                     })
                     .collect();
                 d.update_descriptor_sets(&writes, &[]);
-                // 7: the f32 texels, 16: the 8-bit codes, 17: the vertices; uniform texel buffers.
+                // 0: the materials, 7: the f32 texels, 16: the 8-bit codes, 17: the vertices; uniform texel buffers.
                 // 12, 14, 18: the walks' tree, records (leaf order) and the tree in depth-first order, and 15 the
                 // sun's cells, for the pipelines with shadow rays.
                 let (nodes, walk_records, threaded) = scene
@@ -997,8 +1002,9 @@ impl Renderer {
                     [sun_cells.view],
                     [scene.vertex_texels.view],
                     [threaded.view],
+                    [scene.materials.view],
                 ];
-                let mut bindings = vec![(7, &views[0]), (16, &views[1]), (17, &views[5])];
+                let mut bindings = vec![(0, &views[7]), (7, &views[0]), (16, &views[1]), (17, &views[5])];
                 if self.pipeline.has_shadow_rays() {
                     bindings.extend([(12, &views[2]), (14, &views[3]), (15, &views[4]), (18, &views[6])]);
                 }
