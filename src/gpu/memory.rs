@@ -110,6 +110,15 @@ impl TexelBuffer {
         let view = unsafe { dev.device.create_buffer_view(&info, None) }.vk("vkCreateBufferView")?;
         Ok(Self { view, buffer })
     }
+
+    /// `bytes` (a multiple of 16) as RGBA32UI texels, four words each: what the shaders read as `usamplerBuffer`
+    /// and take floats from by their bits.
+    pub fn rgba32ui(dev: &Arc<Device>, bytes: &[u8], name: &str) -> Result<Self, GpuError> {
+        debug_assert_eq!(bytes.len() % 16, 0, "{name}: {} bytes", bytes.len());
+        Self::filled(dev, bytes.len() / 16, vk::Format::R32G32B32A32_UINT, name, |out: &mut [[u32; 4]]| {
+            bytemuck::cast_slice_mut::<[u32; 4], u8>(out).copy_from_slice(bytes)
+        })
+    }
 }
 
 impl Drop for TexelBuffer {

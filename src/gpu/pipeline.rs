@@ -141,23 +141,15 @@ impl ScenePipeline {
                 (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
                 (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, MAX_DISK_MAPS as u32),
             ];
-            match ray_spirv {
-                Some((_, _, ShadowRays::Query)) => {
-                    table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1));
-                    table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
-                    table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+            if let Some((_, _, rays)) = ray_spirv {
+                match rays {
+                    ShadowRays::Query => table.push((4, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1)),
+                    ShadowRays::Bvh => {}
                 }
-                Some((_, _, ShadowRays::Bvh)) => {
-                    table.push((12, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((14, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((18, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
-                    table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
-                    table.push((15, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
+                for binding in [12, 14, 15, 18] {
+                    table.push((binding, vk::DescriptorType::UNIFORM_TEXEL_BUFFER, 1));
                 }
-                None => {}
+                table.push((13, vk::DescriptorType::STORAGE_BUFFER, 1));
             }
             let bindings: Vec<_> = table
                 .iter()

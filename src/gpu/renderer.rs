@@ -249,7 +249,7 @@ impl Renderer {
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
         let no_light_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "light fractions (unused)")?;
-        let no_sun_cells = super::sun_cells::texels(&dev, &super::sun_cells::absent(), "sun cells (none)")?;
+        let no_sun_cells = TexelBuffer::rgba32ui(&dev, &super::sun_cells::absent(), "sun cells (none)")?;
         let renderer = Self {
             target: None,
             lights: None,
@@ -500,8 +500,9 @@ impl Renderer {
         // (`walk`).
         let records = occluder_records(scene, &vertex_offsets, rq && masked);
         let occluder_triangles = Buffer::storage(&self.dev, bytemuck::cast_slice(&records), "occluder triangles")?;
-        let bvh_nodes = node_texels(&self.dev, &[BvhNodeGpu::zeroed()])?;
-        let no_walk_records = record_texels(&self.dev, &[[0; 4]])?;
+        let bvh_nodes =
+            TexelBuffer::rgba32ui(&self.dev, bytemuck::bytes_of(&BvhNodeGpu::zeroed()), "occluder BVH nodes")?;
+        let no_walk_records = TexelBuffer::rgba32ui(&self.dev, &[0; 16], "occluder records, leaf order")?;
         // The walk's source where the pipelines have shadow rays: their walk without ray queries, the slices' with.
         let walk_source = (bvh || rq).then(|| WalkSource::new(scene, &vertex_offsets));
         Ok(GpuScene {
@@ -509,13 +510,7 @@ impl Renderer {
             accel,
             vertices,
             indices,
-            materials: TexelBuffer::filled(
-                &self.dev,
-                materials_bytes.len() / 16,
-                vk::Format::R32G32B32A32_UINT,
-                "materials",
-                |out: &mut [[u32; 4]]| bytemuck::cast_slice_mut::<[u32; 4], u8>(out).copy_from_slice(materials_bytes),
-            )?,
+            materials: TexelBuffer::rgba32ui(&self.dev, materials_bytes, "materials")?,
             texels,
             texel_codes,
             texture_table,
@@ -549,9 +544,9 @@ impl Renderer {
     }
 
     /// The shadow technique for this scene and these settings on this device, and why: `auto` and `ray` cast rays
-    /// on any device: the sun's against its cells (`sun_cells`), the other lights' by ray queries or, without them,
-    /// by the fragment shader's walk of the occluders' BVH (`shadow_bvh`; slower on the same device, the same
-    /// rays). `map` shadows the sun and the first `MAX_DISK_MAPS` disk lights from their maps and leaves the sky
+    /// on any device: the sun's against its cells (`sun_cells`), the other lights' by ray queries where the
+    /// renderer casts them (`device_info::casts_ray_queries`) or by the fragment shader's walk of the occluders'
+    /// BVH (`shadow_bvh`; the same rays). `map` shadows the sun and the first `MAX_DISK_MAPS` disk lights from their maps and leaves the sky
     /// (and further disks) unoccluded, with a warning where the scene has them.
     pub fn shadow_choice(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<ShadowChoice, GpuError> {
         let requested = settings.shading.shadows;
@@ -578,7 +573,7 @@ impl Renderer {
             }
             if !lights.disks.is_empty() || lights.sky.is_some() {
                 let by = if self.pipeline.rays_walk_bvh() {
-                    "the fragment shader's walk of the occluders' BVH (without ray queries: the device has none, or is a CPU)"
+                    "the fragment shader's walk of the occluders' BVH (a CPU device, or one without ray queries)"
                 } else {
                     "ray queries"
                 };
@@ -680,7 +675,7 @@ impl Renderer {
             let max_entries = super::sun_cells::max_entries(self.dev.info.max_storage_buffer_range.min(texel_bytes));
             if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle, max_entries) {
                 let bytes = super::sun_cells::bytes(&cells, triangles, records);
-                self.sun_cells = Some(super::sun_cells::texels(&self.dev, &bytes, "sun cells")?);
+                self.sun_cells = Some(TexelBuffer::rgba32ui(&self.dev, &bytes, "sun cells")?);
                 sun_cells =
                     if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
             }
@@ -695,9 +690,12 @@ impl Renderer {
             || settings.shading.visibility_rule == VisibilityRule::Slices;
         if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();
-            let threaded = node_texels(&self.dev, &super::shadow_bvh::threaded(&nodes))?;
-            let nodes = node_texels(&self.dev, &nodes)?;
-            let records = record_texels(&self.dev, &records)?;
+            let threaded = super::shadow_bvh::threaded(&nodes);
+            let threaded =
+                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&threaded), "occluder BVH, depth first")?;
+            let nodes = TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
+            let records =
+                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
             let _ = scene.walk.set((nodes, records, threaded));
         }
         let shadow_setup = t_shadow_setup.elapsed();
@@ -1318,25 +1316,4 @@ fn interpolation_define(interpolation: Interpolation) -> &'static str {
         Interpolation::BarycentricF32 => "SUNSHADE_F32_BARYCENTRICS",
         Interpolation::BarycentricF64 => "SUNSHADE_F64_BARYCENTRICS",
     }
-}
-
-/// The occluders' BVH nodes as a uniform texel buffer of RGBA32UI, two texels a node (binding 12, read by
-/// `bvh_node` in shaders/bindings.glsl).
-fn node_texels(dev: &Arc<Device>, nodes: &[BvhNodeGpu]) -> Result<TexelBuffer, GpuError> {
-    let words: &[[u32; 4]] = bytemuck::cast_slice(nodes);
-    TexelBuffer::filled(
-        dev,
-        words.len(),
-        vk::Format::R32G32B32A32_UINT,
-        "occluder BVH nodes",
-        |out: &mut [[u32; 4]]| out.copy_from_slice(words),
-    )
-}
-
-/// The walk's occluder records (vertex indices and material) as a uniform texel buffer of RGBA32UI, one texel a
-/// record (binding 14, `WALK_RECORD` in shaders/bindings.glsl).
-fn record_texels(dev: &Arc<Device>, records: &[[u32; 4]]) -> Result<TexelBuffer, GpuError> {
-    TexelBuffer::filled(dev, records.len(), vk::Format::R32G32B32A32_UINT, "occluder records, leaf order", |out| {
-        out.copy_from_slice(records)
-    })
 }

@@ -1,6 +1,6 @@
-//! The sun's cells on the device (binding 15, `sun_cells_texels` in shaders/bindings.glsl, a texel a vec4): the header, each cell's
-//! first entry, then every entry's corners, top and occluder record (`layout::occluder_records`), so that the
-//! shader reads a cell's triangles in one place, without an indirection. Built by `visibility::sun_cells` for each
+//! The sun's cells on the device (binding 15, `sun_cells_texels` in shaders/bindings.glsl, a texel a vec4): the
+//! header, each cell's first entry, then every entry's corners, top and occluder record
+//! (`layout::occluder_records`), so that the shader reads a cell's triangles in one place, without an indirection. Built by `visibility::sun_cells` for each
 //! frame's sun.
 
 use bytemuck::{Pod, Zeroable};
@@ -33,17 +33,6 @@ pub const ENTRY_WORDS: usize = 16;
 /// renderer takes with the device's texel-buffer size).
 pub fn max_entries(max_bytes: u32) -> usize {
     max_bytes as usize / 8 * 7 / (ENTRY_WORDS * 4)
-}
-
-/// `bytes` (the header, then the data: a multiple of 16) as a uniform texel buffer of RGBA32UI, one texel a vec4.
-pub(crate) fn texels(
-    dev: &std::sync::Arc<super::context::Device>,
-    bytes: &[u8],
-    name: &str,
-) -> Result<super::memory::TexelBuffer, super::GpuError> {
-    super::memory::TexelBuffer::filled(dev, bytes.len() / 16, ash::vk::Format::R32G32B32A32_UINT, name, |out| {
-        bytemuck::cast_slice_mut::<[u32; 4], u8>(out).copy_from_slice(bytes)
-    })
 }
 
 /// The buffer of `cells`, whose triangle indices point into `triangles` (world corners \[m\], the vertex buffer's
