@@ -209,9 +209,9 @@ layout(std430, set = 0, binding = 2) readonly buffer IndexBuffer {
 #define VERTEX_NORMAL 3u
 #define VERTEX_TANGENT 6u
 // The same vertices as RGBA32UI texels, three a vertex (floats by their bits): position [m] and 0, normal and 0,
-// tangent and handedness (texel offset / 3 of the offsets above). What the fragment shader reads of its triangle's corners and the walks of the
-// occluders': llvmpipe fetches a texel in one gather where it loads a storage buffer's words lane by lane
-// (docs/platform.md, "Loads in the walks"). Texel k of vertex i as floats:
+// tangent and handedness (texel offset / 3 of the offsets above). What the fragment shader reads of its
+// triangle's corners and the walks of the occluders': llvmpipe fetches a texel in one gather where it loads a
+// storage buffer's words lane by lane (docs/platform.md, "Loads in the walks"). Texel k of vertex i as floats:
 layout(set = 0, binding = 17) uniform usamplerBuffer vertex_texels;
 #define VERTEX_TEXEL(i, k) uintBitsToFloat(texelFetch(vertex_texels, int(3u * (i) + (k))))
 
@@ -272,21 +272,23 @@ struct BvhNode {
 };
 // Read as a uniform texel buffer of RGBA32UI, two texels a node (its lo and first, its hi and count; the box's
 // floats by their bits): llvmpipe loads a storage buffer's element lane by lane with a bounds test each, a texel
-// fetch as one gather (docs/platform.md, "Loads in the walk").
+// fetch as one gather (docs/platform.md, "Loads in the walks").
 layout(set = 0, binding = 12) uniform usamplerBuffer bvh_node_texels;
 // The same tree in depth-first order for the shadow rays' walk without a stack (gpu::shadow_bvh::threaded): a
 // node's first is where the walk goes past its subtree, its count a leaf's record or THREADED_INNER.
 layout(set = 0, binding = 18) uniform usamplerBuffer threaded_node_texels;
 #define THREADED_INNER 0xffffffffu
-BvhNode threaded_node(uint i) {
-    uvec4 a = texelFetch(threaded_node_texels, int(2u * i));
-    uvec4 b = texelFetch(threaded_node_texels, int(2u * i + 1u));
+// Node i of either tree from its two texels.
+#define BVH_NODE_FROM(texels, i) \
+    bvh_node_from(texelFetch(texels, int(2u * (i))), texelFetch(texels, int(2u * (i) + 1u)))
+BvhNode bvh_node_from(uvec4 a, uvec4 b) {
     return BvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
 }
+BvhNode threaded_node(uint i) {
+    return BVH_NODE_FROM(threaded_node_texels, i);
+}
 BvhNode bvh_node(uint i) {
-    uvec4 a = texelFetch(bvh_node_texels, int(2u * i));
-    uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));
-    return BvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+    return BVH_NODE_FROM(bvh_node_texels, i);
 }
 // The lights' visible fractions at each pixel, summed by the renderer from their passes of slices
 // (gpu::slice_passes): a layer a light (ROWS_OF_*), each row-major (pc.framebuffer_size.x a row), read where

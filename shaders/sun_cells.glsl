@@ -26,8 +26,7 @@
 // Words an entry takes (gpu::sun_cells::ENTRY_WORDS): corners and top (c0, top), (c1, 0), (c2, 0) in f32, then its
 // occluder record; the entries start at a multiple of four words (dims.z).
 #define SUN_CELL_ENTRY_WORDS 16u
-// Word w of entry i, and its vec4 q (0 to 2) as floats.
-// Vec4 q (0 to 3) of entry i, as words (one 16-byte load) and as floats; word w of the starts.
+// Vec4 q (0 to 3) of entry i, as words (one texel) and as floats; word w of the starts.
 #define SUN_CELL_UVEC4(i, q) SUN_CELLS_DATA(SUN_CELLS_DIMS.z / 4u + (SUN_CELL_ENTRY_WORDS / 4u) * (i) + (q))
 #define SUN_CELL_VEC4(i, q) uintBitsToFloat(SUN_CELL_UVEC4(i, q))
 #define SUN_CELL_RECORD(i) SUN_CELL_UVEC4(i, 3u)
