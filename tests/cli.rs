@@ -434,6 +434,28 @@ fn batch_renders_like_render_goes_on_after_a_failure_and_shards() {
 /// `sunshade` on Debian's own lavapipe (`system`: the Vulkan loader's variables and the library path that
 /// `scripts/lavapipe-rt.sh` sets removed) or on Mesa 25's from `.lavapipe-rt/`.
 fn sunshade_on(system: bool, args: &[&str]) -> Output {
+    sunshade_command_on(system, args).output().expect("run sunshade")
+}
+
+/// Whether Mesa 25's lavapipe is installed in `.lavapipe-rt/` (`scripts/lavapipe-rt.sh` installs it if it can);
+/// where it cannot, says so on the real stderr (not the test's captured output), so that the skip is never silent.
+fn second_lavapipe_installed() -> bool {
+    let install =
+        Command::new("sh").arg("-c").arg("scripts/lavapipe-rt.sh").current_dir(env!("CARGO_MANIFEST_DIR")).output();
+    let install = install.unwrap();
+    if !install.status.success() {
+        use std::io::Write;
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED: the lavapipe with ray queries cannot be installed here: {}",
+            stderr(&install).trim()
+        );
+    }
+    install.status.success()
+}
+
+/// The command of [`sunshade_on`], with validation on.
+fn sunshade_command_on(system: bool, args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_sunshade"));
     c.args(args).env("SUNSHADE_VALIDATION", "1");
     let rt = Path::new(env!("CARGO_MANIFEST_DIR")).join(".lavapipe-rt");
@@ -444,11 +466,12 @@ fn sunshade_on(system: bool, args: &[&str]) -> Output {
         c.env("VK_ICD_FILENAMES", &icd).env("VK_DRIVER_FILES", &icd);
         c.env("LD_LIBRARY_PATH", rt.join("usr/lib/x86_64-linux-gnu"));
     }
-    c.output().expect("run sunshade")
+    c
 }
 
 /// A golden rendered on one lavapipe passes on the other, both ways, the default flags (shadow rays: the sun's
-/// through its cells on both, the disk light's by the BVH walk on Mesa 22.3 and by ray queries on Mesa 25), and
+/// through its cells on both, the disk light's by the BVH walk, on Mesa 25 by its ray queries where
+/// `SUNSHADE_RAY_QUERIES=1` asks for them, as `make test`'s second stage does), and
 /// each image passes `render --check` against the reference. Runs where `scripts/lavapipe-rt.sh` has installed
 /// Mesa 25 (`make test`'s second stage, which names `gpu_`), else says why it cannot.
 #[test]
@@ -1022,20 +1045,7 @@ fn info_says_whether_the_device_has_ray_queries_on_both_lavapipes() {
             assert_eq!(d["ray_query"], false, "Debian 12's lavapipe has no ray queries: {d}");
         }
     }
-    let install = Command::new("sh")
-        .arg("-c")
-        .arg("scripts/lavapipe-rt.sh")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    if !install.status.success() {
-        // Said on the real stderr (not the test's captured output), so that the skip is never silent.
-        use std::io::Write;
-        let _ = writeln!(
-            std::io::stderr(),
-            "SKIPPED: the lavapipe with ray queries cannot be installed here: {}",
-            stderr(&install).trim()
-        );
+    if !second_lavapipe_installed() {
         return;
     }
     let rt = info("unset SUNSHADE_RAY_QUERIES; eval \"$(scripts/lavapipe-rt.sh)\" && ");
@@ -1053,36 +1063,19 @@ fn info_says_whether_the_device_has_ray_queries_on_both_lavapipes() {
 /// occluders' BVH in the fragment shader. Skipped, loudly, where Mesa 25's lavapipe cannot be installed.
 #[test]
 fn a_render_on_one_lavapipe_is_the_same_image_on_the_other() {
-    let rt =
-        Command::new("sh").arg("-c").arg("scripts/lavapipe-rt.sh").current_dir(env!("CARGO_MANIFEST_DIR")).output();
-    let rt = rt.unwrap();
-    if !rt.status.success() {
-        use std::io::Write;
-        let _ = writeln!(
-            std::io::stderr(),
-            "SKIPPED: the second lavapipe cannot be installed here: {}",
-            stderr(&rt).trim()
-        );
+    if !second_lavapipe_installed() {
         return;
     }
     let dir = TempDir::new("cli-two-lavapipes");
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
-    // The system's lavapipe with the environment of `make test`'s second stage removed.
-    let on = |prefix: &str, name: &str, args: &[&str]| -> Vec<u8> {
+    // Each lavapipe by default, whatever `make test`'s second stage asks of the ray queries.
+    let on = |system: bool, name: &str, args: &[&str]| -> Vec<u8> {
         let out = dir.path(name);
-        let args: Vec<String> = args.iter().map(|a| format!("'{a}'")).collect();
-        let script = format!(
-            "{prefix}exec '{}' render {} -o '{}' --width 96 --height 72",
-            env!("CARGO_BIN_EXE_sunshade"),
-            args.join(" "),
-            out.display()
-        );
-        let o = Command::new("sh").arg("-c").arg(&script).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap();
-        assert!(o.status.success(), "{script}: {}", stderr(&o));
+        let mut c = sunshade_command_on(system, &["render", "-o", s(&out), "--width", "96", "--height", "72"]);
+        let o = c.args(args).env_remove("SUNSHADE_RAY_QUERIES").output().unwrap();
+        assert!(o.status.success(), "{args:?} (system lavapipe: {system}): {}", stderr(&o));
         std::fs::read(&out).unwrap()
     };
-    let system = "unset VK_ICD_FILENAMES VK_DRIVER_FILES LD_LIBRARY_PATH SUNSHADE_RAY_QUERIES; ";
-    let mesa25 = "unset SUNSHADE_RAY_QUERIES; eval \"$(scripts/lavapipe-rt.sh)\" && ";
     let mut cases: Vec<Vec<String>> = Vec::new();
     for entry in std::fs::read_dir(&models).unwrap() {
         let path = entry.unwrap().path();
@@ -1099,8 +1092,8 @@ fn a_render_on_one_lavapipe_is_the_same_image_on_the_other() {
     }
     for (k, case) in cases.iter().enumerate() {
         let args: Vec<&str> = case.iter().map(String::as_str).collect();
-        let a = on(system, &format!("{k}-22.pfm"), &args);
-        let b = on(mesa25, &format!("{k}-25.pfm"), &args);
+        let a = on(true, &format!("{k}-22.pfm"), &args);
+        let b = on(false, &format!("{k}-25.pfm"), &args);
         assert!(a == b, "{case:?}: the two lavapipes' images differ");
     }
 }
