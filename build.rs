@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 const STAGES: [&str; 2] = ["scene.vert", "scene.frag"];
 /// The alpha-masked draws' fragment stage of the shadow-map pass (one module per interpolation mode).
 const MASK_STAGE: &str = "shadow_mask.frag";
+/// The mark between a frame's two draws (src/gpu/second_draw.rs): one module each, no variants.
+const MARK_STAGES: [&str; 2] = ["fullscreen.vert", "second_draw.frag"];
 const INTERPOLATIONS: [&str; 3] =
     ["SUNSHADE_DEVICE_INTERPOLATION", "SUNSHADE_F32_BARYCENTRICS", "SUNSHADE_F64_BARYCENTRICS"];
 const NAIVE_MATH: &str = "SUNSHADE_NAIVE_MATH";
@@ -63,6 +65,9 @@ fn main() {
     }
     for interpolation in INTERPOLATIONS {
         variants.push((MASK_STAGE, vec![interpolation]));
+    }
+    for stage in MARK_STAGES {
+        variants.push((stage, vec![]));
     }
     {
         for (stage, defines) in variants {

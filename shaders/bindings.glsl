@@ -32,6 +32,10 @@
 #define SLICES_OVERFLOWED -2.0
 bool slices_overflowed = false;
 #define LOOP_PROBE_ITERATIONS 2u
+// The coverage alpha of a pixel the first of a frame's two draws leaves to the second (VARIANT_PENUMBRAE), set in
+// `left_to_second_draw`; the value matches gpu::second_draw.
+#define LEFT_TO_SECOND_DRAW -3.0
+bool left_to_second_draw = false;
 // What the fragment shader writes (VARIANT_QUANTITY); values match gpu::layout.
 #define QUANTITY_RADIANCE 0u
 #define QUANTITY_IRRADIANCE 1u
@@ -66,6 +70,14 @@ layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID o
 layout(constant_id = 8) const uint VARIANT_OCCLUDERS_MASKED = 0u; // with shadow rays: 1 where a material of the scene
                                                              // is alpha-masked (occluders.glsl's blocks tests it)
 layout(constant_id = 9) const uint VARIANT_SUN_CELLS = 0u; // with shadow rays and a sun: SUN_CELLS_*
+layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays: PENUMBRAE_HERE or PENUMBRAE_LATER
+
+// Where a pixel whose lights are neither proven wholly visible nor wholly hidden is shaded (VARIANT_PENUMBRAE;
+// gpu::layout's PENUMBRAE_*): by this draw (the whole shader), or by a second draw of the scene after this one
+// (gpu::second_draw): this draw then marks it before any ray but the sun cells' (visibility.glsl's
+// LEAVE_TO_SECOND_DRAW), and holds no grid and no walk of its own.
+#define PENUMBRAE_HERE 0u
+#define PENUMBRAE_LATER 1u
 
 // What the sun's cells answer this frame (VARIANT_SUN_CELLS; gpu::layout's SUN_CELLS_*): nothing (the sun's rays
 // take occluded), every point's rays (no cell holds more than MAX_SUN_CELL_TRIANGLES: occluded is never needed for

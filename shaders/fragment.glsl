@@ -15,12 +15,14 @@
 // lights.counts.z (2) iterations, not known to the compiler, so it is not unrolled; it stops after one exactly when
 // the budget is spent, and the renderer refuses an image with such pixels (gpu::loop_budget). SLICES_OVERFLOWED
 // where the slices of a light gathered more triangles than they keep (gpu::slice_gather), refused too.
+// LEFT_TO_SECOND_DRAW where the first of two draws leaves the pixel to the second (gpu::second_draw).
 float coverage_alpha() {
     uint probe = 0u;
     for (uint i = 0u; i < lights.counts.z; ++i) {
         probe += 1u;
     }
-    return probe != lights.counts.z ? LOOP_BUDGET_SPENT : (slices_overflowed ? SLICES_OVERFLOWED : 1.0);
+    return probe != lights.counts.z ? LOOP_BUDGET_SPENT
+         : (slices_overflowed ? SLICES_OVERFLOWED : (left_to_second_draw ? LEFT_TO_SECOND_DRAW : 1.0));
 }
 
 vec3 fragment_vertex_position(uint index) {

@@ -167,8 +167,9 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
             float delta = lights.sun.direction.w;
             float s = sin(0.5 * delta);
             float radius = tan(0.5 * delta);
-            // The lobe's samples cast rays only in the sun's penumbra (see the Rust).
-            bool penumbra = sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
+            // The lobe's samples cast rays only in the sun's penumbra (see the Rust), which a first draw leaves to
+            // the second (its pixels' fractions are exactly 0 or 1).
+            bool penumbra = VARIANT_PENUMBRAE == PENUMBRAE_HERE && sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
             SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
                 SHADOWS_ON && penumbra ? RAYS_ALONG : RAYS_NONE);
             vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));

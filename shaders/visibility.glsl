@@ -20,6 +20,17 @@
 #include "occluders.glsl"
 #endif
 
+// In the first of two draws (VARIANT_PENUMBRAE == PENUMBRAE_LATER), a pixel that needs a ray through the tree or a
+// light's grid is left to the second draw (gpu::second_draw): marked, and `value` returned in place of what the
+// ray or grid would give, so that the first draw holds none of their code. On llvmpipe a branch that no lane of a
+// SIMD group takes still runs, masked (docs/platform.md, "Branches no pixel takes"): in one draw the grids' code
+// costs every pixel.
+#define LEAVE_TO_SECOND_DRAW(value) \
+    if (VARIANT_PENUMBRAE == PENUMBRAE_LATER) { \
+        left_to_second_draw = true; \
+        return value; \
+    }
+
 #ifdef SUNSHADE_RAY_QUERY
 layout(set = 0, binding = 4) uniform accelerationStructureEXT scene_tlas;
 
@@ -28,6 +39,7 @@ layout(set = 0, binding = 4) uniform accelerationStructureEXT scene_tlas;
 // candidate hit is confirmed where the triangle blocks (occluders.glsl's blocks, at the hit's barycentrics;
 // src/cpu/occluders.rs in the reference), so light passes where the mask cuts the surface away.
 bool occluded(vec3 origin, vec3 direction, float t_max) {
+    LEAVE_TO_SECOND_DRAW(false);
     rayQueryEXT q;
     rayQueryInitializeEXT(q, scene_tlas, gl_RayFlagsTerminateOnFirstHitEXT, 0xFFu, origin, 0.0, direction, t_max);
     while (rayQueryProceedEXT(q)) {
@@ -42,6 +54,7 @@ bool occluded(vec3 origin, vec3 direction, float t_max) {
 // The same on a device without ray queries: the occluders' tree walked in the shader (occluders.glsl). A zero
 // or non-finite direction meets nothing (as WatertightRay::new refuses it).
 bool occluded(vec3 origin, vec3 direction, float t_max) {
+    LEAVE_TO_SECOND_DRAW(false);
     if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
         return false;
     }
@@ -192,11 +205,11 @@ float sky_sample(vec3 a, vec3 e, float tilt, float width, vec2 uv, out vec3 omeg
 // The weight and shadow ray (a direction, or a point on a disk light) of the point uv of the unit square: the
 // sun's and disk lights' through the concentric map, the sky's through its lune.
 float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
-    if (L.kind == GRID_LIGHT_SKY) {
+    if (VARIANT_SKY != LIGHT_ABSENT && L.kind == GRID_LIGHT_SKY) {
         return sky_sample(L.a, L.b, L.tilt, L.radius, uv, ray);
     }
     vec2 xy = concentric_disk(uv.x, uv.y);
-    if (L.kind == GRID_LIGHT_SUN || L.kind == GRID_LIGHT_SUN_CELLS) {
+    if (VARIANT_DISKS == LIGHT_ABSENT || L.kind == GRID_LIGHT_SUN || L.kind == GRID_LIGHT_SUN_CELLS) {
         return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
     }
     return disk_sample(L.x, L.n, L.c, L.d, L.a, L.b, L.radius, xy, ray);
@@ -215,11 +228,11 @@ bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
 #ifdef SUNSHADE_RAY_BVH
     // The listed triangles by the walk's own test (the one the BVH's walk would apply to them); with ray queries
     // the walk lists none (disk_cone.glsl's DISK_CONE_LIST_LIMIT): the rays stay the device's.
-    if (L.kind == GRID_LIGHT_DISK_LISTED) {
+    if (VARIANT_DISKS != LIGHT_ABSENT && L.kind == GRID_LIGHT_DISK_LISTED) {
         return !disk_cone_occluded(origin, ray - origin, SEGMENT_T_MAX);
     }
 #endif
-    bool to_point = L.kind == GRID_LIGHT_DISK;
+    bool to_point = VARIANT_DISKS != LIGHT_ABSENT && L.kind == GRID_LIGHT_DISK;
     return !occluded(origin, to_point ? ray - origin : ray, to_point ? SEGMENT_T_MAX : RAY_T_INFINITE);
 }
 
@@ -289,6 +302,7 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
 // Two columns of corners are kept (weights signed by visibility: w > 0 seen, w < 0 blocked, 0 no weight, and the
 // crossings along v), alternating in one array so that no loop copies them.
 float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
+    LEAVE_TO_SECOND_DRAW(1.0);
     if (k <= 1u) {
         vec3 ray;
         float w = light_sample(L, vec2(0.5), ray);

@@ -277,6 +277,8 @@ const GPU_ONLY_FILES: &[(&str, &str)] = &[
     ("scene.vert", "an entry point"),
     ("scene.frag", "an entry point"),
     ("shadow_mask.frag", "the alpha test of masked draws in the shadow-map pass"),
+    ("fullscreen.vert", "one triangle over the target, for the mark between two draws (src/gpu/second_draw.rs)"),
+    ("second_draw.frag", "the mark between two draws: a stencil, nothing the reference computes"),
 ];
 
 /// Every shader file is paired with its Rust twin by path, each of its functions with a Rust function of the same

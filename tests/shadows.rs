@@ -1332,3 +1332,45 @@ fn gpu_disk_slices_agree_with_the_reference() {
         assert_eq!((second.probe, second.lights_in_passes), (None, first.lights_in_passes), "{second:?}");
     }
 }
+
+/// Renders `flags` on `model` (in models/) in two draws, the default (the first settling the pixels the sun's cells
+/// and the disk lights' walk prove wholly lit or wholly hidden, the second shading the rest), and in one draw of the
+/// whole shader (`ContextOptions::one_draw`): the same bits. The two-draw frame must have made a first draw's
+/// pipeline, so that the comparison is not between two single draws.
+fn two_draws_same_bits(model: &str, flags: &[&str]) {
+    use sunshade::gpu::ContextOptions;
+    use sunshade::testing::{job, CheckedRenderer as Checked};
+    let path = format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR"));
+    let j = job(&path, flags).unwrap_or_else(|e| panic!("{e}"));
+    let mut two = common::shadow_ray_renderer();
+    let a = two.render_job(&j).unwrap_or_else(|e| panic!("{e}"));
+    let created = two.renderer().take_created_pipelines();
+    assert!(
+        created.iter().any(|p| p.what.contains("penumbrae later")),
+        "{model} {flags:?}: no first draw among {:?}",
+        created.iter().map(|p| &p.what).collect::<Vec<_>>()
+    );
+    drop(two);
+    let mut one = Checked::try_with(ContextOptions { one_draw: true, ..ContextOptions::from_env() })
+        .unwrap_or_else(|e| panic!("{e}"));
+    let b = one.render_job(&j).unwrap_or_else(|e| panic!("{e}"));
+    assert!(a.covered_count() > 0, "{model}: nothing drawn");
+    let differ = common::bits(&a).iter().zip(common::bits(&b)).filter(|(x, y)| **x != *y).count();
+    assert_eq!(differ, 0, "{model} {flags:?}: the two draws changed {differ} channel values of the one draw's image");
+}
+
+#[test]
+fn gpu_two_draws_render_the_one_draws_image() {
+    let small = ["--width", "96", "--height", "72"];
+    // The sun's cells (Lambert), a low sun's long penumbrae, a glossy lobe's rays in the penumbrae.
+    two_draws_same_bits("teapot.glb", &small);
+    two_draws_same_bits("sunset.glb", &small);
+    two_draws_same_bits("brdfs.glb", &[&small[..], &["--sun-elevation", "25"]].concat());
+    // Disk lights (their walk's proof), with the sun and alone; alpha-masked occluders.
+    two_draws_same_bits("room.gltf", &small);
+    two_draws_same_bits("cube.glb", &[&small[..], &["--disk-light", "0.3,2.5,0.2:0,-1,0:0.5:2000"]].concat());
+    two_draws_same_bits(
+        "gltf-samples/AlphaBlendModeTest/AlphaBlendModeTest.glb",
+        &[&small[..], &["--disk-light", "0.3,2.5,0.2:0,-1,0:0.5:2000"]].concat(),
+    );
+}

@@ -70,16 +70,21 @@ pub struct ContextOptions {
     /// Shadow rays by ray queries: `None` where the device has them and is a GPU (`device_info::casts_ray_queries`,
     /// which `SUNSHADE_RAY_QUERIES` overrides), `Some(true)` wherever the device has them, `Some(false)` never.
     pub ray_queries: Option<bool>,
+    /// Diagnostics only: shade every pixel in one draw of the whole shader, without the first draw that settles the
+    /// pixels the cheap proofs can (`ShaderVariant::first_draw`): for measuring what the two draws save and checking
+    /// that images do not change (`SUNSHADE_ONE_DRAW=1`, `bench --shadow-cost`, tests/gpu_render.rs).
+    pub one_draw: bool,
 }
 
 impl ContextOptions {
-    /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`; whole shaders (diagnostics) when
-    /// `SUNSHADE_WHOLE_SHADERS` is `1`.
+    /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`; whole shaders and one draw
+    /// (diagnostics) when `SUNSHADE_WHOLE_SHADERS` and `SUNSHADE_ONE_DRAW` are `1`.
     pub fn from_env() -> Self {
         let on = |k: &str| std::env::var(k).is_ok_and(|v| v == "1");
         Self {
             validation: on("SUNSHADE_VALIDATION"),
             whole_shaders: on("SUNSHADE_WHOLE_SHADERS"),
+            one_draw: on("SUNSHADE_ONE_DRAW"),
             ..Default::default()
         }
     }

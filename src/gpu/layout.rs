@@ -31,6 +31,11 @@ pub const VISIBILITY_SLICES: u32 = 1;
 pub const SUN_CELLS_NONE: u32 = 0;
 pub const SUN_CELLS_COMPLETE: u32 = 1;
 pub const SUN_CELLS_PARTIAL: u32 = 2;
+/// Where a draw with shadow rays shades the pixels whose lights are neither proven wholly visible nor wholly hidden
+/// (`VARIANT_PENUMBRAE`): itself, or a second draw of the scene after it (the first then discards them before any
+/// ray but the sun cells').
+pub const PENUMBRAE_HERE: u32 = 0;
+pub const PENUMBRAE_LATER: u32 = 1;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
@@ -60,7 +65,7 @@ pub const MIP_LINEAR: u32 = 2;
 pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 9). The shader keeps only the code these select; `shadows` also
+/// `shaders/bindings.glsl`, constant ids 0 to 10). The shader keeps only the code these select; `shadows` also
 /// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
@@ -86,6 +91,8 @@ pub struct ShaderVariant {
     pub occluders_masked: u32,
     /// With shadow rays and a sun, what the frame's sun cells answer (`SUN_CELLS_*`); `SUN_CELLS_NONE` otherwise.
     pub sun_cells: u32,
+    /// `PENUMBRAE_HERE`, or `PENUMBRAE_LATER` in the first of a frame's two draws ([`ShaderVariant::first_draw`]).
+    pub penumbrae: u32,
 }
 
 impl ShaderVariant {
@@ -119,7 +126,26 @@ impl ShaderVariant {
         };
         let occluders_masked = (shadows == SHADOWS_RAY && scene_masked) as u32;
         let sun_cells = if shadows == SHADOWS_RAY && sun != LIGHT_ABSENT { sun_cells } else { SUN_CELLS_NONE };
-        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells }
+        let penumbrae = PENUMBRAE_HERE;
+        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells, penumbrae }
+    }
+
+    /// The variant of this one for the first of two draws, which shades only the pixels whose lights the cheap
+    /// proofs settle (the sun's cells, the disk lights' walk: wholly visible or wholly hidden) and leaves the rest
+    /// to this variant drawn after it; `None` where such a draw would settle no pixel, and the frame draws once:
+    /// without shadow rays or by slices, with the sky (whose grid every pixel casts), small-source disks or a sun
+    /// without cells (whose rays go through the tree), and in the slices' passes.
+    pub fn first_draw(&self) -> Option<Self> {
+        let sun_settles = self.sun == LIGHT_ABSENT || self.sun_cells != SUN_CELLS_NONE;
+        let something_settled = (self.sun == SUN_DISK && self.sun_cells != SUN_CELLS_NONE) || self.disks == DISKS_EXACT;
+        let first = self.shadows == SHADOWS_RAY
+            && self.visibility == VISIBILITY_GRID
+            && self.quantity != QUANTITY_LIGHT_ROWS
+            && self.sky == LIGHT_ABSENT
+            && self.disks != DISKS_SMALL_SOURCE
+            && sun_settles
+            && something_settled;
+        first.then_some(Self { penumbrae: PENUMBRAE_LATER, ..*self })
     }
 
     /// The variant in words, for `-v` and the start-up bench: "Ward · disk sun · exact disks · sky · shadow maps ·
@@ -148,12 +174,15 @@ impl ShaderVariant {
             SUN_CELLS_PARTIAL => parts.push("sun cells, partly".into()),
             _ => {}
         }
+        if self.penumbrae == PENUMBRAE_LATER {
+            parts.push("penumbrae later".into());
+        }
         parts.push(pick(self.quantity, &["radiance", "irradiance", "a light's rows"]));
         parts.join(" · ")
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 10] {
+    pub fn constants(&self) -> [u32; 11] {
         [
             self.brdf,
             self.sun,
@@ -165,6 +194,7 @@ impl ShaderVariant {
             self.visibility,
             self.occluders_masked,
             self.sun_cells,
+            self.penumbrae,
         ]
     }
 }
@@ -485,6 +515,8 @@ mod tests {
             ("VISIBILITY_SLICES", VISIBILITY_SLICES),
             ("SUN_CELLS_NONE", SUN_CELLS_NONE),
             ("SUN_CELLS_COMPLETE", SUN_CELLS_COMPLETE),
+            ("PENUMBRAE_HERE", PENUMBRAE_HERE),
+            ("PENUMBRAE_LATER", PENUMBRAE_LATER),
             ("SUN_CELLS_PARTIAL", SUN_CELLS_PARTIAL),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
@@ -552,6 +584,7 @@ mod tests {
             "VARIANT_VISIBILITY",
             "VARIANT_OCCLUDERS_MASKED",
             "VARIANT_SUN_CELLS",
+            "VARIANT_PENUMBRAE",
         ];
         assert_eq!(
             variant_constants.len(),

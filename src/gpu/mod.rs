@@ -6,11 +6,12 @@
 //! - `memory`: buffers and images with their memory;
 //! - `shaders`: the embedded GLSL and its run-time compilation;
 //! - `layout`: the byte layouts shared with the shaders;
-//! - `pipeline`: the graphics pipeline (dynamic rendering, RGBA32F + D32);
+//! - `pipeline`: the graphics pipeline (dynamic rendering, RGBA32F + D32, with S8 for the scene);
 //! - `commands`: record, submit, wait;
 //! - `accel`: acceleration structures for the shadow rays (ray queries);
 //! - `shadow_map`: the sun's shadow-map pass;
 //! - `slice_passes`: the lights' slices, taken in passes before the frame where a fragment cannot take them;
+//! - `second_draw`: a frame in two draws, the pixels the cheap proofs settle first, the penumbrae after;
 //! - `frame_probe`: a sparse first look at a frame, to learn whether it would run out of llvmpipe's loop budget;
 //! - `renderer`: upload, draw, readback.
 
@@ -26,6 +27,7 @@ mod memory;
 mod pipeline;
 pub mod pipeline_cache;
 mod renderer;
+pub mod second_draw;
 pub mod shaders;
 pub mod shadow_bvh;
 mod shadow_map;

@@ -19,6 +19,7 @@ use super::context::Device;
 use super::error::{GpuError, VkContext};
 use super::layout::{PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY, VISIBILITY_SLICES};
 use super::pipeline_cache::{self, DiskPipelineCache};
+use super::second_draw::SCENE_DEPTH_STENCIL_FORMAT;
 
 pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -262,6 +263,7 @@ impl ScenePipeline {
             visibility: 0,
             occluders_masked: 0,
             sun_cells: 0,
+            penumbrae: 0,
         };
         // SAFETY: valid device, layout, modules and cache owned by self.
         let (p, made) = unsafe {
@@ -400,7 +402,7 @@ unsafe fn create_pipeline(
     whole: bool,
 ) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
     let started = std::time::Instant::now();
-    let constants = variant.map_or([0; 10], |v| v.constants());
+    let constants = variant.map_or([0; 11], |v| v.constants());
     let mut instructions = 0;
     let module = match fs {
         Some(words) => {
@@ -435,7 +437,7 @@ unsafe fn create_pipeline_from(
     layout: vk::PipelineLayout,
     (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
-    constants: &[u32; 10],
+    constants: &[u32; 11],
     depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.
@@ -490,13 +492,32 @@ unsafe fn create_pipeline_from(
             [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default()
             .attachments(&blend_attachments[..if depth_only { 0 } else { 1 }]);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR, vk::DynamicState::CULL_MODE];
-        let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+        // The scene's pipelines take their depth and stencil tests from the frame (the one draw, or the first or
+        // second of two: gpu::second_draw::set_tests); a shadow map's are fixed above, and it has no stencil.
+        let dynamic_states = [
+            vk::DynamicState::VIEWPORT,
+            vk::DynamicState::SCISSOR,
+            vk::DynamicState::CULL_MODE,
+            vk::DynamicState::DEPTH_COMPARE_OP,
+            vk::DynamicState::STENCIL_TEST_ENABLE,
+            vk::DynamicState::STENCIL_OP,
+            vk::DynamicState::STENCIL_COMPARE_MASK,
+            vk::DynamicState::STENCIL_WRITE_MASK,
+            vk::DynamicState::STENCIL_REFERENCE,
+        ];
+        let dynamic = vk::PipelineDynamicStateCreateInfo::default()
+            .dynamic_states(&dynamic_states[..if depth_only { 3 } else { dynamic_states.len() }]);
         let all_formats = [COLOR_FORMAT];
         let color_formats = &all_formats[..if depth_only { 0 } else { 1 }];
+        let (depth_format, stencil_format) = if depth_only {
+            (DEPTH_FORMAT, vk::Format::UNDEFINED)
+        } else {
+            (SCENE_DEPTH_STENCIL_FORMAT, SCENE_DEPTH_STENCIL_FORMAT)
+        };
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(color_formats)
-            .depth_attachment_format(DEPTH_FORMAT);
+            .depth_attachment_format(depth_format)
+            .stencil_attachment_format(stencil_format);
         let info = vk::GraphicsPipelineCreateInfo::default()
             .stages(stages)
             .vertex_input_state(&vertex_input)

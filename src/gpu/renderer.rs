@@ -19,7 +19,8 @@ use super::layout::{
     SUN_CELLS_PARTIAL, SUN_DISK,
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
-use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT, DEPTH_FORMAT};
+use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT};
+use super::second_draw::{self, MarkPass, SCENE_DEPTH_STENCIL_FORMAT};
 use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
@@ -73,7 +74,10 @@ struct FrameDraws<'a> {
     sun_map: Option<glam::DMat4>,
     disk_maps: Vec<Option<glam::DMat4>>,
     map_pipelines: &'a [vk::Pipeline],
+    /// Each draw's pipeline: its first draw's where it has one (`ShaderVariant::first_draw`), else its own.
     draw_pipelines: &'a [vk::Pipeline],
+    /// Each draw's pipeline for the second draw of the scene, null where its first draw shaded every pixel.
+    second_pipelines: &'a [vk::Pipeline],
 }
 
 /// A scene's geometry and materials on the device.
@@ -162,9 +166,13 @@ pub struct Renderer {
     /// The first disk lights' shadow maps (`MAX_DISK_MAPS`).
     disk_maps: Vec<DepthMap>,
     pipeline: ScenePipeline,
+    /// The mark between a frame's two draws (`second_draw`).
+    mark: MarkPass,
     commands: Commands,
     setup: SetupTimings,
     interpolation: Interpolation,
+    /// `ContextOptions::one_draw` (diagnostics).
+    one_draw: bool,
     dev: Arc<Device>,
 }
 
@@ -246,6 +254,7 @@ impl Renderer {
         )?;
         let shader_compile = compile_time + t1.elapsed();
         let commands = Commands::new(&dev)?;
+        let mark = MarkPass::new(&dev)?;
         let sun_map = DepthMap::new(&dev, 1)?;
         let disk_maps = (0..MAX_DISK_MAPS).map(|_| DepthMap::new(&dev, 1)).collect::<Result<Vec<_>, _>>()?;
         let no_light_fractions = Buffer::storage(&dev, bytemuck::bytes_of(&-1.0f32), "light fractions (unused)")?;
@@ -260,9 +269,11 @@ impl Renderer {
             sun_map,
             disk_maps,
             pipeline,
+            mark,
             commands,
             setup: SetupTimings { instance, shader_compile },
             interpolation,
+            one_draw: options.one_draw,
             dev,
         };
         renderer.check_validation()?;
@@ -716,7 +727,27 @@ impl Renderer {
                 )
             })
             .collect();
-        let draw_pipelines = self.pipeline.pipelines_of(&variants)?;
+        // Each draw's first draw, where one settles pixels, made with the others (in parallel) and drawn before them:
+        // the pixels it leaves (penumbrae, rays through the tree) are shaded by the whole variant after it.
+        let firsts: Vec<Option<ShaderVariant>> =
+            variants.iter().map(|v| if self.one_draw { None } else { v.first_draw() }).collect();
+        let every: Vec<ShaderVariant> = variants.iter().copied().chain(firsts.iter().flatten().copied()).collect();
+        self.pipeline.prepare_variants(&every)?;
+        let whole_pipelines = self.pipeline.pipelines_of(&variants)?;
+        let mut draw_pipelines = Vec::with_capacity(variants.len());
+        let mut second_pipelines = Vec::with_capacity(variants.len());
+        for (first, &whole) in firsts.iter().zip(&whole_pipelines) {
+            match first {
+                Some(first) => {
+                    draw_pipelines.push(self.pipeline.pipelines_of(&[*first])?[0]);
+                    second_pipelines.push(whole);
+                }
+                None => {
+                    draw_pipelines.push(whole);
+                    second_pipelines.push(vk::Pipeline::null());
+                }
+            }
+        }
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
         // Alpha-masked draws test their alpha in the maps too (shadow_mask.frag).
         let mut map_pipelines = Vec::new();
@@ -756,6 +787,7 @@ impl Renderer {
                 .collect(),
             map_pipelines: &map_pipelines,
             draw_pipelines: &draw_pipelines,
+            second_pipelines: &second_pipelines,
         };
         let mut passed = slice_passes::PassedFractions::new((width * height) as usize);
         // A first frame at these rows that slices the sun or disk lights itself is probed first (`frame_probe`), on
@@ -792,6 +824,7 @@ impl Renderer {
                 self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
                 let t_readback = Instant::now();
                 let image = self.read_back(width, height)?;
+                second_draw::check(&image).map_err(GpuError::Unsupported)?;
                 match super::loop_budget::check(&image, &self.dev.info.name) {
                     Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {}
                     Err(e) => return Err(GpuError::LoopBudget(e)),
@@ -836,7 +869,7 @@ impl Renderer {
             for (map, to_map) in self.disk_maps.iter().zip(&draws.disk_maps).filter_map(|(m, f)| Some((m, (*f)?))) {
                 self.record_depth_pass(cb, scene, settings, map, to_map, draws.map_pipelines);
             }
-            self.record_scene_pass(cb, scene, settings, draws.draw_pipelines, blocks);
+            self.record_scene_pass(cb, scene, settings, (draws.draw_pipelines, draws.second_pipelines), blocks);
             self.commands.submit_and_wait(&self.dev, cb)?;
         }
         Ok(())
@@ -888,7 +921,7 @@ impl Renderer {
                 unsafe {
                     self.write_descriptors(scene, &pass_lights, &self.no_light_fractions);
                     let cb = self.commands.begin(&self.dev)?;
-                    self.record_scene_pass(cb, scene, settings, &pass_pipelines, &[]);
+                    self.record_scene_pass(cb, scene, settings, (&pass_pipelines, &[]), &[]);
                     self.commands.submit_and_wait(&self.dev, cb)?;
                 }
                 let image = self.read_back(settings.width, settings.height)?;
@@ -923,7 +956,10 @@ impl Renderer {
                     width,
                     height,
                     COLOR_FORMAT,
-                    vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                    // Storage: the mark between two draws reads it (`second_draw`).
+                    vk::ImageUsageFlags::COLOR_ATTACHMENT
+                        | vk::ImageUsageFlags::TRANSFER_SRC
+                        | vk::ImageUsageFlags::STORAGE,
                     vk::ImageAspectFlags::COLOR,
                     "colour target",
                 )?,
@@ -931,10 +967,10 @@ impl Renderer {
                     &self.dev,
                     width,
                     height,
-                    DEPTH_FORMAT,
+                    SCENE_DEPTH_STENCIL_FORMAT,
                     vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-                    vk::ImageAspectFlags::DEPTH,
-                    "depth target",
+                    vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+                    "depth and stencil target",
                 )?,
                 readback: Buffer::new(
                     &self.dev,
@@ -1080,55 +1116,122 @@ impl Renderer {
         }
     }
 
-    /// Records the scene pass: targets cleared, every draw with its pipeline variant.
+    /// Records the scene pass: targets cleared, every draw with its pipeline variant; where the frame has a second
+    /// draw (`second_pipelines` not all null: `second_draw`), the mark and the second draw after it.
     unsafe fn record_scene_pass(
         &self,
         cb: vk::CommandBuffer,
         scene: &GpuScene,
         settings: &RenderSettings,
-        draw_pipelines: &[vk::Pipeline],
+        (draw_pipelines, second_pipelines): (&[vk::Pipeline], &[vk::Pipeline]),
         blocks: &[(u32, u32, u32)],
     ) {
         let d = &self.dev.device;
         let target = self.target.as_ref().expect("made by ensure_target");
         let (width, height) = (settings.width, settings.height);
-        // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer.
+        let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) else {
+            // Nothing to draw: the targets cleared.
+            // SAFETY: as below.
+            unsafe {
+                self.begin_scene_rendering(cb, settings, (true, false));
+                d.cmd_end_rendering(cb);
+            }
+            return;
+        };
+        let second = second_pipelines.iter().any(|p| *p != vk::Pipeline::null());
+        let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width, height } };
+        // The whole image, or the scene drawn once for each of the probe's blocks (`frame_probe`).
+        let scissors: Vec<vk::Rect2D> = match blocks {
+            [] => vec![area],
+            _ => blocks
+                .iter()
+                .map(|&(x, y, side)| vk::Rect2D {
+                    offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                    extent: vk::Extent2D { width: side, height: side },
+                })
+                .collect(),
+        };
+        let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
+        let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
+        // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer; the GPU is idle.
         unsafe {
-            let to_attachment = [
-                image_barrier(
-                    target.color.image,
-                    vk::ImageAspectFlags::COLOR,
-                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
-                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                ),
-                image_barrier(
-                    target.depth.image,
-                    vk::ImageAspectFlags::DEPTH,
-                    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
-                    (
-                        vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                        vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
-                            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            self.begin_scene_rendering(cb, settings, (true, second));
+            second_draw::set_tests(d, cb, false);
+            for &scissor in &scissors {
+                d.cmd_set_scissor(cb, 0, &[scissor]);
+                self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), push);
+            }
+            d.cmd_end_rendering(cb);
+            if second {
+                self.mark.record(cb, &target.color, &target.depth, area);
+                self.begin_scene_rendering(cb, settings, (false, false));
+                second_draw::set_tests(d, cb, true);
+                for &scissor in &scissors {
+                    d.cmd_set_scissor(cb, 0, &[scissor]);
+                    self.record_draws(cb, scene, (vb, ib), second_pipelines, Some(&cull), push);
+                }
+                d.cmd_end_rendering(cb);
+            }
+        }
+    }
+
+    /// Begins a rendering of the scene's target with the viewport set: `clear`, the targets made attachments and
+    /// cleared (colour 0, depth 1, stencil 0), else both loaded as the last rendering or the mark left them;
+    /// `keep_depth`, the depth and stencil stored for a rendering after this one.
+    ///
+    /// # Safety
+    /// `cb` is being recorded outside a rendering; the target exists.
+    unsafe fn begin_scene_rendering(
+        &self,
+        cb: vk::CommandBuffer,
+        settings: &RenderSettings,
+        (clear, keep_depth): (bool, bool),
+    ) {
+        let d = &self.dev.device;
+        let target = self.target.as_ref().expect("made by ensure_target");
+        let (width, height) = (settings.width, settings.height);
+        let depth_layout = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        // SAFETY: as the caller guarantees.
+        unsafe {
+            if clear {
+                let to_attachment = [
+                    image_barrier(
+                        target.color.image,
+                        vk::ImageAspectFlags::COLOR,
+                        (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
+                        (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                        vk::ImageLayout::UNDEFINED,
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     ),
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-                ),
-            ];
-            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+                    image_barrier(
+                        target.depth.image,
+                        vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+                        (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
+                        (
+                            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                        ),
+                        vk::ImageLayout::UNDEFINED,
+                        depth_layout,
+                    ),
+                ];
+                d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+            }
+            let load = if clear { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD };
             let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width, height } };
             let color_attachments = [vk::RenderingAttachmentInfo::default()
                 .image_view(target.color.view)
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .load_op(load)
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
             let depth_attachment = vk::RenderingAttachmentInfo::default()
                 .image_view(target.depth.view)
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::DONT_CARE)
+                .image_layout(depth_layout)
+                .load_op(load)
+                .store_op(if keep_depth { vk::AttachmentStoreOp::STORE } else { vk::AttachmentStoreOp::DONT_CARE })
                 .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
             d.cmd_begin_rendering(
                 cb,
@@ -1136,7 +1239,8 @@ impl Renderer {
                     .render_area(area)
                     .layer_count(1)
                     .color_attachments(&color_attachments)
-                    .depth_attachment(&depth_attachment),
+                    .depth_attachment(&depth_attachment)
+                    .stencil_attachment(&depth_attachment),
             );
             let viewport = vk::Viewport {
                 x: 0.0,
@@ -1147,27 +1251,6 @@ impl Renderer {
                 max_depth: 1.0,
             };
             d.cmd_set_viewport(cb, 0, &[viewport]);
-            // The whole image, or the scene drawn once for each of the probe's blocks (`frame_probe`).
-            let scissors: Vec<vk::Rect2D> = match blocks {
-                [] => vec![area],
-                _ => blocks
-                    .iter()
-                    .map(|&(x, y, side)| vk::Rect2D {
-                        offset: vk::Offset2D { x: x as i32, y: y as i32 },
-                        extent: vk::Extent2D { width: side, height: side },
-                    })
-                    .collect(),
-            };
-            let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
-            for scissor in scissors {
-                d.cmd_set_scissor(cb, 0, &[scissor]);
-                if let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) {
-                    self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), |draw| {
-                        push_constants(settings, draw.material, draw.first_index, draw.vertex_offset)
-                    });
-                }
-            }
-            d.cmd_end_rendering(cb);
         }
     }
 
@@ -1200,6 +1283,10 @@ impl Renderer {
             d.cmd_bind_index_buffer(cb, ib.buffer, 0, vk::IndexType::UINT32);
             let mut bound = vk::Pipeline::null();
             for (draw, &pipeline) in scene.draws.iter().zip(draw_pipelines) {
+                // A draw without a pipeline in this list (a second draw it does not need) is skipped.
+                if pipeline == vk::Pipeline::null() {
+                    continue;
+                }
                 if pipeline != bound {
                     d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
                     bound = pipeline;

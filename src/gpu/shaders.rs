@@ -33,6 +33,8 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("scene.vert", include_str!("../../shaders/scene.vert")),
     ("scene.frag", include_str!("../../shaders/scene.frag")),
     ("shadow_mask.frag", include_str!("../../shaders/shadow_mask.frag")),
+    ("fullscreen.vert", include_str!("../../shaders/fullscreen.vert")),
+    ("second_draw.frag", include_str!("../../shaders/second_draw.frag")),
 ];
 
 pub use sunshade_glsl::compile;
@@ -108,8 +110,9 @@ mod tests {
     fn modules_built_ahead_equal_run_time_compilation() {
         // The same shaderc and the same sources: bitwise the same SPIR-V, hence the same images either way.
         // 2 stages × 3 interpolations × (plain, naive math), the fragment stage's 3 with ray queries and 3 with
-        // the BVH walk, each with and without slices, and the masked shadow-map stage's 3.
-        assert_eq!(MODULES.len(), 27);
+        // the BVH walk, each with and without slices, the masked shadow-map stage's 3, and the mark's 2
+        // (gpu::second_draw).
+        assert_eq!(MODULES.len(), 29);
         for m in MODULES {
             let words = compile(m.stage, SOURCES, m.defines).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(embedded(m.stage, m.defines).unwrap(), words, "{} {:?}", m.stage, m.defines);
