@@ -136,6 +136,48 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     return partial ? (past_rays ? SUN_CONE_UNKNOWN : SUN_CONE_PARTIAL) : SUN_CONE_MISSES;
 }
 
+// The most triangles a penumbra's sun rays test from a list (sun_cone_list) rather than the cell's whole range.
+#define MAX_SUN_LISTED 32u
+// The entries of the shaded point's cell that its sun cone does not provably miss, where sun_cone_list found at
+// most MAX_SUN_LISTED (sun_listed_count of them; sun_listed_valid), for sun_cells_occluded.
+uint sun_listed[MAX_SUN_LISTED];
+uint sun_listed_count = 0u;
+bool sun_listed_valid = false;
+
+// Lists the entries of origin's cell above it whose triangles the cone of half-angle asin(sin_sigma) about l does
+// not provably miss above the horizon of the surface's normal n (sun_triangle_class): the only triangles a ray of
+// the cone leaving above that horizon can meet, so that a penumbra's rays (its grid's, its lobe's) test them alone,
+// with the same answers as the whole range (sun_cells_occluded; a ray leaving below takes the whole range). Leaves
+// sun_listed_valid false where they are more than MAX_SUN_LISTED.
+void sun_cone_list(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
+    uvec2 range = sun_cell_range(origin);
+    uint count = 0u;
+    bool fits = true;
+    for (uint i = range.x; i < range.y && fits; ++i) {
+        uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
+                                      SUN_CELL_VEC4(i, 2u).xyz);
+        if (cls != SUN_CONE_MISSES) {
+            fits = count < MAX_SUN_LISTED;
+            if (fits) {
+                sun_listed[count] = i;
+                count += 1u;
+            }
+        }
+    }
+    sun_listed_count = count;
+    sun_listed_valid = fits;
+}
+
+// Whether the frame has cells and the triangles of `origin`'s cell above it are few enough to classify (at most
+// MAX_SUN_CELL_CLASSIFIED), as sun_cone_class does before it answers SUN_CONE_UNKNOWN.
+bool sun_cells_classify(vec3 origin) {
+    if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
+        return false;
+    }
+    uvec2 range = sun_cell_range(origin);
+    return range.y - range.x <= MAX_SUN_CELL_CLASSIFIED;
+}
+
 // Whether the frame has cells and the sun rays from `origin` can be tested against its cell: at most
 // MAX_SUN_CELL_TRIANGLES of its triangles lie above it.
 bool sun_cells_usable(vec3 origin) {
@@ -148,16 +190,25 @@ bool sun_cells_usable(vec3 origin) {
 
 // Whether the ray from `origin` (on a surface of normal n) along `direction` (within the sun's cone) meets a
 // triangle of its cell that blocks it (occluders.glsl's blocks): the cell's triangles above the origin are every
-// one such a ray can meet; a ray leaving above the tangent plane skips those wholly below it. Only where
-// sun_cells_usable.
+// one such a ray can meet; a ray leaving above the tangent plane skips those wholly below it, and tests only the
+// listed ones where sun_cone_list listed them for this point. Only where sun_cells_usable or listed.
 bool sun_cells_occluded(vec3 origin, vec3 n, vec3 direction) {
     if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
         return false;
     }
-    uvec2 range = sun_cell_range(origin);
+    // The listed entries where sun_cone_list listed them for this point and the ray leaves above its horizon,
+    // else the cell's whole range above it.
     WatertightRay r = watertight_ray(origin, direction);
     bool leaves_above = dot(n, direction) > 0.0;
-    for (uint i = range.x; i < range.y; ++i) {
+    bool listed = sun_listed_valid && leaves_above;
+    uvec2 range = listed ? uvec2(0u, sun_listed_count) : sun_cell_range(origin);
+    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES) {
+        // A point past its cell's bound whose list serves only the rays above its horizon: this one takes the
+        // traversal, as all its rays would without the list.
+        return occluded(origin, direction, RAY_T_INFINITE);
+    }
+    for (uint e = range.x; e < range.y; ++e) {
+        uint i = listed ? sun_listed[e] : e;
         vec3 c0 = SUN_CELL_VEC4(i, 0u).xyz;
         vec3 c1 = SUN_CELL_VEC4(i, 1u).xyz;
         vec3 c2 = SUN_CELL_VEC4(i, 2u).xyz;
@@ -174,7 +225,7 @@ bool sun_cells_occluded(vec3 origin, vec3 n, vec3 direction) {
 
 // sun_cells_usable and sun_cells_occluded where the module has shadow rays.
 #ifdef SUNSHADE_SHADOW_RAYS
-#define SUN_CELLS_USABLE(origin) sun_cells_usable(origin)
+#define SUN_CELLS_USABLE(origin) (sun_listed_valid || sun_cells_usable(origin))
 #define SUN_CELLS_OCCLUDED(origin, n, direction) sun_cells_occluded(origin, n, direction)
 #else
 #define SUN_CELLS_USABLE(origin) false

@@ -257,6 +257,17 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
 
 /// Functions a mirrored shader file defines with no Rust function of the name, and why.
 const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
+    (
+        "sun_cells.glsl",
+        "sun_cone_list",
+        "a penumbra's rays test only the triangles its cone can meet (the classification's own test): the same \
+         answers as the cell's whole range, which the Rust's sun_cells_occluded takes",
+    ),
+    (
+        "sun_cells.glsl",
+        "sun_cells_classify",
+        "the bound sun_cone_class tests inline (its MAX_SUN_CELL_CLASSIFIED), for the list past the rays' bound",
+    ),
     ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
     (
         "lights/disk.glsl",

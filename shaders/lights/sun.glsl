@@ -70,6 +70,12 @@ float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_di
         return 0.0;
     }
     kind = cone == SUN_CONE_UNKNOWN ? GRID_LIGHT_SUN : GRID_LIGHT_SUN_CELLS;
+    // A penumbra's rays (the grid's here, the lobe's in radiance_out) test only the triangles its cone can meet,
+    // where they are few: also past the cell's bound on its rays, where they would otherwise walk the tree.
+    if (VARIANT_PENUMBRAE == PENUMBRAE_HERE && (cone == SUN_CONE_PARTIAL || sun_cells_classify(origin))) {
+        sun_cone_list(origin, n, l, sin_sigma);
+        kind = sun_listed_valid ? GRID_LIGHT_SUN_CELLS : kind;
+    }
 #endif
     vec3 t = orthonormal_to(l);
     VisibilityLight L = VisibilityLight(kind, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
