@@ -8,7 +8,7 @@
 
 use std::time::Instant;
 
-use super::bench_common::{bench_renderer, measured_by, median, ms, warm_frames, BenchArgs};
+use super::bench_common::{bench_renderer, measured_by, median, ms, BenchArgs};
 use super::generated::publish;
 use super::CliError;
 use crate::cpu;
@@ -29,7 +29,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         &info,
         (width, height),
         a.repeat,
-        "frames are the render phase; the CPU reference renders the default image (f64 rays) on every core",
+        "frames are the render phase, the four of a scene timed in turn each round; the CPU reference renders the default image (f64 rays) on every core",
     );
     out += "| scene | covered px | unshadowed frame [ms] | default frame [ms] | default / unshadowed | one draw [ms] | shadow maps frame [ms] | CPU reference [ms] | light | evaluated px | left to rays | cell triangles / px | rays / covered px | rays / px left to rays |\n";
     out += "|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n";
@@ -57,13 +57,22 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
             s.shading.shadows = shadows;
             s
         };
-        let frame = |renderer: &mut crate::gpu::Renderer, shadows: Shadows| {
-            warm_frames(renderer, &uploaded, &with(shadows), a.repeat).map(|(image, t)| (image, median(t)))
-        };
-        let (image, none) = frame(&mut renderer, Shadows::None)?;
-        let (_, auto) = frame(&mut renderer, Shadows::Auto)?;
-        let (_, map) = frame(&mut renderer, Shadows::Map)?;
-        let once = median(warm_frames(&mut one_draw, &uploaded_once, &with(Shadows::Auto), a.repeat)?.1);
+        // Each frame once to warm up, then the four in turn, --repeat rounds: the machine's drift between rounds
+        // touches each alike, so that their ratios hold where the absolute times wander.
+        let image = renderer.render(&uploaded, &with(Shadows::None))?.0;
+        let mut frames: [Vec<std::time::Duration>; 4] = Default::default();
+        for round in 0..=a.repeat {
+            let times = [
+                renderer.render(&uploaded, &with(Shadows::None))?.1.render,
+                renderer.render(&uploaded, &with(Shadows::Auto))?.1.render,
+                renderer.render(&uploaded, &with(Shadows::Map))?.1.render,
+                one_draw.render(&uploaded_once, &with(Shadows::Auto))?.1.render,
+            ];
+            if round > 0 {
+                frames.iter_mut().zip(times).for_each(|(f, t)| f.push(t));
+            }
+        }
+        let [none, auto, map, once] = frames.map(median);
         let t = Instant::now();
         cpu::render(&scene, &with(Shadows::Auto), &reference);
         let cpu_time = t.elapsed();
