@@ -126,6 +126,15 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
                 unusable = Some("lacks dynamicRendering or synchronization2".into());
             } else if geometry_shader == vk::FALSE {
                 unusable = Some("lacks geometryShader (needed for gl_PrimitiveID in fragment shaders)".into());
+            } else if !instance
+                .get_physical_device_format_properties(physical, super::second_draw::SCENE_DEPTH_STENCIL_FORMAT)
+                .optimal_tiling_features
+                .contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT)
+            {
+                unusable = Some(
+                    "lacks D32_SFLOAT_S8_UINT depth-stencil attachments (the frame's two draws need the stencil)"
+                        .into(),
+                );
             }
         }
         if graphics_queue_family.is_none() {
