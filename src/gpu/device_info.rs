@@ -4,6 +4,10 @@ use ash::vk;
 
 use super::error::GpuError;
 
+/// The depth-stencil format of the scene's target and pipelines: the depth of `pipeline::DEPTH_FORMAT` (the same
+/// values) with the stencil that marks the pixels of a frame's second draw (`second_draw`). A device must have it.
+pub const SCENE_DEPTH_STENCIL_FORMAT: vk::Format = vk::Format::D32_SFLOAT_S8_UINT;
+
 /// A physical device and the properties that matter to sunshade.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DeviceInfo {
@@ -127,7 +131,7 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
             } else if geometry_shader == vk::FALSE {
                 unusable = Some("lacks geometryShader (needed for gl_PrimitiveID in fragment shaders)".into());
             } else if !instance
-                .get_physical_device_format_properties(physical, super::second_draw::SCENE_DEPTH_STENCIL_FORMAT)
+                .get_physical_device_format_properties(physical, SCENE_DEPTH_STENCIL_FORMAT)
                 .optimal_tiling_features
                 .contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT)
             {

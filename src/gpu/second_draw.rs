@@ -32,9 +32,7 @@ use crate::film::Image;
 /// shaders/bindings.glsl and shaders/second_draw.frag).
 pub const LEFT_TO_SECOND_DRAW: f32 = -3.0;
 
-/// The depth-stencil format of the scene's target and pipelines: the depth of `pipeline::DEPTH_FORMAT` (the same
-/// values) with the stencil the mark needs.
-pub const SCENE_DEPTH_STENCIL_FORMAT: vk::Format = vk::Format::D32_SFLOAT_S8_UINT;
+pub use super::device_info::SCENE_DEPTH_STENCIL_FORMAT;
 
 /// The mark's pipeline: one triangle over the target, its fragment reading the first draw's colours as a storage
 /// image (binding 0) and setting the stencil where they hold the mark.
