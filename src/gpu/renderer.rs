@@ -732,17 +732,17 @@ impl Renderer {
         let firsts: Vec<Option<ShaderVariant>> =
             variants.iter().map(|v| if self.one_draw { None } else { v.first_draw() }).collect();
         let every: Vec<ShaderVariant> = variants.iter().copied().chain(firsts.iter().flatten().copied()).collect();
-        self.pipeline.prepare_variants(&every)?;
-        let whole_pipelines = self.pipeline.pipelines_of(&variants)?;
+        let made = self.pipeline.pipelines_of(&every)?;
+        let (whole_pipelines, mut first_pipelines) = (&made[..variants.len()], made[variants.len()..].iter());
         let mut draw_pipelines = Vec::with_capacity(variants.len());
         let mut second_pipelines = Vec::with_capacity(variants.len());
-        for (first, &whole) in firsts.iter().zip(&whole_pipelines) {
-            match first {
-                Some(first) => {
-                    draw_pipelines.push(self.pipeline.pipelines_of(&[*first])?[0]);
+        for (first, &whole) in firsts.iter().zip(whole_pipelines) {
+            match (first, first_pipelines.next()) {
+                (Some(_), Some(&first)) => {
+                    draw_pipelines.push(first);
                     second_pipelines.push(whole);
                 }
-                None => {
+                _ => {
                     draw_pipelines.push(whole);
                     second_pipelines.push(vk::Pipeline::null());
                 }
@@ -1153,24 +1153,27 @@ impl Renderer {
         };
         let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
         let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
+        // Every draw with `pipelines` under the tests of the one or first draw, or of the second, in every scissor,
+        // and the rendering ended.
+        let draw_scene = |pipelines: &[vk::Pipeline], as_second: bool| {
+            // SAFETY: inside the rendering begun below, in `cb`; every handle belongs to this renderer.
+            unsafe {
+                second_draw::set_tests(d, cb, as_second);
+                for &scissor in &scissors {
+                    d.cmd_set_scissor(cb, 0, &[scissor]);
+                    self.record_draws(cb, scene, (vb, ib), pipelines, Some(&cull), push);
+                }
+                d.cmd_end_rendering(cb);
+            }
+        };
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer; the GPU is idle.
         unsafe {
             self.begin_scene_rendering(cb, settings, (true, second));
-            second_draw::set_tests(d, cb, false);
-            for &scissor in &scissors {
-                d.cmd_set_scissor(cb, 0, &[scissor]);
-                self.record_draws(cb, scene, (vb, ib), draw_pipelines, Some(&cull), push);
-            }
-            d.cmd_end_rendering(cb);
+            draw_scene(draw_pipelines, false);
             if second {
                 self.mark.record(cb, &target.color, &target.depth, area);
                 self.begin_scene_rendering(cb, settings, (false, false));
-                second_draw::set_tests(d, cb, true);
-                for &scissor in &scissors {
-                    d.cmd_set_scissor(cb, 0, &[scissor]);
-                    self.record_draws(cb, scene, (vb, ib), second_pipelines, Some(&cull), push);
-                }
-                d.cmd_end_rendering(cb);
+                draw_scene(second_pipelines, true);
             }
         }
     }

@@ -118,6 +118,15 @@ impl MarkPass {
                 .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
                 .image_info(&image_info);
             d.update_descriptor_sets(&[write], &[]);
+            // The stencil is written by the first draw's tests, then the mark's, then read by the second draw's.
+            let depth_tests = image_barrier(
+                depth.image,
+                depth_aspect,
+                (tests, depth_access),
+                (tests, depth_access),
+                depth_layout,
+                depth_layout,
+            );
             let to_read = [
                 image_barrier(
                     color.image,
@@ -127,14 +136,7 @@ impl MarkPass {
                     vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                     vk::ImageLayout::GENERAL,
                 ),
-                image_barrier(
-                    depth.image,
-                    depth_aspect,
-                    (tests, depth_access),
-                    (tests, depth_access),
-                    depth_layout,
-                    depth_layout,
-                ),
+                depth_tests,
             ];
             d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_read));
             let depth_attachment = vk::RenderingAttachmentInfo::default()
@@ -173,14 +175,7 @@ impl MarkPass {
                     vk::ImageLayout::GENERAL,
                     vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
                 ),
-                image_barrier(
-                    depth.image,
-                    depth_aspect,
-                    (tests, depth_access),
-                    (tests, depth_access),
-                    depth_layout,
-                    depth_layout,
-                ),
+                depth_tests,
             ];
             d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
         }
