@@ -16,6 +16,11 @@
 // "Infinitely far" for rays to the sun and the sky: beyond any f32 scene (coordinates are below 1e15 m).
 #define RAY_T_INFINITE 1.0e30
 
+// Whether this pipeline casts shadow rays (the pipeline variant; only modules built with SUNSHADE_RAY_QUERY can).
+const bool SHADOWS_ON = VARIANT_SHADOWS == SHADOWS_RAY;
+// Whether it looks the sun and the first disks up in their shadow maps (further disks and the sky unoccluded).
+const bool SHADOWS_MAP_ON = VARIANT_SHADOWS == SHADOWS_MAP;
+
 #if defined(SUNSHADE_RAY_QUERY) || defined(SUNSHADE_RAY_BVH)
 #include "occluders.glsl"
 #endif

@@ -199,7 +199,7 @@ pub fn resolve_with(
         }
         lights.sky = Some(sky.map(|v| v as f32));
     }
-    let unlit = lights.sun.is_none() && lights.disks.is_empty() && lights.sky.is_none();
+    let unlit = lights.is_empty();
     lights.sun = resolve_sun(scene.lights.sun, unlit, &light_options.sun)?;
     Ok(RenderSettings {
         width,

@@ -1,5 +1,6 @@
 // Disk lights in f32: the projected solid angle (the small-source estimate, and the exact value by Stokes' theorem,
-// the disk cut by the horizon included) and the visible fraction. Mirrors src/shading/lights/disk.rs name for name
+// the disk cut by the horizon included), the visible fraction, and its two terms in a shading point's sum
+// (disk_irradiance_visible, disk_specular_visible). Mirrors src/shading/lights/disk.rs name for name
 // (the Rust is the specification; its doc comments derive the formulas and say where precision is at stake).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_LIGHTS_DISK_GLSL
@@ -7,6 +8,8 @@
 
 #include "math.glsl"
 #include "visibility.glsl"
+#include "shadow_map.glsl"
+#include "lobe.glsl"
 
 // A partly visible disk's segment is integrated directly when it is thin (rim arc half-angle below this) or the
 // receiver is at least a radius from every point of the disk; the contour form is used otherwise (see the Rust).
@@ -195,6 +198,85 @@ float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, ve
     VisibilityLight L = VisibilityLight(listed ? GRID_LIGHT_DISK_LISTED : GRID_LIGHT_DISK, x, n, center, d, a,
                                         cross(d, a), radius, 0.0);
     return grid_fraction(origin, k, L);
+}
+
+// The first disks' visible fractions from their maps, found by disk_irradiance_visible and reused by the specular
+// term.
+float disk_map_fraction[MAX_DISK_MAPS] = float[](1.0, 1.0, 1.0, 1.0);
+// Bit i: the rays of disk light i (the first 32) proven clear by disk_irradiance_visible (disk_rays_gather): its
+// lobe's samples then cast none, every one of them getting through.
+uint disk_rays_clear = 0u;
+
+// Disk light i's irradiance [W/m^2] per channel from its visible part, L0 Omega v (the exact or the small-source
+// model, the pipeline variant's); keeps what its specular term reuses (disk_map_fraction, disk_rays_clear).
+vec3 disk_irradiance_visible(uint i, Frame p) {
+    vec3 position = p.position;
+    vec3 normal = p.normal;
+    uint k = lights.sampling.y;
+    DiskGpu d = lights.disks[i];
+    float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
+        ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
+        : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+    float v = 1.0;
+    if (SHADOWS_ON && omega > 0.0) {
+        if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
+            v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
+        } else {
+            // By slices where asked and the shader walks the BVH itself, or by their passes, as the sun's.
+            v = -1.0;
+#ifdef SUNSHADE_SLICES
+            if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
+                v = (lights.light_rows.w & READ_DISKS) != 0u
+                    ? PASSED_FRACTION(ROWS_OF_DISK + i)
+                    : disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
+                                                   d.center_radius.w, 4u * k * k);
+            }
+#endif
+            if (v < 0.0) {
+                uint gathered = disk_rays_gather(p.shadow_origin, position, normal, d.center_radius.xyz,
+                                                 d.direction.xyz, d.center_radius.w);
+                if (gathered == DISK_CONE_CLEAR) {
+                    v = 1.0;
+                    disk_rays_clear |= i < 32u ? 1u << i : 0u;
+                } else {
+                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
+                                              d.direction.xyz, d.center_radius.w, gathered == DISK_CONE_LIST);
+                }
+            }
+        }
+    }
+    if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
+        bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;
+        v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal, d.center_radius.xyz,
+            d.direction.xyz, d.center_radius.w, pcss);
+        disk_map_fraction[i] = v;
+    }
+    omega = omega * v;
+    return d.radiance.rgb * omega;
+}
+
+// Disk light i's specular term [W/(m^2 sr)] per channel, to be scaled by ks: the lobe over the disk (exact) or
+// towards its centre (small source), visible part only (see the Rust).
+vec3 disk_specular_visible(uint i, MaterialGpu material, Frame p) {
+    DiskGpu d = lights.disks[i];
+    vec3 integral;
+    if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
+        vec3 to_center = safe_normalize(d.center_radius.xyz - p.position);
+        float omega = disk_projected_solid_angle_small_source(p.position, p.normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
+        integral = specular_lobe_rgb(material, p, to_center) * omega;
+        if (SHADOWS_ON && any(greaterThan(integral, vec3(0.0))) && !visible_to(p.shadow_origin, d.center_radius.xyz)) {
+            integral = vec3(0.0);
+        }
+    } else {
+        // The grid's sum as it is (see disk_lobe_integral in the Rust); no rays where they are proven clear.
+        bool clear = i < 32u && (disk_rays_clear & (1u << i)) != 0u;
+        integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
+            d.center_radius.w, pc.lobe_samples, SHADOWS_ON && !clear ? RAYS_TO_POINT : RAYS_NONE).lobe;
+    }
+    if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
+        integral *= disk_map_fraction[i];
+    }
+    return integral * d.radiance.rgb;
 }
 
 #endif

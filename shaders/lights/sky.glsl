@@ -1,12 +1,14 @@
 // The overcast sky in f32: the irradiance it gives a tilted surface, its visible fraction, and the specular lobe
-// integrated over it. Mirrors src/shading/lights/sky.rs name for name (see it for the derivations). Included by
-// shade.glsl after the lobe machinery and sky_lune.glsl, which its lobe integral uses.
+// integrated over it, and its two terms in a shading point's sum (sky_irradiance_visible, sky_specular_visible).
+// Mirrors src/shading/lights/sky.rs name for name (see it for the derivations).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_LIGHTS_SKY_GLSL
 #define SUNSHADE_LIGHTS_SKY_GLSL
 
 #include "math.glsl"
 #include "visibility.glsl"
+#include "sky_lune.glsl"
+#include "lobe.glsl"
 
 // Irradiance [W/m^2] from a uniform overcast sky of radiance L0: E = pi L0 (1 + cos t)/2.
 vec3 sky_irradiance(vec3 radiance, float n_dot_up) {
@@ -107,6 +109,31 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
             - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false), vec3(0.0));
     }
     return (1.0 - s) * by_difference + s * direct;
+}
+
+// The sky's irradiance [W/m^2] per channel from its visible part, pi L0 (1 + cos t)/2 v.
+vec3 sky_irradiance_visible(Frame p) {
+    vec3 normal = p.normal;
+    uint k = lights.sampling.y;
+    float v = 1.0;
+    if (SHADOWS_ON && normal.y > -1.0) {
+        // By the slices the sky's passes took before this one, where they did (gpu::slice_passes).
+        v = -1.0;
+#ifdef SUNSHADE_SLICES
+        if ((lights.light_rows.w & READ_SKY) != 0u) {
+            v = PASSED_FRACTION(ROWS_OF_SKY);
+        }
+#endif
+        if (v < 0.0) {
+            v = sky_visible_fraction(p.shadow_origin, k, normal);
+        }
+    }
+    return sky_irradiance(lights.sky.rgb, normal.y) * v;
+}
+
+// The sky's specular term [W/(m^2 sr)] per channel, to be scaled by ks (each lobe sample with its shadow ray).
+vec3 sky_specular_visible(MaterialGpu material, Frame p) {
+    return sky_lobe_integral_visible(material, p, pc.lobe_samples, SHADOWS_ON) * lights.sky.rgb;
 }
 
 #endif

@@ -1,12 +1,15 @@
 // The sun in f32: its irradiance (a delta light, and a disk cut by the horizon), its projected solid angle above
-// the horizon, and the visible fraction of its disk. Mirrors src/shading/lights/sun.rs name for name (the Rust is
-// the specification; its doc comments derive the formulas and say where precision is at stake).
+// the horizon, the visible fraction of its disk, and its two terms in a shading point's sum
+// (sun_irradiance_visible, sun_specular_visible). Mirrors src/shading/lights/sun.rs name for name (the Rust is the
+// specification; its doc comments derive the formulas and say where precision is at stake).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_LIGHTS_SUN_GLSL
 #define SUNSHADE_LIGHTS_SUN_GLSL
 
 #include "math.glsl"
 #include "visibility.glsl"
+#include "shadow_map.glsl"
+#include "lobe.glsl"
 
 // Irradiance [W/m^2] from the sun as a direction (delta light): E = E_perp * max(0, n.l).
 vec3 sun_irradiance_delta(vec3 irradiance_normal, float n_dot_l) {
@@ -81,6 +84,90 @@ float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_di
     VisibilityLight L = VisibilityLight(kind, vec3(0.0), n, l, vec3(0.0), t, cross(l, t),
                                         tan(0.5 * angular_diameter), 0.0);
     return grid_fraction(origin, k, L);
+}
+
+// The sun's visible fraction from the shadow rays' located grid, found by sun_irradiance_visible: the specular
+// term casts its lobe samples' rays only where it is strictly between 0 and 1 (see sun_specular_visible).
+float sun_ray_fraction = 1.0;
+// The sun's visible fraction from its shadow map, found by sun_irradiance_visible and reused by the specular term.
+float sun_map_fraction = 1.0;
+
+// The sun's irradiance [W/m^2] per channel from its visible part, E v (the delta or the disk model, the pipeline
+// variant's); keeps v in sun_ray_fraction (rays) or sun_map_fraction (maps) for sun_specular_visible.
+vec3 sun_irradiance_visible(Frame p) {
+    vec3 normal = p.normal;
+    uint k = lights.sampling.y;
+    vec3 l = lights.sun.direction.xyz;
+    float n_dot_l = dot(normal, l);
+    float delta = lights.sun.direction.w;
+    vec3 unoccluded;
+    if (VARIANT_SUN == SUN_DELTA) {
+        unoccluded = sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
+    } else {
+        unoccluded = sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, delta);
+    }
+    float v = 1.0;
+    if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
+        if (VARIANT_SUN == SUN_DELTA) {
+            v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
+        } else {
+            // By slices where asked and the shader walks the BVH itself (slices.glsl; `4 k^2` rows, as
+            // visibility::slice_rows), or as their passes took them before this one where the frame could not
+            // (gpu::slice_passes); the grid where they cannot be taken.
+            v = -1.0;
+#ifdef SUNSHADE_SLICES
+            if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
+                v = (lights.light_rows.w & READ_SUN) != 0u
+                    ? PASSED_FRACTION(ROWS_OF_SUN)
+                    : sun_visible_fraction_sliced(p.shadow_origin, normal, l, delta, 4u * k * k);
+            }
+#endif
+            if (v < 0.0) {
+                v = sun_visible_fraction(p.shadow_origin, k, normal, l, delta);
+            }
+        }
+        sun_ray_fraction = v;
+    }
+    if (SHADOWS_MAP_ON && lights.sun_map.w != 0.0 && any(greaterThan(unoccluded, vec3(0.0)))) {
+        bool pcss = VARIANT_SUN != SUN_DELTA && lights.sampling.z == 1u;
+        v = sun_visible_fraction_map(p.shadow_origin, k, normal, p.face_normal, l, delta, pcss);
+        sun_map_fraction = v;
+    }
+    return unoccluded * v;
+}
+
+// The sun's specular term [W/(m^2 sr)] per channel, to be scaled by ks: the lobe at its centre (delta) or
+// integrated over its disk, visible part only (see the Rust).
+vec3 sun_specular_visible(MaterialGpu material, Frame p) {
+    vec3 l = lights.sun.direction.xyz;
+    if (VARIANT_SUN == SUN_DELTA) {
+        vec3 factor = specular_lobe_rgb(material, p, l) * max(dot(p.normal, l), 0.0);
+        if (SHADOWS_ON && any(greaterThan(factor, vec3(0.0))) && !sun_visible_along(p.shadow_origin, p.normal, l)) {
+            factor = vec3(0.0);
+        }
+        if (SHADOWS_MAP_ON) {
+            factor *= sun_map_fraction;
+        }
+        return factor * lights.sun.irradiance.rgb;
+    }
+    float delta = lights.sun.direction.w;
+    float s = sin(0.5 * delta);
+    float radius = tan(0.5 * delta);
+    // The lobe's samples cast rays only in the sun's penumbra (see the Rust), which a first draw leaves to the
+    // second (its pixels' fractions are exactly 0 or 1).
+    bool penumbra = VARIANT_PENUMBRAE == PENUMBRAE_HERE && sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
+    SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
+        SHADOWS_ON && penumbra ? RAYS_ALONG : RAYS_NONE);
+    vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
+    if (SHADOWS_ON && sun_ray_fraction == 0.0) {
+        integral = vec3(0.0);
+    }
+    // With the map, the lobe is scaled by the disk's visible fraction (an approximation: exact where the sun is
+    // wholly visible or wholly hidden).
+    if (SHADOWS_MAP_ON) {
+        integral *= sun_map_fraction;
+    }
+    return integral * lights.sun.irradiance.rgb / (PI * s * s);
 }
 
 #endif

@@ -136,7 +136,7 @@ pub fn sun_needs_study(scene: &Scene, settings: &RenderSettings) -> bool {
 /// light: the share of the cells it cuts, [`super::refinement`]).
 pub fn penumbrae_need_study(settings: &RenderSettings, can_occlude: bool) -> bool {
     let lights = &settings.lights;
-    let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
+    let lit = !lights.is_empty();
     can_occlude && settings.shading.shadows == Shadows::Ray && lit
 }
 

@@ -9,7 +9,7 @@ use serde_json::json;
 use crate::accuracy::predicted::Prediction;
 use crate::film::Metadata;
 use crate::render::flags::SceneArgs;
-use crate::scene::Scene;
+use crate::scene::{Light, Scene};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, ShadowMapFilter, SunModel};
 
@@ -27,17 +27,27 @@ pub fn of_render(settings: &RenderSettings, renderer: &str) -> Metadata {
     let cam = &settings.camera;
     let m = |x: glam::DMat4| x.to_cols_array().map(|v| v as f32);
     let l = &settings.lights;
+    let (mut sun, mut disks, mut sky) = (json!(null), Vec::new(), json!(null));
+    for light in l.iter() {
+        match light {
+            Light::Sun(s) => {
+                sun = json!({
+                    "direction_towards_sun": s.direction.to_array(),
+                    "irradiance": s.irradiance,
+                    "angular_diameter_deg": (s.angular_diameter as f64).to_degrees(),
+                })
+            }
+            Light::Disk { disk: d, .. } => disks.push(json!({
+                "center": d.center.to_array(), "direction": d.direction.to_array(), "radius": d.radius, "radiance": d.radiance,
+            })),
+            Light::Sky(radiance) => sky = json!(radiance),
+        }
+    }
     let lights = json!({
         "units": { "sun_irradiance": "W/m2 on a surface facing the sun", "radiance": "W/(m2 sr)", "lengths": "m" },
-        "sun": l.sun.map(|s| json!({
-            "direction_towards_sun": s.direction.to_array(),
-            "irradiance": s.irradiance,
-            "angular_diameter_deg": (s.angular_diameter as f64).to_degrees(),
-        })),
-        "disks": l.disks.iter().map(|d| json!({
-            "center": d.center.to_array(), "direction": d.direction.to_array(), "radius": d.radius, "radiance": d.radiance,
-        })).collect::<Vec<_>>(),
-        "sky_radiance": l.sky,
+        "sun": sun,
+        "disks": disks,
+        "sky_radiance": sky,
     });
     let sh = &settings.shading;
     let quality = json!({

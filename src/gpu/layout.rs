@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::scene::{AlphaMode, Brdf, Lights, Material, Scene, TextureRef};
+use crate::scene::{AlphaMode, Brdf, Light, Lights, Material, Scene, TextureRef};
 use crate::settings::RenderSettings;
 use crate::shading::{DiskModel, Quantity, ShadingOptions, ShadowMapFilter, SunModel};
 use crate::visibility::shadow_map::{DiskMapFrame, SunMapFrame};
@@ -105,17 +105,25 @@ impl ShaderVariant {
         shading: &ShadingOptions,
         (shadows, scene_masked, sun_cells): (u32, bool, u32),
     ) -> Self {
-        let sun = match (&lights.sun, shading.sun) {
-            (None, _) => LIGHT_ABSENT,
-            (Some(_), SunModel::Disk) => SUN_DISK,
-            (Some(_), SunModel::Delta) => SUN_DELTA,
-        };
-        let disks = match (lights.disks.is_empty(), shading.disk) {
-            (true, _) => LIGHT_ABSENT,
-            (false, DiskModel::Exact) => DISKS_EXACT,
-            (false, DiskModel::SmallSource) => DISKS_SMALL_SOURCE,
-        };
-        let sky = if lights.sky.is_some() { SKY_PRESENT } else { LIGHT_ABSENT };
+        // Each kind of light present, with its model: the shader compiles only their terms.
+        let (mut sun, mut disks, mut sky) = (LIGHT_ABSENT, LIGHT_ABSENT, LIGHT_ABSENT);
+        for light in lights.iter() {
+            match light {
+                Light::Sun(_) => {
+                    sun = match shading.sun {
+                        SunModel::Disk => SUN_DISK,
+                        SunModel::Delta => SUN_DELTA,
+                    }
+                }
+                Light::Disk { .. } => {
+                    disks = match shading.disk {
+                        DiskModel::Exact => DISKS_EXACT,
+                        DiskModel::SmallSource => DISKS_SMALL_SOURCE,
+                    }
+                }
+                Light::Sky(_) => sky = SKY_PRESENT,
+            }
+        }
         let quantity = match shading.quantity {
             Quantity::Radiance => QUANTITY_RADIANCE,
             Quantity::Irradiance => QUANTITY_IRRADIANCE,
@@ -422,21 +430,28 @@ pub fn lights_bytes(
             disk_map[i] = [f.tan_half as f32, f.near as f32, f.far as f32, *size as f32];
         }
     }
-    let sun = match &lights.sun {
-        Some(s) => SunGpu {
-            direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
-            irradiance: [s.irradiance[0], s.irradiance[1], s.irradiance[2], 1.0],
-        },
-        None => SunGpu::zeroed(),
-    };
-    let sky = match lights.sky {
-        Some(l) => [l[0], l[1], l[2], 1.0],
-        None => [0.0; 4],
-    };
+    // Each light's record: the sun's and the sky's in the header (w = 1: present), the disks' after it.
+    let (mut sun, mut sky, mut disks) = (SunGpu::zeroed(), [0.0; 4], Vec::new());
+    for light in lights.iter() {
+        match light {
+            Light::Sun(s) => {
+                sun = SunGpu {
+                    direction: [s.direction.x, s.direction.y, s.direction.z, s.angular_diameter],
+                    irradiance: [s.irradiance[0], s.irradiance[1], s.irradiance[2], 1.0],
+                }
+            }
+            Light::Disk { disk: d, .. } => disks.push(DiskGpu {
+                center_radius: [d.center.x, d.center.y, d.center.z, d.radius],
+                direction: [d.direction.x, d.direction.y, d.direction.z, 0.0],
+                radiance: [d.radiance[0], d.radiance[1], d.radiance[2], 0.0],
+            }),
+            Light::Sky(l) => sky = [l[0], l[1], l[2], 1.0],
+        }
+    }
     let header = LightsHeader {
         sun,
         sky,
-        counts: [lights.disks.len() as u32, 0, super::loop_budget::LOOP_PROBE_ITERATIONS, shading.samples_per_axis],
+        counts: [disks.len() as u32, 0, super::loop_budget::LOOP_PROBE_ITERATIONS, shading.samples_per_axis],
         sampling: [shading.sun_samples_per_axis, shading.shadow_samples_per_axis, filter, 0],
         sun_map_from_world: sun_map.map_or([0.0; 16], |(f, _)| f.map_from_world.as_mat4().to_cols_array()),
         sun_map: sun_map.map_or([0.0; 4], |(f, size)| [f.texel as f32, f.depth_extent as f32, size as f32, 1.0]),
@@ -445,13 +460,8 @@ pub fn lights_bytes(
         light_rows: [0, 0, ROWS_OF_SKY, 0],
     };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
-    for d in &lights.disks {
-        let disk = DiskGpu {
-            center_radius: [d.center.x, d.center.y, d.center.z, d.radius],
-            direction: [d.direction.x, d.direction.y, d.direction.z, 0.0],
-            radiance: [d.radiance[0], d.radiance[1], d.radiance[2], 0.0],
-        };
-        bytes.extend_from_slice(bytemuck::bytes_of(&disk));
+    for disk in &disks {
+        bytes.extend_from_slice(bytemuck::bytes_of(disk));
     }
     bytes
 }

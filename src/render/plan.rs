@@ -31,7 +31,7 @@ pub fn default_visibility(a: &SceneArgs, settings: &RenderSettings, scene: &Scen
         PlannedFor::Reference { converged } => converged || in_penumbrae,
         PlannedFor::Gpu { technique } => {
             let lights = &settings.lights;
-            let lit = lights.sun.is_some() || !lights.disks.is_empty() || lights.sky.is_some();
+            let lit = !lights.is_empty();
             let rays = matches!(a.shadows, Shadows::Auto | Shadows::Ray) && technique != Shadows::None;
             in_penumbrae && lit && rays && !scene.has_alpha_masks()
         }

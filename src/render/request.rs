@@ -93,7 +93,7 @@ pub fn resolve_settings(scene: &Scene, a: &SceneArgs) -> Result<RenderSettings, 
             ));
         }
     }
-    let scene_unlit = scene.lights.sun.is_none() && scene.lights.disks.is_empty() && scene.lights.sky.is_none();
+    let scene_unlit = scene.lights.is_empty();
     let other_light = a.sky_radiance.is_some() || !a.disk_lights.is_empty();
     if scene_unlit && other_light && settings.lights.sun.is_none() {
         warn_once(

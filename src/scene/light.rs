@@ -52,8 +52,30 @@ pub struct Lights {
     pub sky: Option<[f32; 3]>,
 }
 
+/// One light of a render, as a loop over [`Lights::iter`] meets it. Every `match` on it names each kind, so that
+/// a new kind of light is a compile error wherever a consumer has not said what it does with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light<'a> {
+    Sun(&'a Sun),
+    /// Disk light number `index` of [`Lights::disks`] (shadows, maps and slices are kept per disk).
+    Disk {
+        index: usize,
+        disk: &'a DiskLight,
+    },
+    /// The overcast sky's radiance [W/(m²·sr)] per channel ([`Lights::sky`]).
+    Sky(&'a [f32; 3]),
+}
+
 impl Lights {
+    /// Every light, in the order their terms are summed (the sun, the disks in order, the sky): a fixed order, so
+    /// that an image does not depend on how its lights were listed.
+    pub fn iter(&self) -> impl Iterator<Item = Light<'_>> {
+        let disks = self.disks.iter().enumerate().map(|(index, disk)| Light::Disk { index, disk });
+        self.sun.iter().map(Light::Sun).chain(disks).chain(self.sky.iter().map(Light::Sky))
+    }
+
+    /// Whether there is no light at all.
     pub fn is_empty(&self) -> bool {
-        self.sun.is_none() && self.disks.is_empty() && self.sky.is_none()
+        self.iter().next().is_none()
     }
 }

@@ -25,7 +25,7 @@ use glam::{DVec3, Vec3, Vec4};
 
 pub use camera::{Camera, Projection};
 pub use gltf::files::UriScope;
-pub use light::{DiskLight, Lights, Sun};
+pub use light::{DiskLight, Light, Lights, Sun};
 pub use load::{load, load_with_options, LoadError, LoadOptions, MAX_SCENE_VERTICES};
 pub use material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
 pub use texture::{Texture, TextureRef};

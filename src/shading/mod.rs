@@ -11,6 +11,7 @@ pub mod disk_slices;
 pub mod lights;
 pub mod lobe;
 pub mod measured;
+pub mod options;
 pub mod quadrature;
 pub mod quantity;
 pub mod radiometry;
@@ -30,11 +31,11 @@ pub use lights::sun::sun_lobe_integral;
 pub use lobe::{
     lobe_about_z, lobe_width, normalized_lobe_integral, orthonormal_to, safe_normalize, specular_lobe, SurfacePoint,
 };
-pub use quantity::Quantity;
-pub use shade::{
-    irradiance, irradiance_visible, radiance_out, radiance_out_visible, DiskModel, ShadingOptions, SunChoice, SunModel,
-    DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
+pub use options::{
+    DiskModel, ShadingOptions, SunChoice, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,
 };
+pub use quantity::Quantity;
+pub use shade::{irradiance, irradiance_visible, radiance_out, radiance_out_visible};
 pub use visibility::{
     Occlusion, ShadowMapFilter, ShadowedLights, Shadowing, Shadows, Unoccluded, VisibilityRule,
     DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS, MAPPED_DISKS,

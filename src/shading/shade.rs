@@ -20,122 +20,15 @@
 //!
 //! Convergence in the sample counts is measured in docs/accuracy.md ("BRDFs").
 
-use std::f64::consts::PI;
-
 use glam::DVec3;
 
 use super::brdf::lambert_brdf;
-use super::lights::disk::{
-    disk_geometry, disk_projected_solid_angle, disk_projected_solid_angle_small_source, disk_visible_fraction,
-};
-use super::lights::sky::{sky_irradiance, sky_lobe_integral_visible, sky_visible_fraction};
-use super::lights::sun::{
-    sun_irradiance_delta, sun_irradiance_disk, sun_projected_solid_angle_above, sun_visible_fraction,
-};
-use super::lobe::{
-    normalized_lobe_integral, safe_normalize, segment_lobe_integral_visible, specular_lobe_rgb, SampleRays,
-    SurfacePoint,
-};
-use super::visibility::{
-    ShadowMapFilter, Shadowing, Shadows, DEFAULT_SHADOW_MAP_SIZE, DEFAULT_SHADOW_SAMPLES_PER_AXIS,
-};
+use super::lights::{light_irradiance_visible, light_specular_visible};
+use super::lobe::SurfacePoint;
+use super::visibility::Shadowing;
 use crate::scene::{Brdf, Lights};
 
-/// How the sun is evaluated.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum SunModel {
-    /// A disk of angular diameter δ: exact irradiance (also while it sets); specular lobes integrated over it.
-    #[default]
-    Disk,
-    /// A single direction: `E⊥ max(0, cos θ)`, lobes evaluated at the sun's centre.
-    Delta,
-}
-
-/// How disk lights are evaluated.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum DiskModel {
-    /// The exact irradiance, horizon clipping included; lobes integrated over the disk.
-    #[default]
-    Exact,
-    /// The small-source estimate `L0 A cosθ_r cosθ_d / d²`, lobes evaluated towards the centre.
-    SmallSource,
-}
-
-/// The sun's model and grid for one material's surfaces (`RenderSettings::sun_per_material`): `--tolerance`
-/// chooses the cheapest that meets its bound for each material's lobe, so that a wide lobe or a Lambertian surface
-/// does not pay for the sharpest lobe's grid.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SunChoice {
-    pub sun: SunModel,
-    /// Grid side over the sun's disk (`SunModel::Disk`).
-    pub sun_samples_per_axis: u32,
-}
-
-/// Default sample counts (per axis of the stratified grids).
-pub const DEFAULT_SUN_SAMPLES_PER_AXIS: u32 = 8;
-pub const DEFAULT_SAMPLES_PER_AXIS: u32 = 16;
-
-/// Model choices for a render.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ShadingOptions {
-    pub sun: SunModel,
-    pub disk: DiskModel,
-    /// Grid side for integrating lobes over the sun's disk (`n²` directions).
-    pub sun_samples_per_axis: u32,
-    /// Grid side for integrating lobes over disk lights and the sky (`n²` samples each).
-    pub samples_per_axis: u32,
-    /// How shadows are computed.
-    pub shadows: Shadows,
-    /// Grid side of each light's visible-fraction grid (`n²` shadow rays per light and pixel).
-    pub shadow_samples_per_axis: u32,
-    /// Side of the sun's shadow map \[texels\] (`--shadows map`).
-    pub shadow_map_size: u32,
-    /// Its filter.
-    pub shadow_map_filter: ShadowMapFilter,
-    /// What the pixels hold: radiance, or the irradiance at the surface.
-    pub quantity: super::Quantity,
-    /// How the reference takes the lights' visible fractions (the GPU's grids, or slices).
-    pub visibility_rule: super::visibility::VisibilityRule,
-}
-
-impl Default for ShadingOptions {
-    fn default() -> Self {
-        Self {
-            sun: SunModel::Disk,
-            disk: DiskModel::Exact,
-            sun_samples_per_axis: DEFAULT_SUN_SAMPLES_PER_AXIS,
-            samples_per_axis: DEFAULT_SAMPLES_PER_AXIS,
-            shadows: Shadows::Auto,
-            shadow_samples_per_axis: DEFAULT_SHADOW_SAMPLES_PER_AXIS,
-            shadow_map_size: DEFAULT_SHADOW_MAP_SIZE,
-            shadow_map_filter: ShadowMapFilter::Pcss,
-            quantity: super::Quantity::Radiance,
-            visibility_rule: super::visibility::VisibilityRule::Grid,
-        }
-    }
-}
-
-impl std::str::FromStr for SunModel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "disk" => Ok(SunModel::Disk),
-            "delta" => Ok(SunModel::Delta),
-            _ => Err(format!("'{s}' is not a sun model (disk, delta)")),
-        }
-    }
-}
-
-impl std::str::FromStr for DiskModel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "exact" => Ok(DiskModel::Exact),
-            "small-source" => Ok(DiskModel::SmallSource),
-            _ => Err(format!("'{s}' is not a disk model (exact, small-source)")),
-        }
-    }
-}
+use super::options::ShadingOptions;
 
 /// Irradiance [W/m²] per channel at `point` from all the lights, unoccluded.
 pub fn irradiance(point: &SurfacePoint, lights: &Lights, options: &ShadingOptions) -> [f64; 3] {
@@ -151,73 +44,11 @@ pub fn irradiance_visible(
     options: &ShadingOptions,
     shadow: Option<&Shadowing>,
 ) -> [f64; 3] {
-    irradiance_and_sun_fraction(point, lights, options, shadow).0
-}
-
-/// [`irradiance_visible`] and the sun's visible fraction it took (1 without a sun, without shadows, or where the
-/// sun's disk is wholly below the surface's horizon), which the specular part reuses: the GPU keeps it in a
-/// global as `irradiance_visible` finds it (`sun_ray_fraction`, as `sun_map_fraction` for maps).
-pub fn irradiance_and_sun_fraction(
-    point: &SurfacePoint,
-    lights: &Lights,
-    options: &ShadingOptions,
-    shadow: Option<&Shadowing>,
-) -> ([f64; 3], f64) {
     let mut e = [0.0; 3];
-    let mut sun_fraction = 1.0;
-    if let Some(sun) = &lights.sun {
-        let l = sun.direction.as_dvec3();
-        let n_dot_l = point.normal.dot(l);
-        let delta = sun.angular_diameter as f64;
-        let mut unoccluded = [0.0; 3];
-        for (ec, &perp) in unoccluded.iter_mut().zip(&sun.irradiance) {
-            *ec = match options.sun {
-                SunModel::Disk => sun_irradiance_disk(perp as f64, n_dot_l, delta),
-                SunModel::Delta => sun_irradiance_delta(perp as f64, n_dot_l),
-            };
-        }
-        let v = match shadow.and_then(Shadowing::for_sun) {
-            Some(s) if unoccluded.iter().any(|&x| x > 0.0) => match options.sun {
-                SunModel::Disk => sun_visible_fraction(s, point.normal, l, delta),
-                SunModel::Delta => f64::from(u8::from(s.visible_along(l))),
-            },
-            _ => 1.0,
-        };
-        sun_fraction = v;
-        for (ec, u) in e.iter_mut().zip(unoccluded) {
-            *ec += u * v;
-        }
+    for light in lights.iter() {
+        add(&mut e, light_irradiance_visible(light, point, options, shadow).0);
     }
-    for (i, disk) in lights.disks.iter().enumerate() {
-        let g = disk_geometry(disk);
-        let omega = match options.disk {
-            DiskModel::Exact => disk_projected_solid_angle(point.position, point.normal, &g),
-            DiskModel::SmallSource => disk_projected_solid_angle_small_source(point.position, point.normal, &g),
-        };
-        let v = match shadow.and_then(|s| s.for_disk(i)) {
-            Some(s) if omega > 0.0 => match options.disk {
-                DiskModel::Exact => {
-                    disk_visible_fraction(s, point.position, point.normal, g.center, g.direction, g.radius)
-                }
-                DiskModel::SmallSource => f64::from(u8::from(s.visible_to(g.center))),
-            },
-            _ => 1.0,
-        };
-        let omega = omega * v;
-        for (ec, &l0) in e.iter_mut().zip(&disk.radiance) {
-            *ec += l0 as f64 * omega;
-        }
-    }
-    if let Some(sky) = &lights.sky {
-        let v = match shadow.and_then(Shadowing::for_sky) {
-            Some(s) if point.normal.y > -1.0 => sky_visible_fraction(s, point.normal),
-            _ => 1.0,
-        };
-        for (ec, &l0) in e.iter_mut().zip(sky) {
-            *ec += sky_irradiance(l0 as f64, point.normal.y) * v;
-        }
-    }
-    (e, sun_fraction)
+    e
 }
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer, every light unoccluded.
@@ -226,8 +57,8 @@ pub fn radiance_out(brdf: &Brdf, point: &SurfacePoint, lights: &Lights, options:
 }
 
 /// Outgoing radiance [W/(m²·sr)] per linear RGB channel at `point` towards the viewer from the visible part of
-/// each light (`shadow`; `None`: unoccluded): the diffuse part by the lights' visible fractions, each specular
-/// sample by its own shadow ray (`visibility`; the sun's only in its penumbra, see the sun's branch).
+/// each light (`shadow`; `None`: unoccluded): `kd/π · E + ks · Σ specular`, the diffuse part by the lights'
+/// visible fractions, each specular sample by its own shadow ray (`lights`; the sun's only in its penumbra).
 pub fn radiance_out_visible(
     brdf: &Brdf,
     point: &SurfacePoint,
@@ -239,88 +70,30 @@ pub fn radiance_out_visible(
     if point.normal == DVec3::ZERO {
         return [0.0; 3];
     }
-    let (e, sun_fraction) = irradiance_and_sun_fraction(point, lights, options, shadow);
+    let lobed = !brdf.is_lambert();
+    let (mut e, mut specular) = ([0.0; 3], [0.0; 3]);
+    for light in lights.iter() {
+        let (irradiance, fraction) = light_irradiance_visible(light, point, options, shadow);
+        add(&mut e, irradiance);
+        if lobed {
+            add(&mut specular, light_specular_visible(light, brdf, point, options, shadow, fraction));
+        }
+    }
     let (kd, ks) = (brdf.kd(), brdf.ks());
     let mut radiance = [0, 1, 2].map(|c| lambert_brdf(kd[c] as f64) * e[c]);
-    if brdf.is_lambert() {
-        return radiance;
-    }
-    // Specular part: per unit radiance (or irradiance), then per channel.
-    let mut specular = [0.0; 3];
-    if let Some(sun) = &lights.sun {
-        let shadow = shadow.and_then(Shadowing::for_sun);
-        let l = sun.direction.as_dvec3();
-        match options.sun {
-            SunModel::Delta => {
-                let cos = point.normal.dot(l).max(0.0);
-                let mut factor = specular_lobe_rgb(brdf, point, l).map(|lobe| lobe * cos);
-                if factor.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_along(l)) {
-                    factor = [0.0; 3];
-                }
-                for ((sc, &perp), factor) in specular.iter_mut().zip(&sun.irradiance).zip(factor) {
-                    *sc += factor * perp as f64;
-                }
-            }
-            SunModel::Disk => {
-                let delta = sun.angular_diameter as f64;
-                let radius = (0.5 * delta).tan();
-                // The lobe's samples cast their rays only in the sun's penumbra, where its visible fraction (the
-                // diffuse part's, whose grid locates the edges) is strictly between 0 and 1: where that grid sees
-                // all of the disk the lobe is unoccluded, where it sees none the lobe is 0, as the diffuse part
-                // takes them (an occluder slipping between all of that grid's rays is missed by both alike).
-                let penumbra = sun_fraction > 0.0 && sun_fraction < 1.0;
-                let rays = shadow.filter(|_| penumbra).map(SampleRays::Along);
-                let sums =
-                    segment_lobe_integral_visible(brdf, point, l, -l, radius, options.sun_samples_per_axis, rays);
-                let mut integral =
-                    normalized_lobe_integral(sums, sun_projected_solid_angle_above(point.normal.dot(l), delta));
-                if shadow.is_some() && sun_fraction == 0.0 {
-                    integral = [0.0; 3];
-                }
-                let s = (0.5 * delta).sin();
-                for ((sc, &perp), integral) in specular.iter_mut().zip(&sun.irradiance).zip(integral) {
-                    *sc += integral * perp as f64 / (PI * s * s);
-                }
-            }
+    if lobed {
+        for c in 0..3 {
+            radiance[c] += ks[c] as f64 * specular[c];
         }
-    }
-    for (i, disk) in lights.disks.iter().enumerate() {
-        let g = disk_geometry(disk);
-        let shadow = shadow.and_then(|s| s.for_disk(i));
-        let integral = match options.disk {
-            DiskModel::Exact => {
-                let rays = shadow.map(SampleRays::ToPoint);
-                let q = g.center - point.position;
-                // The grid's sum as it is (see `disk_lobe_integral`).
-                segment_lobe_integral_visible(brdf, point, q, g.direction, g.radius, options.samples_per_axis, rays)
-                    .lobe
-            }
-            DiskModel::SmallSource => {
-                let to_center = safe_normalize(g.center - point.position);
-                let omega = disk_projected_solid_angle_small_source(point.position, point.normal, &g);
-                let integral = specular_lobe_rgb(brdf, point, to_center).map(|lobe| lobe * omega);
-                if integral.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_to(g.center)) {
-                    [0.0; 3]
-                } else {
-                    integral
-                }
-            }
-        };
-        for ((sc, &l0), integral) in specular.iter_mut().zip(&disk.radiance).zip(integral) {
-            *sc += integral * l0 as f64;
-        }
-    }
-    if let Some(sky) = &lights.sky {
-        let integral =
-            sky_lobe_integral_visible(brdf, point, options.samples_per_axis, shadow.and_then(Shadowing::for_sky));
-        for ((sc, &l0), integral) in specular.iter_mut().zip(sky).zip(integral) {
-            *sc += integral * l0 as f64;
-        }
-    }
-    for c in 0..3 {
-        radiance[c] += ks[c] as f64 * specular[c];
     }
     radiance
+}
+
+/// `sum += term`, per channel.
+fn add(sum: &mut [f64; 3], term: [f64; 3]) {
+    for (s, t) in sum.iter_mut().zip(term) {
+        *s += t;
+    }
 }
 
 #[cfg(test)]
@@ -329,6 +102,7 @@ mod tests {
     use crate::scene::Sun;
     use crate::shading::lights::sky::sky_lobe_integral;
     use crate::shading::lobe::*;
+    use std::f64::consts::PI;
 
     fn point(normal: DVec3, to_viewer: DVec3) -> SurfacePoint {
         let tangent = crate::scene::tangent::default_tangent(normal);

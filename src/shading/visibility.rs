@@ -47,6 +47,8 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
+use crate::scene::Light;
+
 /// Default side of the visibility grids, `k = 6` (`--shadow-samples 36`): the sun and disk lights cast `(k + 1)² = 49`
 /// rays a pixel (up to 85 in a penumbra, locating its edges), the sky 30 (25 on a floor: its lune's sides of zero
 /// weight cast none; up to 66 with its edges). Chosen by measurement
@@ -264,6 +266,15 @@ impl<'a> Shadowing<'a> {
     /// caller takes the grid).
     pub fn by_slices(&self, sliced: impl FnOnce(u32) -> Option<f64>) -> Option<f64> {
         self.slices.then(|| sliced(slice_rows(self.samples_per_axis))).flatten()
+    }
+
+    /// These rays for `light`, if the render shadows it.
+    pub fn for_light(&self, light: Light) -> Option<&Self> {
+        match light {
+            Light::Sun(_) => self.for_sun(),
+            Light::Disk { index, .. } => self.for_disk(index),
+            Light::Sky(_) => self.for_sky(),
+        }
     }
 
     /// These rays for the sun, if it is shadowed.

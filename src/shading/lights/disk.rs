@@ -8,7 +8,10 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use crate::scene::{Brdf, DiskLight};
-use crate::shading::lobe::segment_lobe_integral;
+use crate::shading::lobe::{
+    safe_normalize, segment_lobe_integral, segment_lobe_integral_visible, specular_lobe_rgb, SampleRays,
+};
+use crate::shading::options::{DiskModel, ShadingOptions};
 use crate::shading::visibility::{grid_fraction, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
 
@@ -267,6 +270,63 @@ pub fn disk_visible_fraction(s: &Shadowing, x: DVec3, n: DVec3, center: DVec3, d
     let a = orthonormal_to(d);
     let b = d.cross(a);
     grid_fraction(s, &GridLight::Disk { x, n, center, d, a, b, radius })
+}
+
+/// A disk light's irradiance [W/m²] per channel at `point` from its visible part, `L0 Ω⊥ v`, with `Ω⊥` the exact
+/// or the small-source projected solid angle (`options.disk`) and `v` its visible fraction (`shadow`: the rays
+/// that shadow this disk, if any; one ray to the centre for a small source), and `v`.
+pub fn disk_irradiance_visible(
+    disk: &DiskLight,
+    point: &SurfacePoint,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> ([f64; 3], f64) {
+    let g = disk_geometry(disk);
+    let omega = match options.disk {
+        DiskModel::Exact => disk_projected_solid_angle(point.position, point.normal, &g),
+        DiskModel::SmallSource => disk_projected_solid_angle_small_source(point.position, point.normal, &g),
+    };
+    let v = match shadow {
+        Some(s) if omega > 0.0 => match options.disk {
+            DiskModel::Exact => disk_visible_fraction(s, point.position, point.normal, g.center, g.direction, g.radius),
+            DiskModel::SmallSource => f64::from(u8::from(s.visible_to(g.center))),
+        },
+        _ => 1.0,
+    };
+    let omega = omega * v;
+    (disk.radiance.map(|l0| l0 as f64 * omega), v)
+}
+
+/// A disk light's specular term at `point`: `∫ lobe(ω) L0 (n·ω)+ V(ω) dω` over the disk [W/(m²·sr)] per channel,
+/// to be scaled by `ks`: the exact model's graded grid over the part above the horizon, each sample with its own
+/// shadow ray (the grid's sum as it is, see [`disk_lobe_integral`]); the small source's lobe towards the centre
+/// times its projected solid angle, shadowed by the ray to the centre.
+pub fn disk_specular_visible(
+    disk: &DiskLight,
+    brdf: &Brdf,
+    point: &SurfacePoint,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
+    let g = disk_geometry(disk);
+    let integral = match options.disk {
+        DiskModel::Exact => {
+            let rays = shadow.map(SampleRays::ToPoint);
+            let q = g.center - point.position;
+            segment_lobe_integral_visible(brdf, point, q, g.direction, g.radius, options.samples_per_axis, rays).lobe
+        }
+        DiskModel::SmallSource => {
+            let to_center = safe_normalize(g.center - point.position);
+            let omega = disk_projected_solid_angle_small_source(point.position, point.normal, &g);
+            let integral = specular_lobe_rgb(brdf, point, to_center).map(|lobe| lobe * omega);
+            if integral.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_to(g.center)) {
+                [0.0; 3]
+            } else {
+                integral
+            }
+        }
+    };
+    [0, 1, 2].map(|c| integral[c] * disk.radiance[c] as f64)
 }
 
 #[cfg(test)]

@@ -174,6 +174,33 @@ pub fn sky_visible_fraction(s: &Shadowing, n: DVec3) -> f64 {
     grid_fraction(s, &GridLight::Sky(sky_lune(n)))
 }
 
+/// The sky's irradiance [W/m²] per channel at `point` from its visible part, `π L0 (1 + cos t)/2 · v`, with `v`
+/// its visible fraction (`shadow`: the rays that shadow the sky, if any), and `v`.
+pub fn sky_irradiance_visible(
+    radiance: &[f32; 3],
+    point: &SurfacePoint,
+    shadow: Option<&Shadowing>,
+) -> ([f64; 3], f64) {
+    let v = match shadow {
+        Some(s) if point.normal.y > -1.0 => sky_visible_fraction(s, point.normal),
+        _ => 1.0,
+    };
+    (radiance.map(|l0| sky_irradiance(l0 as f64, point.normal.y) * v), v)
+}
+
+/// The sky's specular term at `point`: `∫ lobe(ω) L0 (n·ω)+ V(ω) dω` over the sky [W/(m²·sr)] per channel, to be
+/// scaled by `ks` ([`sky_lobe_integral_visible`], each sample with its own shadow ray).
+pub fn sky_specular_visible(
+    radiance: &[f32; 3],
+    brdf: &Brdf,
+    point: &SurfacePoint,
+    per_axis: u32,
+    shadow: Option<&Shadowing>,
+) -> [f64; 3] {
+    let integral = sky_lobe_integral_visible(brdf, point, per_axis, shadow);
+    [0, 1, 2].map(|c| integral[c] * radiance[c] as f64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::rel;

@@ -8,8 +8,11 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use crate::scene::Brdf;
-use crate::shading::lobe::{normalized_lobe_integral, segment_lobe_integral};
+use crate::scene::{Brdf, Sun};
+use crate::shading::lobe::{
+    normalized_lobe_integral, segment_lobe_integral, segment_lobe_integral_visible, specular_lobe_rgb, SampleRays,
+};
+use crate::shading::options::{ShadingOptions, SunModel};
 use crate::shading::radiometry::cone_solid_angle;
 use crate::shading::visibility::{grid_fraction, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
@@ -126,6 +129,75 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
     let t = orthonormal_to(l);
     let b = l.cross(t);
     grid_fraction(s, &GridLight::Sun { n, l, t, b, radius })
+}
+
+/// The sun's irradiance [W/m²] per channel at `point` from its visible part, `E · v`, with `E` the delta or the
+/// disk model's (`options.sun`) and `v` its visible fraction (`shadow`: the rays that shadow the sun, if any), and
+/// `v`, which [`sun_specular_visible`] reuses (1 unshadowed, or where the disk is wholly below the horizon). The
+/// GPU keeps `v` in a global as it finds it (`sun_ray_fraction`, as `sun_map_fraction` for maps).
+pub fn sun_irradiance_visible(
+    sun: &Sun,
+    point: &SurfacePoint,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+) -> ([f64; 3], f64) {
+    let l = sun.direction.as_dvec3();
+    let n_dot_l = point.normal.dot(l);
+    let delta = sun.angular_diameter as f64;
+    let unoccluded = sun.irradiance.map(|perp| match options.sun {
+        SunModel::Disk => sun_irradiance_disk(perp as f64, n_dot_l, delta),
+        SunModel::Delta => sun_irradiance_delta(perp as f64, n_dot_l),
+    });
+    let v = match shadow {
+        Some(s) if unoccluded.iter().any(|&x| x > 0.0) => match options.sun {
+            SunModel::Disk => sun_visible_fraction(s, point.normal, l, delta),
+            SunModel::Delta => f64::from(u8::from(s.visible_along(l))),
+        },
+        _ => 1.0,
+    };
+    (unoccluded.map(|u| u * v), v)
+}
+
+/// The sun's specular term at `point`: `∫ lobe(ω) L_sun (n·ω)+ V(ω) dω` over its disk [W/(m²·sr)] per channel, to
+/// be scaled by `ks`. The delta model takes the lobe at the centre, `lobe(l) E⊥ (n·l)+`; the disk model integrates
+/// it over the cap (`segment_lobe_integral_visible`, radiance `L_sun = E⊥ / (π sin²(δ/2))`). `sun_fraction` is
+/// [`sun_irradiance_visible`]'s `v`: the lobe's samples cast their rays only in the sun's penumbra, where it is
+/// strictly between 0 and 1 (that grid locates the edges): where it sees all of the disk the lobe is
+/// unoccluded, where it sees none the lobe is 0, as the diffuse part takes them (an occluder slipping between all
+/// of that grid's rays is missed by both alike).
+pub fn sun_specular_visible(
+    sun: &Sun,
+    brdf: &Brdf,
+    point: &SurfacePoint,
+    options: &ShadingOptions,
+    shadow: Option<&Shadowing>,
+    sun_fraction: f64,
+) -> [f64; 3] {
+    let l = sun.direction.as_dvec3();
+    match options.sun {
+        SunModel::Delta => {
+            let cos = point.normal.dot(l).max(0.0);
+            let mut factor = specular_lobe_rgb(brdf, point, l).map(|lobe| lobe * cos);
+            if factor.iter().any(|&x| x > 0.0) && shadow.is_some_and(|s| !s.visible_along(l)) {
+                factor = [0.0; 3];
+            }
+            [0, 1, 2].map(|c| factor[c] * sun.irradiance[c] as f64)
+        }
+        SunModel::Disk => {
+            let delta = sun.angular_diameter as f64;
+            let radius = (0.5 * delta).tan();
+            let penumbra = sun_fraction > 0.0 && sun_fraction < 1.0;
+            let rays = shadow.filter(|_| penumbra).map(SampleRays::Along);
+            let sums = segment_lobe_integral_visible(brdf, point, l, -l, radius, options.sun_samples_per_axis, rays);
+            let mut integral =
+                normalized_lobe_integral(sums, sun_projected_solid_angle_above(point.normal.dot(l), delta));
+            if shadow.is_some() && sun_fraction == 0.0 {
+                integral = [0.0; 3];
+            }
+            let s = (0.5 * delta).sin();
+            [0, 1, 2].map(|c| integral[c] * sun.irradiance[c] as f64 / (PI * s * s))
+        }
+    }
 }
 
 #[cfg(test)]
