@@ -7,6 +7,9 @@
 
 #include "bindings.glsl"
 #include "brdf.glsl"
+#include "brdf/phong.glsl"
+#include "brdf/blinn_phong.glsl"
+#include "brdf/ward.glsl"
 #include "measured.glsl"
 #include "visibility.glsl"
 
@@ -32,17 +35,24 @@ struct Frame {
     vec3 face_normal;   // the triangle's unit normal on the shaded side (shadow-map bias)
 };
 
-// The specular lobe of a material (without ks) for light from l.
+// The table of models: each question asked of the variant's lobe is a `switch` naming every BRDF kind and calling
+// its file (brdf/*.glsl, measured.glsl), as src/shading/lobe.rs's matches do.
+
+// The specular lobe of a material (without ks) for light from l; a measured table's, the mean of its channels'.
 float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
-    uint kind = VARIANT_BRDF;
-    if (kind == BRDF_PHONG) {
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
+        return 0.0;
+    case BRDF_PHONG:
         return phong_lobe(p.normal, l, p.to_viewer, m.ks.w);
-    }
-    if (kind == BRDF_BLINN_PHONG) {
+    case BRDF_BLINN_PHONG:
         return blinn_phong_lobe(p.normal, l, p.to_viewer, m.ks.w);
-    }
-    if (kind == BRDF_WARD) {
+    case BRDF_WARD:
         return ward_lobe(p.normal, p.tangent, p.bitangent, l, p.to_viewer, m.params.x, m.params.y);
+    case BRDF_MEASURED: {
+        vec3 rgb = measured_residual(m, p.normal, l, p.to_viewer);
+        return (rgb.r + rgb.g + rgb.b) / 3.0;
+    }
     }
     return 0.0;
 }
@@ -50,28 +60,70 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
 // The specular lobe of a material (without ks) per channel for light from l: an analytic lobe's one value in each.
 // A measured table's: its part above its floor.
 vec3 specular_lobe_rgb(MaterialGpu m, Frame p, vec3 l) {
-    if (VARIANT_BRDF == BRDF_MEASURED) {
+    switch (VARIANT_BRDF) {
+    case BRDF_MEASURED:
         return measured_residual(m, p.normal, l, p.to_viewer);
+    case BRDF_LAMBERT:
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+        return vec3(specular_lobe(m, p, l));
     }
-    return vec3(specular_lobe(m, p, l));
+    return vec3(0.0);
 }
 
 // The angular width [rad] about a lobe's peak over which the disk integral crowds its samples (see the Rust).
 float lobe_width(MaterialGpu m) {
-    uint kind = VARIANT_BRDF;
-    if (kind == BRDF_PHONG) {
-        return 1.0 / sqrt(m.ks.w + 1.0);
-    }
-    if (kind == BRDF_BLINN_PHONG) {
-        return 2.0 / sqrt(m.ks.w + 1.0);
-    }
-    if (kind == BRDF_WARD) {
-        return 2.0 * sqrt(m.params.x * m.params.y);
-    }
-    if (kind == BRDF_MEASURED) {
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
+        return PI;
+    case BRDF_PHONG:
+        return phong_lobe_width(m.ks.w);
+    case BRDF_BLINN_PHONG:
+        return blinn_phong_lobe_width(m.ks.w);
+    case BRDF_WARD:
+        return ward_lobe_width(m.params.x, m.params.y);
+    case BRDF_MEASURED:
         return m.ks.w;
     }
     return PI;
+}
+
+// The axis a lobe's inverse-CDF directions are drawn about: Phong's mirror direction of the viewer, the others'
+// normal.
+vec3 sampling_axis(Frame p) {
+    switch (VARIANT_BRDF) {
+    case BRDF_PHONG:
+        return mirror(p.to_viewer, p.normal);
+    case BRDF_LAMBERT:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+    case BRDF_MEASURED:
+        return p.normal;
+    }
+    return p.normal;
+}
+
+// One sample (xi1, phi) of a stratified grid through the lobe's own inverse CDF about (axis, t, b): the weight
+// lobe(w) (n.w)+ / pdf(w) per channel, and the direction in `omega`. A Lambertian BRDF has no lobe: weight 0.
+vec3 lobe_sample(MaterialGpu m, Frame p, vec3 axis, vec3 t, vec3 b, float xi1, float phi, out vec3 omega) {
+    vec3 n = p.normal;
+    vec3 v = p.to_viewer;
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
+        omega = n;
+        return vec3(0.0);
+    case BRDF_PHONG:
+        return vec3(phong_lobe_sample(n, axis, t, b, m.ks.w, xi1, phi, omega));
+    case BRDF_BLINN_PHONG:
+        return vec3(blinn_phong_lobe_sample(n, v, axis, t, b, m.ks.w, xi1, phi, omega));
+    case BRDF_WARD:
+        return vec3(ward_lobe_sample(n, p.tangent, p.bitangent, v, m.params.x, m.params.y, xi1, phi, omega));
+    case BRDF_MEASURED:
+        return measured_lobe_sample(m, n, v, t, b, xi1, phi, omega);
+    }
+    omega = n;
+    return vec3(0.0);
 }
 
 // The point for u in (0, 1) of a grid on [a, b] graded about c with width w, x = c + w sinh(z), and its density
@@ -211,22 +263,6 @@ SegmentSums segment_lobe_integral_visible(MaterialGpu m, Frame p, vec3 q, vec3 d
         }
     }
     return SegmentSums(sum / (k * k), projected / (k * k), min(beta_axis.blend, s_axis.blend));
-}
-
-// A direction at angle a from the unit `axis` with cos a = (1 - xi1)^(1/(e+1)) and azimuth phi in the frame
-// (t, b) about it: the inverse CDF of the pdf (e+1)/(2 pi) cos^e a. 1 - cos a as -expm1(log1p(-xi1)/(e+1)), which
-// keeps its digits for large e (see the Rust).
-vec3 cos_power_direction(vec3 axis, vec3 t, vec3 b, float exponent, float xi1, float phi) {
-    float one_minus_cos = -exp_minus_one(log1p_accurate(-xi1) / (exponent + 1.0));
-    float cos_a = 1.0 - one_minus_cos;
-    float sin_a = sqrt(one_minus_cos * (1.0 + cos_a));
-    return cos_a * axis + sin_a * (cos(phi) * t + sin(phi) * b);
-}
-
-// The alpha of the Ward half-vector distribution that draws a measured table's sky samples: its peak width / sqrt(2),
-// in [1e-3, 1].
-float measured_sampling_alpha(float lobe_width) {
-    return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
 }
 
 #endif

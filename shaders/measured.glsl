@@ -97,4 +97,29 @@ vec3 measured_residual(MaterialGpu m, vec3 n, vec3 l, vec3 v) {
     return measured_brdf(m.kind.w, m.params.w != 0.0, n, l, v) - m.params.rgb;
 }
 
+// The alpha of the Ward half-vector distribution that draws a measured table's sky samples: its peak width / sqrt(2),
+// in [1e-3, 1].
+float measured_sampling_alpha(float lobe_width) {
+    return clamp(lobe_width / 1.41421356237309504880, 1e-3, 1.0);
+}
+
+// One sample of the sky's inverse-CDF grid for a table: Ward's isotropic half vector about n with the table's
+// alpha, reflected into `omega`; the table's part above its floor times the weight (n.w)+ 4 (v.h) pi alpha^2
+// cos^3 delta / xi1, 0 (omega = n) where h faces away from the viewer (see the Rust). (t, b): a frame about n.
+vec3 measured_lobe_sample(MaterialGpu m, vec3 n, vec3 v, vec3 t, vec3 b, float xi1, float phi, out vec3 omega) {
+    float alpha = measured_sampling_alpha(m.ks.w);
+    float tan2 = -alpha * alpha * log_accurate(xi1);
+    float cos_d = 1.0 / sqrt(1.0 + tan2);
+    float sin_d = sqrt(tan2) * cos_d;
+    vec3 h = sin_d * (cos(phi) * t + sin(phi) * b) + cos_d * n;
+    float vh = dot(v, h);
+    if (!(vh > 0.0)) {
+        omega = n;
+        return vec3(0.0);
+    }
+    omega = 2.0 * vh * h - v;
+    float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
+    return measured_residual(m, n, omega, v) * weight;
+}
+
 #endif

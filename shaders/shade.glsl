@@ -35,8 +35,14 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
         return vec3(0.0);
     }
     vec3 radiance = lambert_brdf(material.kd.rgb) * irradiance_visible(p);
-    if (VARIANT_BRDF == BRDF_LAMBERT) {
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
         return radiance;
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+    case BRDF_MEASURED:
+        break;
     }
     vec3 specular = vec3(0.0);
     if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {

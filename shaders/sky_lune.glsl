@@ -18,7 +18,20 @@ const float GRAZING_FLOOR = 0.05;
 // plane of incidence, n.v across it (at least GRAZING_FLOOR); 1 for every other lobe (see sky_lune.rs).
 // 1 - (n.v)^2 = |n x v|^2, so no normalization where n x v is rounding.
 float grazing_narrowing(MaterialGpu m, Frame p, vec3 u) {
-    if (VARIANT_BRDF != BRDF_WARD || m.params.x != m.params.y) {
+    // Every kind by name, so that a new one says whether its lobe narrows.
+    bool isotropic_ward = false;
+    switch (VARIANT_BRDF) {
+    case BRDF_WARD:
+        isotropic_ward = m.params.x == m.params.y;
+        break;
+    case BRDF_LAMBERT:
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_MEASURED:
+        isotropic_ward = false;
+        break;
+    }
+    if (!isotropic_ward) {
         return 1.0;
     }
     vec3 nxv = cross(p.normal, p.to_viewer);
@@ -72,9 +85,19 @@ float sky_lune_blend(MaterialGpu m, Frame p) {
     vec3 r = mirror(p.to_viewer, n);
     float quarter = 0.25 * min(lobe_width(m), 1.0);
     float tilt = up_across(n).w;
-    // A measured table takes the upper lune wherever the surface is tilted (see the Rust).
-    float below = VARIANT_BRDF == BRDF_MEASURED ? 1.0
-        : max(clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0), sky_beyond_lobe(m, p, r));
+    float below = 1.0;
+    switch (VARIANT_BRDF) {
+    case BRDF_MEASURED:
+        // A table takes the upper lune wherever the surface is tilted (see the Rust).
+        below = 1.0;
+        break;
+    case BRDF_LAMBERT:
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+        below = max(clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0), sky_beyond_lobe(m, p, r));
+        break;
+    }
     return below * min(tilt / quarter, 1.0);
 }
 
@@ -89,7 +112,16 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     float tilt = up.w;
     float psi_lo = lune == LUNE_BELOW ? -0.5 * PI : tilt - 0.5 * PI;
     float psi_hi = lune == LUNE_BELOW ? tilt - 0.5 * PI : 0.5 * PI;
-    if (!(psi_hi > psi_lo) || VARIANT_BRDF == BRDF_LAMBERT) {
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
+        return vec3(0.0);
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+    case BRDF_MEASURED:
+        break;
+    }
+    if (!(psi_hi > psi_lo)) {
         return vec3(0.0);
     }
     vec3 b = sin_t > 0.0 ? across / sin_t : orthonormal_to(n);

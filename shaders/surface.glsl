@@ -51,12 +51,22 @@ MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metalli
     precise float r = clamp(roughness, 0.0, 1.0);
     precise float alpha = max(r * r, 1e-3);
     precise float exponent = clamp(2.0 / (alpha * alpha) - 2.0, 0.0, 1e7);
-    if (VARIANT_BRDF == BRDF_LAMBERT) {
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
         m.kd = vec4(base, 0.0);
-    } else {
+        break;
+    case BRDF_WARD:
         m.kd = vec4(kd, 0.0);
-        m.ks = vec4(ks, VARIANT_BRDF == BRDF_WARD ? 0.0 : exponent);
-        m.params = vec4(VARIANT_BRDF == BRDF_WARD ? vec2(alpha) : vec2(0.0), 0.0, 0.0);
+        m.ks = vec4(ks, 0.0);
+        m.params = vec4(vec2(alpha), 0.0, 0.0);
+        break;
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_MEASURED:
+        m.kd = vec4(kd, 0.0);
+        m.ks = vec4(ks, exponent);
+        m.params = vec4(vec2(0.0), 0.0, 0.0);
+        break;
     }
     return m;
 }
@@ -66,10 +76,20 @@ MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metalli
 MaterialGpu surface_brdf(MaterialGpu m, SurfaceSample s, vec4 base) {
     precise float metallic = m.pbr.x;
     precise float roughness = m.pbr.y;
-    if (VARIANT_BRDF != BRDF_LAMBERT && m.tex[TEX_METALLIC_ROUGHNESS].texture.x != NO_TEXTURE) {
-        vec4 t = material_texture(m.tex[TEX_METALLIC_ROUGHNESS], s);
-        metallic = metallic * t.b;
-        roughness = roughness * t.g;
+    switch (VARIANT_BRDF) {
+    case BRDF_LAMBERT:
+        // The mapping's Lambertian BRDF is the base colour: neither factor counts.
+        break;
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+    case BRDF_MEASURED:
+        if (m.tex[TEX_METALLIC_ROUGHNESS].texture.x != NO_TEXTURE) {
+            vec4 t = material_texture(m.tex[TEX_METALLIC_ROUGHNESS], s);
+            metallic = metallic * t.b;
+            roughness = roughness * t.g;
+        }
+        break;
     }
     return brdf_from_metallic_roughness(m, base.rgb, metallic, roughness);
 }

@@ -218,6 +218,9 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
     ("lights/disk.glsl", &["src/shading/lights/disk.rs"], ""),
     ("lights/sky.glsl", &["src/shading/lights/sky.rs"], ""),
     ("brdf.glsl", &["src/shading/brdf.rs"], ""),
+    ("brdf/phong.glsl", &["src/shading/brdf/phong.rs"], ""),
+    ("brdf/blinn_phong.glsl", &["src/shading/brdf/blinn_phong.rs"], ""),
+    ("brdf/ward.glsl", &["src/shading/brdf/ward.rs"], ""),
     ("shade.glsl", &["src/shading/shade.rs"], ""),
     ("lobe.glsl", &["src/shading/lobe.rs"], ""),
     ("sky_lune.glsl", &["src/shading/sky_lune.rs"], ""),
@@ -332,6 +335,73 @@ fn every_shader_file_has_its_rust_twin_by_path() {
         }
     }
     assert!(functions >= 140, "only {functions} GLSL functions seen");
+}
+
+/// GLSL has no exhaustive `match`: so every branch of a shader on the BRDF kind is a `switch (VARIANT_BRDF)` whose
+/// `case`s name every kind of shaders/bindings.glsl (as many as the Rust's `Brdf` has variants) with no `default`,
+/// and no shader compares with a `BRDF_*` constant outside one. A new BRDF is then a list of switches to extend,
+/// each found by this test.
+#[test]
+fn every_branch_on_the_brdf_kind_names_every_kind() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let bindings = std::fs::read_to_string(root.join("shaders/bindings.glsl")).unwrap();
+    let kinds: std::collections::BTreeSet<String> = bindings
+        .lines()
+        .filter_map(|l| l.strip_prefix("#define BRDF_"))
+        .map(|rest| format!("BRDF_{}", rest.split_whitespace().next().unwrap()))
+        .collect();
+    let material = std::fs::read_to_string(root.join("src/scene/material.rs")).unwrap();
+    let brdf_enum = &material[material.find("pub enum Brdf {").expect("enum Brdf")..];
+    let brdf_enum = &brdf_enum[..brdf_enum.find("\n}").unwrap()];
+    let variants = brdf_enum
+        .lines()
+        .filter(|l| l.starts_with("    ") && !l.starts_with("     ") && l.trim_start().starts_with(char::is_uppercase))
+        .count();
+    assert_eq!(kinds.len(), variants, "shaders/bindings.glsl's BRDF_* kinds against the Rust's Brdf variants");
+    let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let mut switches = 0;
+    for (path, text) in sources("shaders") {
+        if path.ends_with("bindings.glsl") {
+            continue;
+        }
+        let code: String = text.lines().map(|l| l.split("//").next().unwrap().to_string() + "\n").collect();
+        // Every BRDF_* token is a case label.
+        for (i, _) in code.match_indices("BRDF_") {
+            if code[..i].chars().next_back().is_some_and(is_ident) {
+                continue; // VARIANT_BRDF and the like
+            }
+            assert!(
+                code[..i].trim_end().ends_with("case"),
+                "{path}: `{}` outside a `case`: branch on the BRDF kind with a switch naming every kind",
+                code[i..].split(|c: char| !is_ident(c)).next().unwrap()
+            );
+        }
+        // Every switch on the kind names each kind once, with no default.
+        for (start, _) in code.match_indices("switch (VARIANT_BRDF)") {
+            let open = start + code[start..].find('{').unwrap();
+            let mut depth = 0;
+            let mut end = open;
+            for (j, c) in code[open..].char_indices() {
+                depth += i32::from(c == '{') - i32::from(c == '}');
+                if depth == 0 {
+                    end = open + j;
+                    break;
+                }
+            }
+            let body = &code[open..end];
+            let named: Vec<&str> = body
+                .match_indices("case ")
+                .map(|(j, _)| body[j + 5..].split(|c: char| !is_ident(c)).next().unwrap())
+                .collect();
+            let line = code[..start].lines().count() + 1;
+            let set: std::collections::BTreeSet<String> = named.iter().map(|s| s.to_string()).collect();
+            assert_eq!(set, kinds, "{path}:{line}: a switch on VARIANT_BRDF must name every kind");
+            assert_eq!(named.len(), kinds.len(), "{path}:{line}: a kind named twice");
+            assert!(!body.contains("default"), "{path}:{line}: no `default` (name each kind)");
+            switches += 1;
+        }
+    }
+    assert!(switches >= 8, "only {switches} switches on the BRDF kind seen");
 }
 
 /// The shaders do not call the built-ins that lose digits on lavapipe (docs/platform.md): `acos`, `asin` (4e-4),

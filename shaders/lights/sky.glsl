@@ -25,11 +25,7 @@ float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
 // lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
 // (see the Rust).
 vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
-    vec3 n = p.normal;
-    vec3 v = p.to_viewer;
-    uint kind = VARIANT_BRDF;
-    // Phong samples about the mirror direction of v, Blinn-Phong's half vector about n (Ward: its own frame).
-    vec3 axis = kind == BRDF_PHONG ? mirror(v, n) : n;
+    vec3 axis = sampling_axis(p);
     vec3 t = orthonormal_to(axis);
     vec3 b = cross(axis, t);
     float k = float(per_axis);
@@ -39,58 +35,12 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
         for (uint j = 0u; j < per_axis; ++j) {
             float xi2 = (float(j) + 0.5) / k;
             float phi = 2.0 * PI * xi2;
-            if (kind == BRDF_PHONG) {
-                float e = m.ks.w;
-                vec3 omega = cos_power_direction(axis, t, b, e, xi1, phi);
-                float value = (e + 2.0) / (e + 1.0) * max(dot(n, omega), 0.0);
-                if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                    sum += value;
-                }
-            } else if (kind == BRDF_BLINN_PHONG) {
-                float e = m.ks.w;
-                vec3 h = cos_power_direction(axis, t, b, e, xi1, phi);
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float value = blinn_phong_normalization(e) * 4.0 * vh * max(dot(n, omega), 0.0) * 2.0 * PI / (e + 1.0);
-                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
-                }
-            } else if (kind == BRDF_WARD) {
-                float ax = m.params.x;
-                float ay = m.params.y;
-                float phi_h = atan2_accurate(ay * sin(phi), ax * cos(phi));
-                float sp = sin(phi_h);
-                float cp = cos(phi_h);
-                float tan2 = -log_accurate(xi1) / (cp * cp / (ax * ax) + sp * sp / (ay * ay));
-                float cos_d = 1.0 / sqrt(1.0 + tan2);
-                float sin_d = sqrt(tan2) * cos_d;
-                vec3 h = sin_d * (cp * p.tangent + sp * p.bitangent) + cos_d * n;
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float value = max(dot(n, omega), 0.0) / (vh * cos_d);
-                    if (!(value > 0.0) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
-                }
-            } else if (kind == BRDF_MEASURED) {
-                // Ward's isotropic half-vector distribution about n with the table's alpha (see the Rust).
-                float alpha = measured_sampling_alpha(m.ks.w);
-                float tan2 = -alpha * alpha * log_accurate(xi1);
-                float cos_d = 1.0 / sqrt(1.0 + tan2);
-                float sin_d = sqrt(tan2) * cos_d;
-                vec3 h = sin_d * (cos(phi) * t + sin(phi) * b) + cos_d * n;
-                float vh = dot(v, h);
-                if (vh > 0.0) {
-                    vec3 omega = 2.0 * vh * h - v;
-                    float weight = max(dot(n, omega), 0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
-                    vec3 value = specular_lobe_rgb(m, p, omega) * weight;
-                    if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0 || visible_along(p.shadow_origin, omega)) {
-                        sum += value;
-                    }
-                }
+            vec3 omega;
+            vec3 value = lobe_sample(m, p, axis, t, b, xi1, phi, omega);
+            // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
+            if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0
+                || visible_along(p.shadow_origin, omega)) {
+                sum += value;
             }
         }
     }

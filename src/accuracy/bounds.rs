@@ -45,6 +45,7 @@ use rayon::prelude::*;
 
 use crate::scene::material::{MAX_EXPONENT, MIN_MAPPED_ALPHA};
 use crate::scene::{Brdf, BrdfKind, Camera, Material, Projection, Scene};
+use crate::shading::lobe::lobe_kink;
 use crate::shading::{lobe_about_z, lobe_width, orthonormal_to};
 
 /// The diff's floor, as a fraction of the image's peak.
@@ -205,26 +206,13 @@ fn scan_lobe_curvature(brdf: &Brdf, step: f64, angles: SunViewAngles) -> (f64, f
 /// width exceeded its estimate by 5%).
 const CELL_PER_LOBE_WIDTH: f64 = 0.25;
 
-/// The slope jump `J` (relative to the lobe's peak) of a lobe with a kink where the light crosses its zero, and
-/// whether a bound can be claimed at all: Phong's `max(0, cos α)ᵉ` bends at α = 90° with a slope jump of e for
-/// 1 ≤ e < 2 (a continuous slope but unbounded curvature above 1), and has an unbounded slope there for 0 < e < 1
-/// (no claim). Blinn-Phong's `n·h` stays positive for light and viewer above the horizon, and Ward is smooth.
-/// Sampled scans do not find a kink (it is a line, the scan's points a 5° lattice), so it is bounded here.
-fn kink(brdf: &Brdf) -> Option<f64> {
-    match *brdf {
-        Brdf::Phong { exponent, .. } if exponent > 0.0 && exponent < 1.0 => None,
-        Brdf::Phong { exponent, .. } if (1.0..2.0).contains(&exponent) => Some(exponent as f64),
-        _ => Some(0.0),
-    }
-}
-
 /// The relative error bound of the delta sun's lobe term against the disk sun's exact integral, for this BRDF
 /// under a sun of angular radius `r` \[rad\]: `(r²/8) max |∇²f|` (see the module's text), at most 1.
 pub fn sun_delta_bound(brdf: &Brdf, r: f64, angles: SunViewAngles) -> f64 {
     if brdf.is_lambert() {
         return 0.0;
     }
-    let Some(jump) = kink(brdf) else { return 1.0 };
+    let Some(jump) = lobe_kink(brdf) else { return 1.0 };
     if 2.0 * r > CELL_PER_LOBE_WIDTH * lobe_width(brdf) {
         return 1.0;
     }
@@ -244,7 +232,7 @@ pub fn sun_grid_bound(brdf: &Brdf, r: f64, k: u32, angles: SunViewAngles) -> f64
     if brdf.is_lambert() {
         return 0.0;
     }
-    let Some(jump) = kink(brdf) else { return 1.0 };
+    let Some(jump) = lobe_kink(brdf) else { return 1.0 };
     let h = PI * r / k as f64;
     if k < MIN_GRID_FOR_BOUND || h > CELL_PER_LOBE_WIDTH * lobe_width(brdf) {
         return 1.0;

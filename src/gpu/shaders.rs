@@ -10,6 +10,9 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("bindings.glsl", include_str!("../../shaders/bindings.glsl")),
     ("math.glsl", include_str!("../../shaders/math.glsl")),
     ("brdf.glsl", include_str!("../../shaders/brdf.glsl")),
+    ("brdf/phong.glsl", include_str!("../../shaders/brdf/phong.glsl")),
+    ("brdf/blinn_phong.glsl", include_str!("../../shaders/brdf/blinn_phong.glsl")),
+    ("brdf/ward.glsl", include_str!("../../shaders/brdf/ward.glsl")),
     ("measured.glsl", include_str!("../../shaders/measured.glsl")),
     ("shade.glsl", include_str!("../../shaders/shade.glsl")),
     ("lobe.glsl", include_str!("../../shaders/lobe.glsl")),
@@ -104,6 +107,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn sources_hold_every_file_of_the_shaders_folder() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+        let mut on_disk = Vec::new();
+        let mut folders = vec![root.clone()];
+        while let Some(folder) = folders.pop() {
+            for entry in std::fs::read_dir(&folder).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    folders.push(path);
+                } else {
+                    on_disk.push(path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/"));
+                }
+            }
+        }
+        let mut listed: Vec<String> = SOURCES.iter().map(|(name, _)| name.to_string()).collect();
+        on_disk.sort();
+        listed.sort();
+        assert_eq!(listed, on_disk, "shaders/ and SOURCES differ: list a new shader file in SOURCES");
     }
 
     #[test]

@@ -1,16 +1,21 @@
-//! A BRDF's specular lobe and how it is sampled: the lobe of a material at a surface point
-//! ([`specular_lobe`], per channel for a measured table), its width ([`lobe_width`]), the graded grids that
-//! integrate it over a light's disk or segment ([`segment_lobe_integral`], with visibility
-//! [`segment_lobe_integral_visible`]), and the inverse-CDF directions about its axis ([`cos_power_direction`]).
-//! The lights (`shading::lights`) integrate it over themselves with these; `shaders/lobe.glsl` mirrors it name for
-//! name.
+//! A BRDF's specular lobe and how it is sampled. The table of models: each question asked of a lobe is one
+//! function here whose `match` names every model and calls its file (`shading::brdf::{phong, blinn_phong, ward}`,
+//! `shading::measured`): the lobe of a material at a surface point ([`specular_lobe`], per channel for a measured
+//! table), its width ([`lobe_width`]), one sample of its inverse CDF ([`lobe_sample`] about [`sampling_axis`]),
+//! its kink for the error bounds ([`lobe_kink`]). Then what every model shares: the graded grids that integrate a
+//! lobe over a light's disk or segment ([`segment_lobe_integral`], with visibility
+//! [`segment_lobe_integral_visible`]). The lights (`shading::lights`) integrate it over themselves with these;
+//! `shaders/lobe.glsl` mirrors it name for name.
 
 use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::brdf::{blinn_phong_lobe, mirror, phong_lobe, ward_lobe};
-use super::measured::measured_residual;
+use super::brdf::blinn_phong::{blinn_phong_lobe, blinn_phong_lobe_sample, blinn_phong_lobe_width};
+use super::brdf::mirror;
+use super::brdf::phong::{phong_lobe, phong_lobe_kink, phong_lobe_sample, phong_lobe_width};
+use super::brdf::ward::{ward_lobe, ward_lobe_sample, ward_lobe_width};
+use super::measured::{measured_lobe_sample, measured_residual};
 use super::visibility::Shadowing;
 use crate::scene::Brdf;
 
@@ -55,7 +60,9 @@ pub fn orthonormal_to(v: DVec3) -> DVec3 {
 pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
     match brdf {
         Brdf::Measured { table, lookup } => measured_residual(table, *lookup, p.normal, l, p.to_viewer),
-        _ => [specular_lobe(brdf, p, l); 3],
+        Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } => {
+            [specular_lobe(brdf, p, l); 3]
+        }
     }
 }
 
@@ -83,16 +90,65 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
 }
 
 /// The angular width \[rad\] about a specular lobe's peak (the mirror direction of the viewer) over which the disk
-/// integral crowds its samples: where the lobe falls to about `e^{-1/2}`. Phong's `cosᵉα` at `α ≈ 1/√e`;
-/// Blinn-Phong's in the half vector, and ω turns twice as fast: `2/√e`; Ward's `exp(−tan²δ/α²)` at `δ = α/√2`,
-/// `√2 α` in ω, taken as `2√(αx αy)` (the geometric mean measured better than either α on anisotropic lobes).
+/// integral crowds its samples: where the lobe falls to about `e^{-1/2}` (each model's file says where).
 pub fn lobe_width(brdf: &Brdf) -> f64 {
     match *brdf {
         Brdf::Lambert { .. } => PI,
-        Brdf::Phong { exponent, .. } => 1.0 / (exponent as f64 + 1.0).sqrt(),
-        Brdf::BlinnPhong { exponent, .. } => 2.0 / (exponent as f64 + 1.0).sqrt(),
-        Brdf::Ward { alpha_x, alpha_y, .. } => 2.0 * (alpha_x as f64 * alpha_y as f64).sqrt(),
+        Brdf::Phong { exponent, .. } => phong_lobe_width(exponent as f64),
+        Brdf::BlinnPhong { exponent, .. } => blinn_phong_lobe_width(exponent as f64),
+        Brdf::Ward { alpha_x, alpha_y, .. } => ward_lobe_width(alpha_x as f64, alpha_y as f64),
         Brdf::Measured { ref table, .. } => table.lobe_width as f64,
+    }
+}
+
+/// The axis a BRDF's inverse-CDF directions are drawn about (for [`lobe_sample`]): Phong's mirror direction of
+/// the viewer, the others' normal (their half vectors are drawn about it).
+pub fn sampling_axis(brdf: &Brdf, p: &SurfacePoint) -> DVec3 {
+    if brdf.sampled_about_mirror() {
+        mirror(p.to_viewer, p.normal)
+    } else {
+        p.normal
+    }
+}
+
+/// One sample `(ξ1, φ = 2πξ2)` of a stratified grid through the lobe's own inverse CDF: the weight
+/// `lobe(ω) (n·ω)+ / pdf(ω)` per channel and the direction ω. `(axis, t, b)`: [`sampling_axis`] and a frame about
+/// it. A Lambertian BRDF has no lobe: weight 0.
+pub fn lobe_sample(
+    brdf: &Brdf,
+    p: &SurfacePoint,
+    (axis, t, b): (DVec3, DVec3, DVec3),
+    xi1: f64,
+    phi: f64,
+) -> ([f64; 3], DVec3) {
+    let (n, v) = (p.normal, p.to_viewer);
+    match *brdf {
+        Brdf::Lambert { .. } => ([0.0; 3], n),
+        Brdf::Phong { exponent, .. } => {
+            let (weight, omega) = phong_lobe_sample(n, axis, t, b, exponent as f64, xi1, phi);
+            ([weight; 3], omega)
+        }
+        Brdf::BlinnPhong { exponent, .. } => {
+            let (weight, omega) = blinn_phong_lobe_sample(n, v, (axis, t, b), exponent as f64, xi1, phi);
+            ([weight; 3], omega)
+        }
+        Brdf::Ward { alpha_x, alpha_y, .. } => {
+            let frame = (n, p.tangent, p.bitangent);
+            let (weight, omega) = ward_lobe_sample(frame, v, (alpha_x as f64, alpha_y as f64), xi1, phi);
+            ([weight; 3], omega)
+        }
+        Brdf::Measured { ref table, lookup } => measured_lobe_sample(table, lookup, (n, v), (t, b), xi1, phi),
+    }
+}
+
+/// The slope jump of the lobe where the light crosses its zero, relative to its peak, for the error bounds
+/// (`accuracy::bounds`; `None`: unbounded, no claim). Sampled scans do not find a kink (it is a line, the scan's
+/// points a lattice), so each model says its own: Phong's at α = 90° (`phong_lobe_kink`); Blinn-Phong's `n·h` stays
+/// positive for light and viewer above the horizon, Ward's lobe is smooth, a table is linear between its bins.
+pub fn lobe_kink(brdf: &Brdf) -> Option<f64> {
+    match *brdf {
+        Brdf::Phong { exponent, .. } => phong_lobe_kink(exponent as f64),
+        Brdf::Lambert { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } | Brdf::Measured { .. } => Some(0.0),
     }
 }
 
@@ -310,34 +366,4 @@ pub fn segment_lobe_integral_visible(
         projected: projected / (k * k),
         uniformity: beta_axis.blend.min(s_axis.blend),
     }
-}
-
-/// `exp(x) − 1` without cancellation for small x (Kahan's trick: exact where `exp` and `ln` are accurate).
-pub fn exp_minus_one(x: f64) -> f64 {
-    let u = x.exp();
-    if u == 1.0 {
-        return x;
-    }
-    let um1 = u - 1.0;
-    if um1 == -1.0 {
-        return -1.0;
-    }
-    um1 * x / u.ln()
-}
-
-/// A direction at angle a from the unit `axis` with `cos a = (1 − ξ1)^{1/(e+1)}` and azimuth φ in the frame
-/// (t, b) about it: the inverse CDF of the pdf `(e+1)/(2π) cosᵉa`. `1 − cos a` is formed as
-/// `−expm1(ln(1 − ξ1)/(e+1))`: for large e the exponent is tiny and `1 − (1 − ξ1)^{1/(e+1)}` would cancel.
-pub fn cos_power_direction(axis: DVec3, t: DVec3, b: DVec3, exponent: f64, xi1: f64, phi: f64) -> DVec3 {
-    let one_minus_cos = -exp_minus_one((-xi1).ln_1p() / (exponent + 1.0));
-    let cos_a = 1.0 - one_minus_cos;
-    let sin_a = (one_minus_cos * (1.0 + cos_a)).sqrt();
-    cos_a * axis + sin_a * (phi.cos() * t + phi.sin() * b)
-}
-
-/// The α of the Ward half-vector distribution that draws a measured table's sky samples: its peak width
-/// `w` (2θ_h at e^{-1/2} of the peak) is Ward's `√2 α`, so `α = w/√2`, kept in [10⁻³, 1] (a table without a peak
-/// has w = π: the broadest distribution).
-pub fn measured_sampling_alpha(lobe_width: f64) -> f64 {
-    (lobe_width / std::f64::consts::SQRT_2).clamp(1e-3, 1.0)
 }

@@ -239,6 +239,41 @@ pub fn tabulate(mut rho: impl FnMut(DVec3, DVec3) -> [f64; 3]) -> [Vec<f64>; 3] 
     planes
 }
 
+/// The α of the Ward half-vector distribution that draws a measured table's sky samples: its peak width
+/// `w` (2θ_h at e^{-1/2} of the peak) is Ward's `√2 α`, so `α = w/√2`, kept in [10⁻³, 1] (a table without a peak
+/// has w = π: the broadest distribution).
+pub fn measured_sampling_alpha(lobe_width: f64) -> f64 {
+    (lobe_width / std::f64::consts::SQRT_2).clamp(1e-3, 1.0)
+}
+
+/// One sample of the sky's inverse-CDF grid for a table, which has no inverse CDF of its own: its part above the
+/// floor ([`measured_residual`]) is drawn through Ward's isotropic half-vector distribution about n,
+/// `p_h = exp(−tan²δ/α²)/(π α² cos³δ)`, with the α of the table's peak width ([`measured_sampling_alpha`]);
+/// `tan²δ = −α² ln ξ1` makes the exponential ξ1 itself, and `p_ω = p_h/(4 v·h)`, so the sample's weight is
+/// `ρ (n·ω) 4 (v·h) π α² cos³δ / ξ1` (ξ1 ≥ 1/(2k) on the midpoint grid); 0 (and ω = n) where h faces away from
+/// the viewer. `(t, b)`: a frame about n.
+pub fn measured_lobe_sample(
+    table: &MeasuredBrdf,
+    lookup: MeasuredLookup,
+    (n, v): (DVec3, DVec3),
+    (t, b): (DVec3, DVec3),
+    xi1: f64,
+    phi: f64,
+) -> ([f64; 3], DVec3) {
+    let alpha = measured_sampling_alpha(table.lobe_width as f64);
+    let tan2 = -alpha * alpha * xi1.ln();
+    let cos_d = 1.0 / (1.0 + tan2).sqrt();
+    let sin_d = tan2.sqrt() * cos_d;
+    let h = sin_d * (phi.cos() * t + phi.sin() * b) + cos_d * n;
+    let vh = v.dot(h);
+    if vh <= 0.0 {
+        return ([0.0; 3], n);
+    }
+    let omega = 2.0 * vh * h - v;
+    let weight = n.dot(omega).max(0.0) * 4.0 * vh * PI * alpha * alpha * cos_d * cos_d * cos_d / xi1;
+    (measured_residual(table, lookup, n, omega, v).map(|x| x * weight), omega)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
