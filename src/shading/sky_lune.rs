@@ -306,9 +306,9 @@ mod tests {
     fn a_silhouette_facing_down_takes_no_sky_from_a_difference_of_grids() {
         // The lower part of a sphere's silhouette seen along +Z (the BRDF chart's view; n·v 0.005 to 0.05, n·up
         // under −0.7), where no sky direction's half vector comes near n: the truth is 0 to 1e-16. 16² against
-        // 512², relative to the larger of the value and 1% of the largest on the silhouette's equator. Before
-        // `sky_beyond_lobe` the blend gave the hemisphere's grid less the lower lune's up to 0.75 of the weight
-        // here, and the remainder of their errors erred 2.4 (at n ≈ (±0.555, −0.831, 0.02)).
+        // 512², relative to the larger of the value and 1% of the largest on the silhouette's equator. Without
+        // `sky_beyond_lobe` the blend would give the hemisphere's grid less the lower lune's up to 0.75 of the
+        // weight here, and the remainder of their errors would err 2.4 (at n ≈ (±0.555, −0.831, 0.02)).
         let brdf = Brdf::Ward { kd: [0.0; 3], ks: [1.0; 3], alpha_x: 0.2, alpha_y: 0.2 };
         let v = DVec3::Z;
         let rim = |nv: f64, ph: f64| nv * v + (1.0f64 - nv * nv).sqrt() * DVec3::new(ph.cos(), ph.sin(), 0.0);

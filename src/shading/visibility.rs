@@ -480,7 +480,7 @@ pub fn cell_visible_area(seen: [bool; 4], bottom: f64, right: f64, top: f64, lef
 /// Direct Illumination", CGF 35(4), 2016, with the crossings found by rays alone). The grid's corners lie on the
 /// light's rim, so a sliver of light left at the rim (a penumbra's dark end) is seen as soon as it spans a side.
 /// A square with a corner of zero weight (the light cut by the horizon: the weights' business) counts its corners,
-/// a quarter each. Left as before: an occluder thinner than the spacing can pass between the rays unseen.
+/// a quarter each. An occluder thinner than the spacing can still pass between the rays unseen.
 ///
 /// The sums run in a fixed order and add the same weights to `visible` and `total`, so a wholly visible light is
 /// exactly 1 and a wholly blocked one exactly 0: only penumbrae see the grid.
