@@ -81,7 +81,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         today(),
         machine(),
         device_description(&info),
-        if ray_queries { "" } else { " (without ray queries: shadows by map or none)" },
+        if ray_queries { "" } else { " (without ray queries: shadow rays by the fragment shader's walk)" },
         build(),
         a.repeat,
         a.accuracy,

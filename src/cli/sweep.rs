@@ -80,23 +80,14 @@ impl Setting {
 
 /// Sample counts per axis of the ladder's rungs: (sun, lobes, shadow rays).
 const LADDER: [(u32, u32, u32); 4] = [(1, 2, 1), (2, 4, 2), (4, 8, 4), (16, 32, 16)];
-/// Shadow-map sizes swept, and the ladder's (one per rung).
+/// Shadow-map sizes swept.
 const MAP_SIZES: [u32; 4] = [512, 1024, 2048, 4096];
 
-/// The settings to sweep: the base first (`interpolation` the renderer's default; shadow rays where the device has
-/// ray queries, shadow maps where it has none: there the rays of disk lights and the sky walk the BVH, seconds a
-/// frame, and every rung would wait on them), then each knob alone, then the ladder; without repeats. `modes`:
-/// the interpolation modes the device offers.
+/// The settings to sweep: the base first (the default render: `interpolation` the renderer's default, shadow rays
+/// where the scene can shadow itself, by ray queries or the fragment shader's walk), then each knob alone, then the
+/// ladder; without repeats. `modes`: the interpolation modes the device offers.
 pub fn sweep(r: &Relevance, default_mode: Interpolation, modes: &[Interpolation]) -> Vec<Setting> {
-    let base = ShadingOptions {
-        shadows: match (r.shadows, r.ray_queries) {
-            (false, _) => Shadows::None,
-            (true, true) => Shadows::Ray,
-            // Without ray queries: shadow maps (see above; docs/accuracy.md, "Shadows").
-            (true, false) => Shadows::Map,
-        },
-        ..Default::default()
-    };
+    let base = ShadingOptions { shadows: if r.shadows { Shadows::Ray } else { Shadows::None }, ..Default::default() };
     let at = |shading: ShadingOptions| Setting { interpolation: default_mode, shading };
     let mut v = vec![at(base)];
     if r.sun {
@@ -124,26 +115,17 @@ pub fn sweep(r: &Relevance, default_mode: Interpolation, modes: &[Interpolation]
             v.push(at(ShadingOptions { shadows: Shadows::Map, shadow_map_size: size, ..base }));
         }
         v.push(at(ShadingOptions { shadows: Shadows::Map, shadow_map_filter: ShadowMapFilter::Nearest, ..base }));
-        if r.ray_queries {
-            for n in [1, 2, 4, 16] {
-                v.push(at(ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: n, ..base }));
-            }
-        } else if r.sky {
-            // Without ray queries the maps leave the sky unoccluded (every setting above errs by its whole light
-            // where an occluder hides it); the fragment shader's walk of the occluders' BVH is the one technique
-            // that shadows it on such a device, seconds a frame at 256²: one row, the default rays, so that the
-            // table shows what shadowing the sky costs and buys here.
-            v.push(at(ShadingOptions { shadows: Shadows::Ray, ..base }));
+        for n in [1, 2, 4, 16] {
+            v.push(at(ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: n, ..base }));
         }
     }
     // The ladder: every count raised together, with the exact models at the default interpolation and with the
     // fast ones (delta sun, small-source disks) at f32.
     let fast_mode = modes.iter().copied().find(|&m| m == Interpolation::BarycentricF32).unwrap_or(default_mode);
-    for (rung, &(sun, lobes, rays)) in LADDER.iter().enumerate() {
-        let shadows = |o: ShadingOptions| match (r.shadows, r.ray_queries) {
-            (false, _) => o,
-            (true, true) => ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: rays, ..o },
-            (true, false) => ShadingOptions { shadows: Shadows::Map, shadow_map_size: MAP_SIZES[rung], ..o },
+    for &(sun, lobes, rays) in &LADDER {
+        let shadows = |o: ShadingOptions| match r.shadows {
+            false => o,
+            true => ShadingOptions { shadows: Shadows::Ray, shadow_samples_per_axis: rays, ..o },
         };
         let exact = ShadingOptions { sun_samples_per_axis: sun, samples_per_axis: lobes, ..base };
         v.push(at(shadows(exact)));
@@ -180,19 +162,18 @@ mod tests {
     }
 
     #[test]
-    fn without_ray_queries_a_sky_through_occluders_gets_the_walk() {
-        // Shadow maps leave the sky unoccluded: the one setting that shadows it is the BVH walk's rays.
+    fn without_ray_queries_the_default_and_the_rays_are_the_walk() {
+        // The default render's shadows are rays on every device: without ray queries the fragment shader walks
+        // the BVH, and the sweep starts from that default and sweeps its grid as it does with ray queries.
         let sky = Relevance { sun: false, disks: false, sky: true, lobes: false, shadows: true, ray_queries: false };
         let labels: Vec<String> =
             sweep(&sky, Interpolation::BarycentricF64, &MODES).iter().map(|s| s.label(&sky)).collect();
-        assert_eq!(labels.iter().filter(|l| l.contains("shadows ray")).count(), 1, "{labels:?}");
-        assert!(labels.contains(&"shadows ray 6² (BVH walk), f64".to_string()), "{labels:?}");
-        assert!(labels[0].contains("shadows map"), "the default stays auto's maps: {labels:?}");
-        // Under the sun alone the maps shadow every light: no walk.
-        let sun = Relevance { sky: false, sun: true, ..sky };
-        let labels: Vec<String> =
-            sweep(&sun, Interpolation::BarycentricF64, &MODES).iter().map(|s| s.label(&sun)).collect();
-        assert!(labels.iter().all(|l| !l.contains("shadows ray")), "{labels:?}");
+        assert_eq!(labels[0], "shadows ray 6² (BVH walk), f64", "{labels:?}");
+        for n in [1, 2, 4, 16] {
+            let rays = format!("shadows ray {n}² (BVH walk), f64");
+            assert!(labels.contains(&rays), "{rays} missing from {labels:?}");
+        }
+        assert!(labels.iter().any(|l| l.contains("shadows map 2048 pcss")), "{labels:?}");
     }
 
     #[test]
