@@ -737,12 +737,13 @@ impl Renderer {
         let mut draw_pipelines = Vec::with_capacity(variants.len());
         let mut second_pipelines = Vec::with_capacity(variants.len());
         for (first, &whole) in firsts.iter().zip(whole_pipelines) {
-            match (first, first_pipelines.next()) {
-                (Some(_), Some(&first)) => {
+            // `made` holds a first pipeline for each draw that has a first draw, in order: take one only for those.
+            match first.and_then(|_| first_pipelines.next()) {
+                Some(&first) => {
                     draw_pipelines.push(first);
                     second_pipelines.push(whole);
                 }
-                _ => {
+                None => {
                     draw_pipelines.push(whole);
                     second_pipelines.push(vk::Pipeline::null());
                 }
