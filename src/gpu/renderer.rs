@@ -632,6 +632,30 @@ impl Renderer {
     /// `map`, the sky's passes of slices where its visible fraction is taken by them (`slice_passes`, with rays
     /// walking the BVH and `--visibility slices`), the scene pass, the readback.
     pub fn render(&mut self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Image, FrameTimings), GpuError> {
+        Ok(self.render_frame(scene, settings, false)?.expect("a frame that shades every pixel is always drawn"))
+    }
+
+    /// The first of the frame's two draws alone (`second_draw`): every pixel whose lights the cheap proofs settle
+    /// (each light wholly visible or wholly hidden) shaded, every other left with the coverage alpha
+    /// [`second_draw::LEFT_TO_SECOND_DRAW`] (its colour meaningless) for the caller to shade. `None` where a draw
+    /// of the frame casts shadow rays without a first draw (the sky, whose grid every pixel casts; a sun without
+    /// complete cells; small-source disks), so that no pixel of it is settled; `settings` must ask for the grid
+    /// rule (the slices have no first draw either).
+    pub fn render_leaving_penumbrae(
+        &mut self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+    ) -> Result<Option<(Image, FrameTimings)>, GpuError> {
+        self.render_frame(scene, settings, true)
+    }
+
+    /// [`Self::render`], or with `leave` [`Self::render_leaving_penumbrae`].
+    fn render_frame(
+        &mut self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        leave: bool,
+    ) -> Result<Option<(Image, FrameTimings)>, GpuError> {
         let (width, height) = (settings.width, settings.height);
         self.check_size(width, height)?;
         self.ensure_target(width, height)?;
@@ -730,25 +754,17 @@ impl Renderer {
         // Each draw's first draw, where one settles pixels, made with the others (in parallel) and drawn before them:
         // the pixels it leaves (penumbrae, rays through the tree) are shaded by the whole variant after it.
         let firsts: Vec<Option<ShaderVariant>> =
-            variants.iter().map(|v| if self.one_draw { None } else { v.first_draw() }).collect();
-        let every: Vec<ShaderVariant> = variants.iter().copied().chain(firsts.iter().flatten().copied()).collect();
-        let made = self.pipeline.pipelines_of(&every)?;
-        let (whole_pipelines, mut first_pipelines) = (&made[..variants.len()], made[variants.len()..].iter());
-        let mut draw_pipelines = Vec::with_capacity(variants.len());
-        let mut second_pipelines = Vec::with_capacity(variants.len());
-        for (first, &whole) in firsts.iter().zip(whole_pipelines) {
-            // `made` holds a first pipeline for each draw that has a first draw, in order: take one only for those.
-            match first.and_then(|_| first_pipelines.next()) {
-                Some(&first) => {
-                    draw_pipelines.push(first);
-                    second_pipelines.push(whole);
-                }
-                None => {
-                    draw_pipelines.push(whole);
-                    second_pipelines.push(vk::Pipeline::null());
-                }
-            }
+            variants.iter().map(|v| if self.one_draw && !leave { None } else { v.first_draw() }).collect();
+        if leave && variants.iter().zip(&firsts).any(|(v, f)| v.shadows == SHADOWS_RAY && f.is_none()) {
+            return Ok(None);
         }
+        let (draw_pipelines, second_pipelines) = if leave {
+            // The first draws alone, and the whole variant of a draw without one (nothing of it is left).
+            let alone: Vec<ShaderVariant> = variants.iter().zip(&firsts).map(|(v, f)| f.unwrap_or(*v)).collect();
+            (self.pipeline.pipelines_of(&alone)?, vec![vk::Pipeline::null(); variants.len()])
+        } else {
+            self.first_and_second_pipelines(&variants, &firsts)?
+        };
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
         // Alpha-masked draws test their alpha in the maps too (shadow_mask.frag).
         let mut map_pipelines = Vec::new();
@@ -825,7 +841,9 @@ impl Renderer {
                 self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
                 let t_readback = Instant::now();
                 let image = self.read_back(width, height)?;
-                second_draw::check(&image).map_err(GpuError::Unsupported)?;
+                if !leave {
+                    second_draw::check(&image).map_err(GpuError::Unsupported)?;
+                }
                 match super::loop_budget::check(&image, &self.dev.info.name) {
                     Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {}
                     Err(e) => return Err(GpuError::LoopBudget(e)),
@@ -844,7 +862,35 @@ impl Renderer {
         self.light_fractions = light_fractions;
         self.check_validation()?;
         let lights_in_passes = slice_passes::read_bits(&slots);
-        Ok((image, FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe }))
+        Ok(Some((image, FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe })))
+    }
+
+    /// Each draw's pipeline and the pipeline of its second draw (null where it has no first draw, `firsts`), made
+    /// together (in parallel): a draw with a first draw takes it, and its whole variant (`variants`) second.
+    fn first_and_second_pipelines(
+        &mut self,
+        variants: &[ShaderVariant],
+        firsts: &[Option<ShaderVariant>],
+    ) -> Result<(Vec<vk::Pipeline>, Vec<vk::Pipeline>), GpuError> {
+        let every: Vec<ShaderVariant> = variants.iter().copied().chain(firsts.iter().flatten().copied()).collect();
+        let made = self.pipeline.pipelines_of(&every)?;
+        let (whole_pipelines, mut first_pipelines) = (&made[..variants.len()], made[variants.len()..].iter());
+        let mut draw_pipelines = Vec::with_capacity(variants.len());
+        let mut second_pipelines = Vec::with_capacity(variants.len());
+        for (first, &whole) in firsts.iter().zip(whole_pipelines) {
+            // `made` holds a first pipeline for each draw that has a first draw, in order: take one only for those.
+            match first.and_then(|_| first_pipelines.next()) {
+                Some(&first) => {
+                    draw_pipelines.push(first);
+                    second_pipelines.push(whole);
+                }
+                None => {
+                    draw_pipelines.push(whole);
+                    second_pipelines.push(vk::Pipeline::null());
+                }
+            }
+        }
+        Ok((draw_pipelines, second_pipelines))
     }
 
     /// One frame's draws, with the light buffer `lights` and the passes' fractions (binding 13; the unused one
