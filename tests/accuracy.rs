@@ -600,7 +600,8 @@ fn render_tolerance_keeps_the_gpu_delta_trial() {
     assert!(measured <= 1e-2, "GPU delta render: {measured:.3e}");
 }
 
-/// `render --tolerance` on the GPU (validation on) where the lobe grids need their study: brdfs.glb under sun,
+/// `render --tolerance --tolerance-by-study` on the GPU (validation on) where the lobe grids have no bound (without
+/// the flag their pixels are refined on the reference: tests/tolerance_refined.rs): brdfs.glb under sun,
 /// sky and a disk light, unshadowed, at T = 1e-2 and 1e-3: `-v` names the study and the grid it kept (a finer one
 /// at the tighter T; per material, `accuracy::material_study`), `--check` finds the reference of the same grids
 /// in agreement (each draw reads its material's grid), and each image meets T against the converged reference.
@@ -633,7 +634,7 @@ fn render_tolerance_studies_the_lobe_grids_on_the_gpu() {
         let flags = format!(
             "models/brdfs.glb --width 64 --height 64 --shadows none --sun-elevation 40 --sun-azimuth 30 \
              --sun-irradiance 1000 --sky-radiance 100 --disk-light 0,3,1.5:0,-1,0:0.6:500 --tolerance {tolerance} -v \
-             --check"
+             --check --tolerance-by-study"
         );
         let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
@@ -897,7 +898,8 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
     }
 }
 
-/// `render --tolerance` on the sky through occluders (overcast.glb, the sky through the teapot onto its floor):
+/// `render --tolerance --tolerance-by-study` on the sky through occluders (overcast.glb, the sky through the teapot
+/// onto its floor; without the flag every pixel is refined on the reference: tests/tolerance_refined.rs):
 /// the sky is taken by slices in passes (`gpu::slice_passes`), the grids are
 /// studied on the reference (the same rows in f64), and the GPU's image, measured against the reference's at the
 /// kept settings, meets T = 1e-2 and 1e-3 over every pixel against a truth whose every pixel's last doubling moved
@@ -920,7 +922,7 @@ fn render_tolerance_meets_it_on_the_sky_through_occluders() {
     let mut grids = Vec::new();
     for t in [1e-2, 1e-3] {
         let out = dir.path(&format!("overcast-{t:e}.exr"));
-        let flags = format!("models/overcast.glb --width 32 --height 24 --tolerance {t:e} -v");
+        let flags = format!("models/overcast.glb --width 32 --height 24 --tolerance {t:e} -v --tolerance-by-study");
         let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
         };
@@ -947,7 +949,9 @@ fn render_tolerance_meets_it_on_the_sky_through_occluders() {
     assert!(!dir.path("overcast.exr").exists(), "no image where it refused");
 }
 
-/// `render --tolerance T` on sunset.glb (the sun's penumbrae) on any device, which holds T in penumbrae by default
+/// `render --tolerance T --tolerance-by-study` (the study; without the flag the penumbrae are refined on the
+/// reference: tests/tolerance_refined.rs) on sunset.glb (the sun's penumbrae) on any device, which holds T in
+/// penumbrae by default
 /// since 2026-12-05 (room.gltf below names `--tolerance-in-penumbrae`, still accepted): the shadow
 /// rays' grids join the study, `-v` says so, and the image meets T everywhere, penumbrae included, against the
 /// reference with the sun's and lobes' grids at 181² and the sun's visible fraction by 4 × 64² slices (an
@@ -966,7 +970,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     for t in [1e-2, 1e-3, 1e-4] {
         let out = dir.path(&format!("sunset-{t:e}.exr"));
         // `--tolerance` alone: it holds in penumbrae by default (since 2026-12-05).
-        let flags = format!("models/sunset.glb --width 48 --height 36 --tolerance {t:e} -v");
+        let flags = format!("models/sunset.glb --width 48 --height 36 --tolerance {t:e} -v --tolerance-by-study");
         let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
         };
@@ -989,7 +993,8 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     // 1.0e-4 (docs/accuracy.md); here 1e-2 at 32², against the reference with 64² shadow samples by slices.
     let (scene, s) = common::sliced("room.gltf", (32, 32), 64);
     let out = dir.path("room.exr");
-    let flags = "models/room.gltf --width 32 --height 32 --tolerance 1e-2 --tolerance-in-penumbrae -v";
+    let flags =
+        "models/room.gltf --width 32 --height 32 --tolerance 1e-2 --tolerance-in-penumbrae -v --tolerance-by-study";
     if let Some(e) = render_with_tolerance(flags, &out) {
         assert!(e.contains("penumbrae included") && !e.contains("not bounded"), "{e}");
         let (measured, line) = common::error_against_fine(&out, &scene, &s, &e);
@@ -1005,7 +1010,10 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     s.shading.samples_per_axis = 181;
     s.shading.sun_samples_per_axis = 181;
     let out = dir.path("cube.exr");
-    let o = render_to("models/cube.glb --width 64 --height 64 --tolerance 1e-4 --tolerance-in-penumbrae -v", &out);
+    let o = render_to(
+        "models/cube.glb --width 64 --height 64 --tolerance 1e-4 --tolerance-in-penumbrae -v --tolerance-by-study",
+        &out,
+    );
     let e = String::from_utf8_lossy(&o.stderr);
     if o.status.success() {
         let (measured, line) = common::error_against_fine(&out, &scene, &s, &e);
@@ -1014,7 +1022,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
         // `--check` compares the GPU's own pixels with the reference, not those taken from it: where pixels were
         // taken (further than their budget, itself over the check's 1e-5), the check fails.
         if line.contains("taken from the reference's f64 image") {
-            let flags = "models/cube.glb --width 64 --height 64 --tolerance 1e-4 --check -q";
+            let flags = "models/cube.glb --width 64 --height 64 --tolerance 1e-4 --tolerance-by-study --check -q";
             let checked = render_to(flags, &dir.path("cube-checked.exr"));
             assert_eq!(checked.status.code(), Some(1), "{}", String::from_utf8_lossy(&checked.stderr));
         }

@@ -975,9 +975,14 @@ fn renders_say_their_predicted_error_and_tolerance_chooses_the_sun() {
         samples.push(line);
     }
     assert_ne!(samples[0], samples[1], "{samples:?}");
-    // Under a sky the lobe grid has no derived bound: its error is estimated by refinement, within the tolerance.
+    // Under a sky the lobe grid has no derived bound: its pixels are refined on the reference, within the
+    // tolerance; or, with --tolerance-by-study, its error estimated by refinement over whole renders.
     let sky = dir.path("sky.exr");
     let o = sunshade(&[&base[..], &["--sky-radiance", "100", "--tolerance", "1e-3"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pixel(s) no bound covers"), "{}", stderr(&o));
+    assert!(predicted(&o) <= 1e-3, "{}", stderr(&o));
+    let o = sunshade(&[&base[..], &["--sky-radiance", "100", "--tolerance", "1e-3", "--tolerance-by-study"]].concat());
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("estimated by refinement"), "{}", stderr(&o));
     assert!(predicted(&o) <= 1e-3, "{}", stderr(&o));
@@ -1240,19 +1245,20 @@ fn gpu_slices_refuse_a_light_cone_holding_too_many_triangles() {
 }
 
 /// One render layer: the same flags through `sunshade render` and through the `testing` API give the same image, bit
-/// for bit, also where `--tolerance` chooses the models (by bounds, by a study on the reference, by slices measured
-/// against it) and where `--visibility` names the rule.
+/// for bit, also where `--tolerance` chooses the models (by bounds, refining the pixels without one on the reference,
+/// by a study on the reference, by slices measured against it) and where `--visibility` names the rule.
 #[test]
 fn gpu_the_library_and_the_command_line_render_the_same_flags_to_the_same_image() {
     let dir = TempDir::new("same-flags");
     let teapot = concat!(env!("CARGO_MANIFEST_DIR"), "/models/teapot.glb");
     let cube = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube.glb");
     let size = ["--width", "48", "--height", "36"];
-    let cases: [(&str, &[&str]); 4] = [
-        // Each of the first three differs from the image without `--tolerance` (checked below).
+    let cases: [(&str, &[&str]); 5] = [
+        // Each of the first four differs from the image without `--tolerance` (checked below).
         (teapot, &["--brdf", "ward", "--tolerance", "1e-3"]),
         (cube, &["--brdf", "ward", "--tolerance", "1e-3", "--tolerance-outside-penumbrae"]),
-        (cube, &["--brdf", "ward", "--tolerance", "1e-3", "--visibility", "grid"]),
+        (cube, &["--brdf", "ward", "--tolerance", "1e-3", "--visibility", "grid", "--tolerance-by-study"]),
+        (teapot, &["--brdf", "ward", "--tolerance", "1e-3", "--tolerance-by-study"]),
         (teapot, &["--shadows", "map", "--brdf", "ward"]),
     ];
     let mut gpu = CheckedRenderer::new();
@@ -1268,7 +1274,7 @@ fn gpu_the_library_and_the_command_line_render_the_same_flags_to_the_same_image(
         let from_library = gpu.render_job(&job).unwrap();
         assert!(from_cli.covered_count() > 100, "{flags:?}");
         assert_eq!(bits(&from_cli), bits(&from_library), "{flags:?}: the CLI's and the library's images differ");
-        if i < 3 {
+        if i < 4 {
             let untoleranced: Vec<&str> = size.iter().chain(&["--brdf", "ward"]).copied().collect();
             let plain = gpu.render_job(&sunshade::testing::job(model, &untoleranced).unwrap()).unwrap();
             assert_ne!(bits(&plain), bits(&from_library), "{flags:?}: --tolerance chose the default models");

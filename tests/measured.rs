@@ -394,7 +394,7 @@ fn command_line_tabulates_fits_and_renders_measured_materials() {
     };
     assert_eq!(all["sunshadeMeasured"][0]["file"], json!(t), "{all}");
     assert_eq!(all["sunshadeMeasured"][0]["lookup"], json!("linear"));
-    // No error bound is derived for tables: --tolerance estimates their grids by refinement, and says so.
+    // No error bound is derived for tables: --tolerance refines their pixels on the reference, and says so.
     let o = sunshade(&[
         "render",
         scene.to_str().unwrap(),
@@ -414,7 +414,7 @@ fn command_line_tabulates_fits_and_renders_measured_materials() {
     ]);
     let e = String::from_utf8_lossy(&o.stderr);
     if !e.contains("interpolation has no error bound") || e.contains("interpolation's bound") {
-        assert!(o.status.success() && e.contains("the sun's grid and the lobe grids"), "{e}");
+        assert!(o.status.success() && e.contains("pixel(s) no bound covers"), "{e}");
         assert!(!e.contains("not bounded"), "{e}");
     }
     let bad = dir.path("bad.binary");

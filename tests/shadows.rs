@@ -1072,8 +1072,8 @@ fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
     assert!(kept >= 10, "{kept} kept:\n{report}");
 }
 
-/// The sky through occluders under `render --tolerance 1e-2 --tolerance-in-penumbrae` (overcast.glb, the sky alone
-/// through the teapot): with ray queries the study keeps a grid and the image meets T against the reference with
+/// The sky through occluders under `render --tolerance 1e-2 --tolerance-in-penumbrae --tolerance-by-study`
+/// (overcast.glb, the sky alone through the teapot): with ray queries the study keeps a grid and the image meets T against the reference with
 /// its shadow grid at 128² (measured 2026-12-03 on Mesa 25's lavapipe: 56², 3.1e-3, predicted 8.1e-3). On a device
 /// whose fragment shader walks the BVH the study's finer rungs pass llvmpipe's loop budget (overcast.glb fits 32²
 /// at 96 × 72 since the slab test lost its loop; 10² before), and the render must then refuse by name, not return a
@@ -1088,7 +1088,7 @@ fn gpu_ray_queries_keep_the_sky_through_occluders_under_tolerance() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
         .args(["render", "models/overcast.glb", "--width", &w.to_string(), "--height", &h.to_string()])
         .args(["--tolerance", "1e-2"])
-        .args(["--tolerance-in-penumbrae", "-v", "-o"])
+        .args(["--tolerance-in-penumbrae", "--tolerance-by-study", "-v", "-o"])
         .arg(&out)
         .env("SUNSHADE_VALIDATION", "1")
         .output()

@@ -71,12 +71,48 @@ pub struct Prediction {
 
 /// The prediction's name for f32 interpolation while its bound is not computed ([`Prediction::add_f32_bound`]).
 const F32_UNBOUNDED: &str = "f32 interpolation (bounded with --tolerance)";
+/// The prediction's names for what has no derived bound but the pixels refined on the reference cover
+/// ([`Prediction::add_refined_pixels`]): measured materials' grids, specular lobes' grids under disk lights and the
+/// sky, the visible fractions in penumbrae.
+const MEASURED_UNBOUNDED: &str = "measured BRDFs (their grids)";
+const DISK_LOBES_UNBOUNDED: &str = "the disk lights (their lobe grids)";
+const SKY_LOBE_UNBOUNDED: &str = "the sky (its lobe grid)";
+const PENUMBRAE_UNBOUNDED: &str =
+    "penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae estimates them)";
 
 impl Prediction {
     /// Adds the bound of f32 interpolation (`accuracy::interpolation`), which it no longer lists as unbounded.
     pub fn add_f32_bound(&mut self, bound: f64) {
         self.unbounded.retain(|u| u != F32_UNBOUNDED);
         self.add_term("f32 interpolation (barycentric rounding, per pixel):", bound);
+    }
+
+    /// The pixels no bound covers taken from the reference refined per pixel (`accuracy::converged::refine`,
+    /// `render::refined_pixels`): `count` of them, each claimed within `claim` (two doublings of every grid
+    /// changed it by less than a tenth of it), `unconverged` of them not, the largest last change `worst`. They
+    /// are apart from the pixels the other terms bound, so the image's bound is the larger of the two (not their
+    /// sum); what they cover is no longer listed as unbounded.
+    pub fn add_refined_pixels(&mut self, count: usize, claim: f64, (unconverged, worst): (usize, f64)) {
+        let covered = [MEASURED_UNBOUNDED, DISK_LOBES_UNBOUNDED, SKY_LOBE_UNBOUNDED, PENUMBRAE_UNBOUNDED];
+        self.unbounded.retain(|u| !covered.contains(&u.as_str()));
+        if count == 0 {
+            self.terms.push(("no pixel without a bound (every light of every pixel settled):".into(), 0.0));
+            return;
+        }
+        self.terms.push((
+            format!(
+                "the {count} pixel(s) no bound covers (penumbrae, lobes without a bound), from the reference \
+                 refined per pixel until two doublings of every grid moved each by less than a third of the claim, \
+                 apart from the rest:"
+            ),
+            claim,
+        ));
+        self.max_relative = self.max_relative.max(claim);
+        if unconverged > 0 {
+            self.unbounded.push(format!(
+                "{unconverged} refined pixel(s) that did not converge (the largest last change {worst:.1e})"
+            ));
+        }
     }
 
     /// Adds a term to the bound and its terms: a derived bound, or a measured value (`what` says which).
@@ -298,14 +334,14 @@ pub fn predict_with_peak(
         }
     }
     if has_measured(scene) && lobes.is_none() {
-        p.unbounded.push("measured BRDFs (their grids)".into());
+        p.unbounded.push(MEASURED_UNBOUNDED.into());
     }
     let lambertian = only_lambertian(scene);
     if !lights.disks.is_empty() {
         match (lambertian, shading.disk, lobes) {
             (true, DiskModel::Exact, _) => p.terms.push(("disk lights, exact, on Lambertian surfaces:".into(), 0.0)),
             (true, DiskModel::SmallSource, _) => p.unbounded.push("the disk lights' small-source estimate".into()),
-            (false, DiskModel::Exact, None) => p.unbounded.push("the disk lights (their lobe grids)".into()),
+            (false, DiskModel::Exact, None) => p.unbounded.push(DISK_LOBES_UNBOUNDED.into()),
             (false, DiskModel::Exact, Some(_)) => {}
             (false, DiskModel::SmallSource, _) => {
                 p.unbounded.push("the disk lights (their lobe grids and the small-source estimate)".into())
@@ -315,7 +351,7 @@ pub fn predict_with_peak(
     if lights.sky.is_some() {
         match (lambertian, lobes) {
             (true, _) => p.terms.push(("the sky on Lambertian surfaces:".into(), 0.0)),
-            (false, None) => p.unbounded.push("the sky (its lobe grid)".into()),
+            (false, None) => p.unbounded.push(SKY_LOBE_UNBOUNDED.into()),
             (false, Some(_)) => {}
         }
     }
@@ -389,11 +425,7 @@ fn occlusion_and_arithmetic(
                 p.unbounded.push("the shadow maps".into())
             }
             _ if estimate.is_some_and(|e| e.shadow_grid) => {}
-            _ => p.unbounded.push(
-                "penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae \
-                 estimates them)"
-                    .into(),
-            ),
+            _ => p.unbounded.push(PENUMBRAE_UNBOUNDED.into()),
         }
     }
     if let Renderer::Gpu { barycentrics } = renderer {
@@ -569,7 +601,50 @@ pub(crate) fn choose_sun_within(
              do; docs/accuracy.md, \"Error bounds\")"
         ));
     }
-    let mut shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
+    let shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
+    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), tolerance, delta_peak)
+}
+
+/// `--tolerance` where the pixels no bound covers are refined on the reference (`render::refined_pixels`): the
+/// disk lights' exact model, and the sun's models of the analytic lobes as [`choose_sun_within`] chooses them; a
+/// measured material's pixels and the light of the sky through occluders are the refined pixels' part.
+pub(crate) fn choose_sun_for_bounded_pixels(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    tolerance: f64,
+) -> Result<Choice, String> {
+    let shading = techniques_within(settings, renderer, can_occlude, true, tolerance)?;
+    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), tolerance, None)
+}
+
+/// Whether the pixels of material `material` have no derived bound under the lights of `settings`, so that
+/// `--tolerance` refines them on the reference (`render::refined_pixels`): a measured material under any light (its
+/// table's grids), an analytic one whose sharpest lobe is not Lambertian under disk lights or the sky (its lobe
+/// grids). An irradiance image has no material in it.
+pub fn material_unbounded(scene: &Scene, settings: &RenderSettings, material: usize) -> bool {
+    let Some(m) = scene.materials.get(material) else { return false };
+    let lights = &settings.lights;
+    if settings.shading.quantity == Quantity::Irradiance || lights.is_empty() {
+        return false;
+    }
+    if m.brdf.is_measured() {
+        return true;
+    }
+    let lobed = !super::bounds::sharpest_brdf(m, scene).is_lambert();
+    lobed && (!lights.disks.is_empty() || lights.sky.is_some())
+}
+
+/// [`choose_sun_within`] from the techniques `shading` allows: each analytic lobe's sun model.
+fn choose_sun_of_lobes(
+    scene: &Scene,
+    settings: &RenderSettings,
+    mut shading: ShadingOptions,
+    (renderer, can_occlude): (Renderer, bool),
+    tolerance: f64,
+    delta_peak: Option<f64>,
+) -> Result<Choice, String> {
     let lights = &settings.lights;
     let arithmetic = renderer.arithmetic();
     let Some(sun) = &lights.sun else { return Ok(Choice::uniform(shading)) };

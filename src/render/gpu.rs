@@ -3,6 +3,7 @@
 
 use super::flags::SceneArgs;
 use super::plan;
+use super::refined_pixels;
 use super::tolerance::{beyond_this_device, slices_measured_against_the_reference, studied_on_the_reference};
 use super::RenderError;
 use crate::accuracy::predicted::{self, Prediction};
@@ -31,6 +32,11 @@ pub struct Rendered {
     /// The GPU's own image, where `--tolerance` took some of `image`'s pixels from `reference`
     /// (`accuracy::from_reference`): a check compares the device's pixels, not the reference's.
     pub device_image: Option<Image>,
+    /// The pixels `--tolerance` refined on the reference, no bound covering them (`refined_pixels`), one flag a
+    /// pixel: a check takes them as they are (they are the reference's).
+    pub refined: Option<Vec<bool>>,
+    /// The reference's time on those pixels.
+    pub reference_time: std::time::Duration,
 }
 
 /// Renders `scene` (uploaded to `renderer` as `gpu_scene`) with the flags `a`, the rule `visibility` (else the
@@ -45,8 +51,7 @@ pub fn on_gpu(
     reference: &ReferenceOptions,
 ) -> Result<Rendered, RenderError> {
     let r = renderer;
-    let plan = plan::for_gpu(r, gpu_scene, scene, a, visibility, settings)?;
-    let mut settings = plan.settings;
+    let plan = plan::for_gpu(r, gpu_scene, scene, a, visibility, settings.clone())?;
     let predicted_for = predicted::Renderer::Gpu { barycentrics: predicted_barycentrics(r.interpolation()) };
     let request = predicted::Request {
         scene,
@@ -55,6 +60,26 @@ pub fn on_gpu(
         scene_can_occlude: gpu_scene.can_occlude(),
     };
     let tolerance = a.tolerance();
+    // What has no derived bound refined pixel by pixel on the reference (`refined_pixels`), unless the study is asked.
+    if let Some(t) = tolerance.filter(|&t| !a.tolerance_by_study && refined_pixels::wanted(request, &plan.settings, t))
+    {
+        // The GPU's frame casts the grid (its first draw settles the pixels it can; the slices have none).
+        let plan = plan::for_gpu(r, gpu_scene, scene, a, Some(VisibilityRule::Grid), settings)?;
+        let mut settings = plan.settings;
+        let done = refined_pixels::render(r, (scene, gpu_scene), &mut settings, request, t, reference)?;
+        return Ok(Rendered {
+            image: done.image,
+            settings,
+            shadow_reason: plan.shadow_reason,
+            prediction: done.prediction,
+            frame: done.frame,
+            reference: None,
+            device_image: None,
+            refined: Some(done.refined),
+            reference_time: done.reference_time,
+        });
+    }
+    let mut settings = plan.settings;
     // Where the GPU slices the lights in their penumbrae (the sky through occluders, whose penumbra is the image, or
     // every light where the tolerance holds in penumbrae, its default), the grids are studied on the reference, whose
     // promise then holds in penumbrae too (`studied_on_the_reference`).
@@ -126,6 +151,8 @@ pub fn on_gpu(
         frame: spent,
         reference: reference_image,
         device_image,
+        refined: None,
+        reference_time: std::time::Duration::ZERO,
     })
 }
 

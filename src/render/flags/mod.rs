@@ -291,35 +291,23 @@ pub struct SceneArgs {
 
     /// The largest relative error the image may have against the truth; the cheapest models that keep it are chosen.
     ///
-    /// For each material, the cheapest sun model (delta, or the disk with the fewest samples) whose derived
-    /// error bound for its lobe, with the GPU's f32 arithmetic, is at most REL (relative, with the diff's floor of
-    /// 1% of the peak); `-v` prints the models and the predicted error (docs/accuracy.md, "Error bounds"). The sun is bounded for every
-    /// analytic BRDF (the delta sun tried first where its own image's peak decides its horizon term); disk lights
-    /// (exact) and the sky on Lambertian surfaces by their closed forms. Specular surfaces under disk lights or a
-    /// sky: the image is rendered on a ladder of lobe grids (4² up to 162², overriding --samples) until the
-    /// finest one's error, estimated by refinement (Roache's grid convergence index), fits what the sun's bound
-    /// leaves (with several specular materials, a ladder per material: each keeps the coarsest rung that fits its
-    /// own pixels); measured materials likewise, with the sun's grid on the ladder too; every rung's time counts in the
-    /// render's. f32 interpolation: its bound (per pixel, from the triangles' shape) is computed by the reference
-    /// and kept within REL beside the models'. Refused: light of the sky through occluders (its penumbra is every
-    /// point that sees an occluder above its horizon), the device's interpolation, and `--shadows map` (`auto`
-    /// casts shadow rays, on a device without ray queries by the shader's walk of the scene's BVH; `--shadows
-    /// none` measures against the unshadowed truth). Where the scene shadows itself the promise holds in the
-    /// penumbrae too (the shadow rays' grids join the study: --tolerance-in-penumbrae's text);
-    /// `--tolerance-outside-penumbrae` keeps it outside the penumbrae of the sun and of disk lights (cheaper).
+    /// REL is relative, with the diff's floor of 1% of the peak; `-v` prints the models and the predicted error
+    /// (docs/accuracy.md, "Error bounds"). Pixels with a derived bound are rendered on the GPU: for each material
+    /// the cheapest sun model whose bound for its lobe (with the GPU's f32 arithmetic) meets REL; disk lights and
+    /// the sky on Lambertian surfaces in closed form; every light wholly visible or wholly hidden (the frame's first
+    /// draw proves it). The other pixels (penumbrae, where a light is partly hidden; specular surfaces under disk
+    /// lights or the sky; measured materials; every pixel under a sky through occluders) are refined one by one on
+    /// the CPU reference until two doublings of every grid change each by less than REL/3: their cost follows
+    /// their number, and `-v` says how many. With f32 barycentrics their bound (per pixel) is kept within REL
+    /// beside the models'. Refused: the device's interpolation, and `--shadows map` where the scene shadows itself.
+    /// `--tolerance-outside-penumbrae` holds REL outside the penumbrae of the sun and of disk lights only;
+    /// `--tolerance-by-study` estimates what has no bound over a ladder of whole renders instead.
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
     /// With --tolerance: hold it in penumbrae too (the default; the flag is kept for the scripts that name it).
-    /// The shadow rays' grids (overriding --shadow-samples) go on the
-    /// study's ladder with the sun's and the lobes' grids, and the finest image's error is estimated by
-    /// refinement, its order taken as at most 1 (the lobe samples' rays converge at first order through a
-    /// penumbra, the lights' located edges at second; 2 on the reference where every light is taken by slices
-    /// and every material the meshes use is Lambertian). Light of the sky through occluders is then estimated
-    /// instead of refused. Where `render` takes every light by slices (its default here: shadow rays, no alpha
-    /// masks), the study runs on the reference and the GPU renders once, its distance from the reference's image
-    /// measured and added to the prediction. Costly, and refused where the ladder cannot reach T: in the dark end
-    /// of a penumbra the visible fraction must be right to T/100 of the peak (the diff's floor).
+    /// The penumbrae's pixels are refined on the reference (--tolerance's text); with --tolerance-by-study the
+    /// shadow rays' grids go on the study's ladder with the sun's and the lobes' grids instead.
     #[arg(help_heading = "Quality", long, requires = "tolerance")]
     pub tolerance_in_penumbrae: bool,
 
@@ -330,6 +318,17 @@ pub struct SceneArgs {
     /// image).
     #[arg(help_heading = "Quality", long, requires = "tolerance", conflicts_with = "tolerance_in_penumbrae")]
     pub tolerance_outside_penumbrae: bool,
+
+    /// With --tolerance: estimate what has no derived bound by a study over a ladder of whole renders instead of
+    /// refining those pixels alone on the reference. Specular surfaces under disk lights or a sky are rendered on
+    /// a ladder of lobe grids (4² up to 162², overriding --samples; a ladder per material) until the finest one's
+    /// error, estimated by refinement (Roache's grid convergence index), fits what the sun's bound leaves;
+    /// measured materials likewise, the sun's grid on the ladder too; in penumbrae the shadow rays' grids join
+    /// the ladder (its order taken as at most 1), and where every light can be sliced the study runs on the
+    /// reference and the GPU's one image is measured against the reference's. Every rung renders the whole
+    /// image: costly, and refused where the ladder cannot reach REL.
+    #[arg(help_heading = "Quality", long, requires = "tolerance")]
+    pub tolerance_by_study: bool,
 
     /// Shadows: `auto` (shadow rays; none where nothing can occlude a light), `none`, `ray`, or `map`.
     ///
