@@ -100,8 +100,8 @@ pub struct BenchArgs {
     #[arg(long, value_name = "PNG", requires = "pareto")]
     pub plot: Option<PathBuf>,
     /// With --pareto: its `--tolerance` table holds each T in the penumbrae too, as `render --tolerance T` does by
-    /// default (the shadow rays' grids join the study; costly), instead of outside them, as `render --tolerance T
-    /// --tolerance-outside-penumbrae` does (the sweep's default: its two minutes a scene).
+    /// default (the penumbrae's pixels refined on the reference: seconds where they are many), instead of outside
+    /// them, as `render --tolerance T --tolerance-outside-penumbrae` does (the sweep's default).
     #[arg(long, requires = "pareto")]
     pub tolerance_in_penumbrae: bool,
     /// With --pareto: the accuracy the converged reference claims (relative).

@@ -1,9 +1,10 @@
 //! `bench --pareto`'s `--tolerance` table: for each scene and T = 1e-2, 1e-3, 1e-4, the models `render --tolerance T
 //! --tolerance-outside-penumbrae` chose (with `bench --tolerance-in-penumbrae`: `render --tolerance T`, which holds T
-//! in the penumbrae too; costlier, so not the sweep's default, whose two minutes a scene it would break), what its
-//! renders cost on the GPU (the sum of each render's median warm frame: a delta trial, a grid study's rungs, the image
-//! kept), and the kept image's error against a converged reference, over every pixel and outside the penumbrae (what
-//! `--tolerance-outside-penumbrae` promises); or why it refused.
+//! in the penumbrae too, refining their pixels on the reference, `render::refined_pixels`), what its renders cost on
+//! the GPU (the sum of each render's median warm frame: a delta trial, a grid study's rungs, the image kept; one
+//! frame where pixels were refined) and on the reference (the refined pixels), and the kept image's error against a
+//! converged reference, over every pixel and outside the penumbrae (what `--tolerance-outside-penumbrae` promises);
+//! or why it refused.
 //!
 //! On a device without ray queries, a scene that shadows itself gets its table at a smaller size ([`table_size`])
 //! against its own converged reference: its shadow rays walk the BVH in the fragment shader there, seconds a frame
@@ -19,10 +20,10 @@ use crate::accuracy::error::image_error;
 use crate::accuracy::penumbrae::outside_penumbrae_excluded;
 use crate::accuracy::predicted::Renderer as Predicted;
 use crate::accuracy::predicted::Request;
-use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError};
+use crate::accuracy::trial::{render_within_tolerance, Tolerance, TrialError, WithinTolerance};
 use crate::cpu::ReferenceOptions;
 use crate::gpu::{GpuError, GpuScene, Renderer};
-use crate::render::beyond_this_device;
+use crate::render::{beyond_this_device, refined_pixels, RenderError};
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 use crate::shading::Shadows;
@@ -48,6 +49,8 @@ struct ToleranceRow {
 struct Kept {
     models: String,
     gpu_ms: f64,
+    /// The reference's time on the pixels without a bound (`render::refined_pixels`), 0 where none were refined.
+    reference_ms: f64,
     renders: u32,
     max_rel: f64,
     max_rel_outside_penumbrae: f64,
@@ -101,22 +104,36 @@ pub(super) fn tolerance_rows(
         let mut s = settings.clone();
         // The GPU's grids, whatever rule the truth took (`render`'s slices are not in this table yet).
         s.shading.visibility_rule = crate::shading::VisibilityRule::Grid;
-        let (mut spent, mut renders) = (Duration::ZERO, 0u32);
+        let (mut spent, mut renders, mut reference_time) = (Duration::ZERO, 0u32, Duration::ZERO);
         let request =
             Request { scene, renderer: predicted, asked: settings.shading.shadows, scene_can_occlude: can_occlude };
-        let done = render_within_tolerance(
-            request,
-            &mut s,
-            Some(if in_penumbrae { Tolerance::everywhere(tolerance) } else { Tolerance::outside_penumbrae(tolerance) }),
-            reference,
-            |s| {
-                let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;
-                spent += median(times);
-                renders += 1;
-                Ok::<_, GpuError>(image)
-            },
-            |image| image,
-        );
+        let promise =
+            if in_penumbrae { Tolerance::everywhere(tolerance) } else { Tolerance::outside_penumbrae(tolerance) };
+        let done = if refined_pixels::wanted(request, &s, promise) {
+            // As `render --tolerance` does: one frame, the pixels without a bound refined on the reference.
+            match refined_pixels::render(renderer, (scene, uploaded), &mut s, request, promise, reference) {
+                Ok(r) => {
+                    (spent, renders, reference_time) = (r.frame.render, 1, r.reference_time);
+                    Ok(WithinTolerance { kept: r.image, prediction: r.prediction })
+                }
+                Err(RenderError::Usage(why)) => Err(TrialError::Tolerance(why)),
+                Err(e) => return Err(e.into()),
+            }
+        } else {
+            render_within_tolerance(
+                request,
+                &mut s,
+                Some(promise),
+                reference,
+                |s| {
+                    let (image, times) = warm_frames(renderer, uploaded, s, repeat)?;
+                    spent += median(times);
+                    renders += 1;
+                    Ok::<_, GpuError>(image)
+                },
+                |image| image,
+            )
+        };
         let outcome = match done {
             Ok(done) => {
                 let error = |excluded: &[bool]| {
@@ -134,6 +151,7 @@ pub(super) fn tolerance_rows(
                 Ok(Kept {
                     models: models.join("; "),
                     gpu_ms: ms(spent),
+                    reference_ms: ms(reference_time),
                     renders,
                     max_rel: error(&excluded)?,
                     max_rel_outside_penumbrae: error(outside)?,
@@ -183,27 +201,31 @@ pub(super) fn tolerance_table(
         None => String::new(),
     };
     let mut out = format!(
-        "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made; max \
-         rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae (where a light \
-         is partly hidden{penumbrae}): what `--tolerance-outside-penumbrae` promises; † where the \
+        "`{flags}` on {name} ({truth}; GPU time: the sum of the median warm frames of every render it made, or \
+         its one frame where the pixels without a bound were refined on the reference, whose time is the next \
+         column; max rel over every pixel the truth converged on, penumbrae included, and outside the penumbrae \
+         (where a light is partly hidden{penumbrae}): what `--tolerance-outside-penumbrae` promises; † where the \
          prediction names part of the image as not bounded, the penumbrae):\n\n| T | models chosen | renders | GPU \
-         time [ms] | max rel | max rel outside penumbrae | predicted |\n\
-         |---:|---|---:|---:|---:|---:|---:|\n"
+         time [ms] | reference [ms] | max rel | max rel outside penumbrae | predicted |\n\
+         |---:|---|---:|---:|---:|---:|---:|---:|\n"
     );
     for r in &table.rows {
         out += &match &r.outcome {
             Ok(k) => format!(
-                "| {:.0e} | {} | {} | {:.2} | {:.2e} | {:.2e} | {:.1e}{} |\n",
+                "| {:.0e} | {} | {} | {:.2} | {:.2} | {:.2e} | {:.2e} | {:.1e}{} |\n",
                 r.tolerance,
                 k.models,
                 k.renders,
                 k.gpu_ms,
+                k.reference_ms,
                 k.max_rel,
                 k.max_rel_outside_penumbrae,
                 k.predicted.0,
                 if k.predicted.1 { "†" } else { "" }
             ),
-            Err(why) => format!("| {:.0e} | refused: {} | 0 | — | — | — | — |\n", r.tolerance, why.replace('|', "/")),
+            Err(why) => {
+                format!("| {:.0e} | refused: {} | 0 | — | — | — | — | — |\n", r.tolerance, why.replace('|', "/"))
+            }
         };
     }
     out + "\n"

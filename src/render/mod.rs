@@ -12,7 +12,7 @@ pub mod flags;
 mod gpu;
 pub mod plan;
 mod reference;
-mod refined_pixels;
+pub mod refined_pixels;
 pub mod request;
 mod tolerance;
 pub mod warnings;
