@@ -301,7 +301,8 @@ pub struct SceneArgs {
     /// their number, and `-v` says how many. With f32 barycentrics their bound (per pixel) is kept within REL
     /// beside the models'. Refused: the device's interpolation, and `--shadows map` where the scene shadows itself.
     /// `--tolerance-outside-penumbrae` holds REL outside the penumbrae of the sun and of disk lights only;
-    /// `--tolerance-by-study` estimates what has no bound over a ladder of whole renders instead.
+    /// `--tolerance-by-study` estimates what has no bound over a ladder of whole renders instead, as `reference
+    /// --tolerance` always does.
     #[arg(help_heading = "Quality", long, value_name = "REL", value_parser = parse_positive, conflicts_with_all = ["sun_model", "sun_samples"])]
     pub tolerance: Option<f64>,
 
