@@ -1,5 +1,6 @@
 //! A request rendered on the GPU: its plan, then the frame, or with `--tolerance` the models chosen by their bounds
-//! and, where none is derived, by a study or a measurement against the reference (`tolerance`).
+//! and, where none is derived, the pixels refined on the reference (`refined_pixels`), or with
+//! `--tolerance-by-study` a study or a measurement against the reference (`tolerance`).
 
 use super::flags::SceneArgs;
 use super::plan;

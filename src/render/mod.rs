@@ -4,7 +4,8 @@
 //! ```text
 //! flags (flags::SceneArgs, request::RequestArgs) ──► request::load, request::resolve_settings ──► Scene, settings
 //!   ──► plan (shadow technique, visibility rule: for_gpu / for_reference) ──► on_gpu / on_reference
-//!   ──► Rendered (image, final settings, prediction; tolerance's measurements against the reference)
+//!   ──► Rendered (image, final settings, prediction; --tolerance's pixels refined on the reference, or with
+//!       --tolerance-by-study its measurements against the reference)
 //! ```
 
 mod error;

@@ -1,5 +1,6 @@
-//! `--tolerance` where no bound is derived for the GPU's part: the grids studied on the reference, the GPU's
+//! `--tolerance-by-study` where no bound is derived for the GPU's part: the grids studied on the reference, the GPU's
 //! distance from the reference's f64 image measured and added to the prediction, the pixels too far taken from it.
+//! (Without the flag those pixels are refined on the reference one by one: `refined_pixels`.)
 
 use super::RenderError;
 use crate::accuracy::predicted::Prediction;
