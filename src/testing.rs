@@ -120,6 +120,32 @@ pub fn check_against_reference(
     }
 }
 
+/// [`check_against_reference`] for what the render layer rendered ([`CheckedRenderer::rendered_job`]): the
+/// reference at the settings the image was rendered with (`--tolerance`'s choice), and the pixels `--tolerance`
+/// refined on the reference ([`Rendered::refined`]) taken as they are, as `render --check` does.
+pub fn check_rendered_against_reference(
+    job: &Job,
+    rendered: &Rendered,
+    options: &ReferenceOptions,
+    diff: &DiffOptions,
+) -> Result<DiffReport, TestingError> {
+    let (scene, _) = job.prepare()?;
+    let (mut reference, apart) = cpu::checked::checked_reference(&scene, &rendered.settings, options);
+    if let Some(refined) = &rendered.refined {
+        let pixels = reference.pixels_mut().iter_mut().zip(rendered.image.pixels()).zip(refined);
+        for ((r, p), _) in pixels.filter(|(_, &f)| f) {
+            *r = *p;
+        }
+    }
+    let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
+    let (report, _) = compare::diff_apart(&rendered.image, &reference, diff, apart).map_err(TestingError::Compare)?;
+    if report.pass {
+        Ok(report)
+    } else {
+        Err(TestingError::Compare(report.text("gpu", "cpu reference")))
+    }
+}
+
 /// A GPU renderer with the validation layer on. Any validation message fails: after each render, and when the
 /// renderer is dropped (messages about objects left alive arrive then).
 pub struct CheckedRenderer {

@@ -126,6 +126,23 @@ fn render_tolerance_check_takes_the_refined_pixels_as_they_are() {
     assert!(o.status.success() && out.exists(), "{e}{}", String::from_utf8_lossy(&o.stdout));
 }
 
+/// The library's check of a `--tolerance` render (`testing::check_rendered_against_reference`) takes the refined
+/// pixels as they are, as the command line's does: it passes on sunset.glb at 1e-3 with the diff's default
+/// tolerance, where the reference at the render's grid is far from the refined penumbrae.
+#[test]
+fn the_library_checks_a_tolerance_render_as_the_command_line_does() {
+    use sunshade::compare::DiffOptions;
+    let mut gpu = CheckedRenderer::new();
+    let reference = gpu.reference_options();
+    let path = format!("{}/models/sunset.glb", env!("CARGO_MANIFEST_DIR"));
+    let j = job(&path, &["--width", "48", "--height", "36", "--tolerance", "1e-3"]).unwrap();
+    let rendered = gpu.rendered_job(&j).unwrap();
+    assert!(rendered.refined.as_ref().is_some_and(|r| r.contains(&true)), "{}", rendered.prediction.line());
+    let report =
+        sunshade::testing::check_rendered_against_reference(&j, &rendered, &reference, &DiffOptions::default());
+    assert!(report.is_ok(), "{}", report.err().map(|e| e.to_string()).unwrap_or_default());
+}
+
 /// `--tolerance-by-study` keeps the study over a ladder of whole renders: `-v` names its estimate, not refined
 /// pixels, and no pixel is taken from a per-pixel refinement.
 #[test]
