@@ -266,7 +266,10 @@ mod tests {
         };
         let text = tolerance_table("overcast.glb", &table, true, None);
         let line = text.lines().find(|l| l.starts_with("| 1e-3 |")).expect("the refused row");
-        assert!(line.contains("refused: a / b a render it needs") && line.ends_with("| 0 | — | — | — | — |"), "{line}");
+        assert!(
+            line.contains("refused: a / b a render it needs") && line.ends_with("| 0 | — | — | — | — | — |"),
+            "{line}"
+        );
     }
 
     #[test]
