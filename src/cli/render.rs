@@ -286,22 +286,23 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             (Some(d), n) => eprintln!("sunshade: pipeline cache: {n} bytes from {}", d.display()),
         }
         let setup = renderer.setup_timings();
-        print_phases(
-            &[
-                ("load", job.load),
-                ("instance", setup.instance),
-                ("shader compile", setup.shader_compile), // on other threads, during "instance"
-                ("upload", job.upload),
-                ("shadow setup", job.render.frame.shadow_setup),
-                ("pipelines", job.render.frame.pipelines),
-                ("cache save", cache_save),
-                ("render", job.render.frame.render),
-                ("readback", job.render.frame.readback),
-                ("reference pixels", job.render.reference_time), // --tolerance's pixels without a bound
-                ("encode", encode_time),
-            ],
-            started.elapsed(),
-        );
+        let mut phases = vec![
+            ("load", job.load),
+            ("instance", setup.instance),
+            ("shader compile", setup.shader_compile), // on other threads, during "instance"
+            ("upload", job.upload),
+            ("shadow setup", job.render.frame.shadow_setup),
+            ("pipelines", job.render.frame.pipelines),
+            ("cache save", cache_save),
+            ("render", job.render.frame.render),
+            ("readback", job.render.frame.readback),
+        ];
+        if job.render.refined.is_some() {
+            // `--tolerance`'s pixels without a bound, refined on the reference.
+            phases.push(("reference pixels", job.render.reference_time));
+        }
+        phases.push(("encode", encode_time));
+        print_phases(&phases, started.elapsed());
     }
     if a.check {
         check_job(&mut session, a, &job, a.verbose)?;
