@@ -111,8 +111,18 @@ pub fn check_against_reference(
 ) -> Result<DiffReport, TestingError> {
     let (scene, settings) = job.prepare()?;
     let (reference, apart) = cpu::checked::checked_reference(&scene, &settings, options);
-    let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
-    let (report, _) = compare::diff_apart(image, &reference, diff, apart).map_err(TestingError::Compare)?;
+    compare_with_reference(image, &reference, apart.as_ref(), diff)
+}
+
+/// `image` against `reference`, the pixels of `apart` counted apart; `Err` holds the report of a failed comparison.
+fn compare_with_reference(
+    image: &Image,
+    reference: &Image,
+    apart: Option<&cpu::checked::ApartClass>,
+    diff: &DiffOptions,
+) -> Result<DiffReport, TestingError> {
+    let apart = apart.map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
+    let (report, _) = compare::diff_apart(image, reference, diff, apart).map_err(TestingError::Compare)?;
     if report.pass {
         Ok(report)
     } else {
@@ -130,20 +140,8 @@ pub fn check_rendered_against_reference(
     diff: &DiffOptions,
 ) -> Result<DiffReport, TestingError> {
     let (scene, _) = job.prepare()?;
-    let (mut reference, apart) = cpu::checked::checked_reference(&scene, &rendered.settings, options);
-    if let Some(refined) = &rendered.refined {
-        let pixels = reference.pixels_mut().iter_mut().zip(rendered.image.pixels()).zip(refined);
-        for ((r, p), _) in pixels.filter(|(_, &f)| f) {
-            *r = *p;
-        }
-    }
-    let apart = apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction));
-    let (report, _) = compare::diff_apart(&rendered.image, &reference, diff, apart).map_err(TestingError::Compare)?;
-    if report.pass {
-        Ok(report)
-    } else {
-        Err(TestingError::Compare(report.text("gpu", "cpu reference")))
-    }
+    let (reference, apart) = cpu::checked::checked_reference(&scene, &rendered.settings, options);
+    compare_with_reference(&rendered.image, &rendered.with_refined_pixels(reference), apart.as_ref(), diff)
 }
 
 /// A GPU renderer with the validation layer on. Any validation message fails: after each render, and when the

@@ -78,7 +78,7 @@ const MEASURED_UNBOUNDED: &str = "measured BRDFs (their grids)";
 const DISK_LOBES_UNBOUNDED: &str = "the disk lights (their lobe grids)";
 const SKY_LOBE_UNBOUNDED: &str = "the sky (its lobe grid)";
 const PENUMBRAE_UNBOUNDED: &str =
-    "penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae estimates them)";
+    "penumbrae (the shadow rays' visible fractions: --tolerance without --tolerance-outside-penumbrae refines them)";
 
 impl Prediction {
     /// Adds the bound of f32 interpolation (`accuracy::interpolation`), which it no longer lists as unbounded.
@@ -89,7 +89,7 @@ impl Prediction {
 
     /// The pixels no bound covers taken from the reference refined per pixel (`accuracy::converged::refine`,
     /// `render::refined_pixels`): `count` of them, each claimed within `claim` (two doublings of every grid
-    /// changed it by less than a tenth of it), `unconverged` of them not, the largest last change `worst`. They
+    /// changed it by less than a third of it), `unconverged` of them not, the largest last change `worst`. They
     /// are apart from the pixels the other terms bound, so the image's bound is the larger of the two (not their
     /// sum); what they cover is no longer listed as unbounded.
     pub fn add_refined_pixels(&mut self, count: usize, claim: f64, (unconverged, worst): (usize, f64)) {

@@ -143,19 +143,11 @@ pub fn checked_reference_of(
     let scene = session.scene_ref(job.scene);
     let plain = !cpu::checked::may_be_fragile(scene, &job.render.settings)
         && job.render.settings.shading.shadows != Shadows::Map;
-    let (mut reference, apart) = match &job.render.reference {
+    let (reference, apart) = match &job.render.reference {
         Some(image) if plain => (image.clone(), None),
         _ => cpu::checked::checked_reference(scene, &job.render.settings, &options),
     };
-    // The pixels `--tolerance` refined are the reference's own, at finer grids than `settings` name: compared as
-    // they are.
-    if let Some(refined) = &job.render.refined {
-        let (to, from) = (reference.pixels_mut(), job.render.image.pixels());
-        for ((r, p), _) in to.iter_mut().zip(from).zip(refined).filter(|(_, &f)| f) {
-            *r = *p;
-        }
-    }
-    (reference, apart)
+    (job.render.with_refined_pixels(reference), apart)
 }
 
 /// `--check`: the CPU reference with the device's sub-pixel bits ([`checked_reference_of`]), compared;

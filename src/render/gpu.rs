@@ -40,6 +40,21 @@ pub struct Rendered {
     pub reference_time: std::time::Duration,
 }
 
+impl Rendered {
+    /// `reference` (the reference at [`Self::settings`], for a check) with the pixels `--tolerance` refined on the
+    /// reference ([`Self::refined`]) taken from the image as they are: they are the reference's own, at finer grids
+    /// than `settings` name.
+    pub fn with_refined_pixels(&self, mut reference: Image) -> Image {
+        if let Some(refined) = &self.refined {
+            let pixels = reference.pixels_mut().iter_mut().zip(self.image.pixels()).zip(refined);
+            for ((r, p), _) in pixels.filter(|(_, &f)| f) {
+                *r = *p;
+            }
+        }
+        reference
+    }
+}
+
 /// Renders `scene` (uploaded to `renderer` as `gpu_scene`) with the flags `a`, the rule `visibility` (else the
 /// plan's default) and the resolved `settings`; `reference` mirrors the device (for the bound of f32 interpolation
 /// and what `--tolerance` measures against the reference).

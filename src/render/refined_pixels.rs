@@ -20,7 +20,8 @@
 //! still moving until two doublings in a row change each by less than a third of the tolerance
 //! (`accuracy::converged::refine` with `Criterion::TOLERANCE`: the converged reference's refinement, with Roache's
 //! factor of safety for two grids in place of the truth's tenth and without its final check; an estimate, not a
-//! bound, measured against the converged reference on every model by `tests/accuracy.rs`). The grids start from
+//! bound, measured against the converged reference by `tests/tolerance_refined.rs` and on every model in
+//! docs/accuracy.md). The grids start from
 //! the render's (6² shadow samples, `4·6²` rows of slices: the truth's start too). The cost follows the pixels that
 //! need it: a penumbra's band, a specular sphere.
 //!
@@ -72,9 +73,19 @@ pub fn wanted(request: Request, settings: &RenderSettings, tolerance: Tolerance)
         && request.can_occlude()
         && settings.shading.shadows == Shadows::Ray
         && !settings.lights.is_empty();
-    let scene = request.scene;
-    let materials = scene.meshes.iter().any(|m| material_unbounded(scene, settings, m.material));
-    penumbrae || materials
+    penumbrae || any_mesh_of(request.scene, &unbounded_materials(request.scene, settings))
+}
+
+/// For each material of `scene`, whether its pixels have no derived bound under `settings`' lights
+/// (`predicted::material_unbounded`), each asked once: a mapped material's sharpest lobe reads its whole roughness
+/// texture.
+fn unbounded_materials(scene: &Scene, settings: &RenderSettings) -> Vec<bool> {
+    (0..scene.materials.len()).map(|m| material_unbounded(scene, settings, m)).collect()
+}
+
+/// Whether some mesh of `scene` uses a material flagged in `flags`.
+fn any_mesh_of(scene: &Scene, flags: &[bool]) -> bool {
+    scene.meshes.iter().any(|m| flags.get(m.material) == Some(&true))
 }
 
 /// Renders `scene` within `tolerance` (see the module's text): `settings` updated to the GPU's models (the grid
@@ -131,10 +142,11 @@ pub fn render(
             (Image::new(settings.width, settings.height), FrameTimings::default(), vec![true; n])
         }
     };
-    if scene.meshes.iter().any(|m| material_unbounded(scene, settings, m.material)) {
+    let unbounded = unbounded_materials(scene, settings);
+    if any_mesh_of(scene, &unbounded) {
         let materials = cpu::material_map(scene, settings, reference);
         for (flag, m) in selected.iter_mut().zip(materials) {
-            *flag |= m.is_some_and(|m| material_unbounded(scene, settings, m));
+            *flag |= m.is_some_and(|m| unbounded.get(m) == Some(&true));
         }
     }
     if selected.contains(&true) {
