@@ -49,9 +49,8 @@ use crate::settings::RenderSettings;
 use crate::shading::{Shadows, VisibilityRule};
 
 /// Doublings of a refined pixel's grids at most: past the converged reference's six, since only the pixels still
-/// moving pay for them (a specular lobe's samples through an occluder's edge under the sky, which converge at the
-/// first order or slower: 11 of 738 refined pixels of the BRDF chart at 40 × 30 under a disk light and the sky were
-/// still moving by 1.5e-3 after six doublings at T = 1e-3).
+/// moving pay for them (a specular lobe's samples through an occluder's edge under the sky converge at the first
+/// order or slower, and six left some of the BRDF chart's pixels moving at T = 1e-3).
 const MAX_PIXEL_REFINEMENTS: u32 = 10;
 
 /// A render whose unbounded pixels were refined on the reference.
