@@ -9,6 +9,7 @@
 #define BRDF_BLINN_PHONG 2u
 #define BRDF_WARD 3u
 #define BRDF_MEASURED 4u
+#define BRDF_GLTF 5u
 
 // Which lights a frame has, and their models (the VARIANT_* constants below); values match gpu::layout.
 #define LIGHT_ABSENT 0u
@@ -136,10 +137,11 @@ struct MaterialGpu {
     vec4 kd;     // rgb: diffuse reflectance kd (the albedo for Lambert; pi floor for a measured table); w unused
     vec4 ks;     // rgb: specular reflectance ks (1 for a measured table); w: Phong / Blinn-Phong exponent, or a
                  // measured table's lobe width [rad]
-    vec4 params; // x, y: Ward alpha_x, alpha_y; measured: rgb the table's floor [1/sr], w 1 for the nearest lookup
+    vec4 params; // x, y: Ward alpha_x, alpha_y; measured: rgb the table's floor [1/sr], w 1 for the nearest lookup;
+                 // glTF: x alpha, y metallic
     uvec4 kind;  // x: BRDF kind (the pipeline variant's VARIANT_BRDF); y: 1 if double-sided; z: 1 if alpha MASK;
                  // w: a measured table's first sample in measured_values[]
-    vec4 base;   // base colour factor (rgb linear, alpha)
+    vec4 base;   // base colour factor (rgb linear, alpha); glTF's lobe reads the pixel's (surface.glsl)
     vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
     vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
     TextureRefGpu tex[4]; // TEX_BASE, TEX_METALLIC_ROUGHNESS, TEX_NORMAL, TEX_EMISSIVE

@@ -10,6 +10,7 @@
 #include "brdf/phong.glsl"
 #include "brdf/blinn_phong.glsl"
 #include "brdf/ward.glsl"
+#include "brdf/metallic_roughness.glsl"
 #include "measured.glsl"
 #include "visibility.glsl"
 
@@ -53,6 +54,10 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
         vec3 rgb = measured_residual(m, p.normal, l, p.to_viewer);
         return (rgb.r + rgb.g + rgb.b) / 3.0;
     }
+    case BRDF_GLTF: {
+        vec3 rgb = gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x);
+        return (rgb.r + rgb.g + rgb.b) / 3.0;
+    }
     }
     return 0.0;
 }
@@ -63,6 +68,8 @@ vec3 specular_lobe_rgb(MaterialGpu m, Frame p, vec3 l) {
     switch (VARIANT_BRDF) {
     case BRDF_MEASURED:
         return measured_residual(m, p.normal, l, p.to_viewer);
+    case BRDF_GLTF:
+        return gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x);
     case BRDF_LAMBERT:
     case BRDF_PHONG:
     case BRDF_BLINN_PHONG:
@@ -85,6 +92,8 @@ float lobe_width(MaterialGpu m) {
         return ward_lobe_width(m.params.x, m.params.y);
     case BRDF_MEASURED:
         return m.ks.w;
+    case BRDF_GLTF:
+        return gltf_lobe_width(m.params.x);
     }
     return PI;
 }
@@ -99,6 +108,7 @@ vec3 sampling_axis(Frame p) {
     case BRDF_BLINN_PHONG:
     case BRDF_WARD:
     case BRDF_MEASURED:
+    case BRDF_GLTF:
         return p.normal;
     }
     return p.normal;
@@ -121,9 +131,26 @@ vec3 lobe_sample(MaterialGpu m, Frame p, vec3 axis, vec3 t, vec3 b, float xi1, f
         return vec3(ward_lobe_sample(n, p.tangent, p.bitangent, v, m.params.x, m.params.y, xi1, phi, omega));
     case BRDF_MEASURED:
         return measured_lobe_sample(m, n, v, t, b, xi1, phi, omega);
+    case BRDF_GLTF:
+        return gltf_lobe_sample(n, t, b, v, m.base.rgb, m.params.y, m.params.x, xi1, phi, omega);
     }
     omega = n;
     return vec3(0.0);
+}
+
+// The count per axis of the sky's inverse-CDF grid for a lobe asked `per_axis`: glTF's mixture takes an even one.
+uint sky_grid_per_axis(uint per_axis) {
+    switch (VARIANT_BRDF) {
+    case BRDF_GLTF:
+        return per_axis + per_axis % 2u;
+    case BRDF_LAMBERT:
+    case BRDF_PHONG:
+    case BRDF_BLINN_PHONG:
+    case BRDF_WARD:
+    case BRDF_MEASURED:
+        return per_axis;
+    }
+    return per_axis;
 }
 
 // The point for u in (0, 1) of a grid on [a, b] graded about c with width w, x = c + w sinh(z), and its density

@@ -42,6 +42,7 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
     case BRDF_BLINN_PHONG:
     case BRDF_WARD:
     case BRDF_MEASURED:
+    case BRDF_GLTF:
         break;
     }
     vec3 specular = vec3(0.0);

@@ -28,6 +28,7 @@ float grazing_narrowing(MaterialGpu m, Frame p, vec3 u) {
     case BRDF_PHONG:
     case BRDF_BLINN_PHONG:
     case BRDF_MEASURED:
+    case BRDF_GLTF:
         isotropic_ward = false;
         break;
     }
@@ -95,6 +96,7 @@ float sky_lune_blend(MaterialGpu m, Frame p) {
     case BRDF_PHONG:
     case BRDF_BLINN_PHONG:
     case BRDF_WARD:
+    case BRDF_GLTF:
         below = max(clamp(0.5 - r.y / (2.0 * quarter), 0.0, 1.0), sky_beyond_lobe(m, p, r));
         break;
     }
@@ -119,6 +121,7 @@ vec3 sky_lobe_in_lune(MaterialGpu m, Frame p, uint per_axis, uint lune, bool sha
     case BRDF_BLINN_PHONG:
     case BRDF_WARD:
     case BRDF_MEASURED:
+    case BRDF_GLTF:
         break;
     }
     if (!(psi_hi > psi_lo)) {

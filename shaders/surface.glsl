@@ -60,6 +60,15 @@ MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metalli
         m.ks = vec4(ks, 0.0);
         m.params = vec4(vec2(alpha), 0.0, 0.0);
         break;
+    case BRDF_GLTF: {
+        // Its own model (shading::brdf::gltf): kd = (1 - m)(1 - 0.04) base, ks = 1, and the lobe's parameters.
+        precise vec3 gltf_kd = base * (1.0 - mm) * 0.96;
+        m.kd = vec4(gltf_kd, 0.0);
+        m.ks = vec4(1.0, 1.0, 1.0, 0.0);
+        m.params = vec4(alpha, mm, 0.0, 0.0);
+        m.base = vec4(base, m.base.a);
+        break;
+    }
     case BRDF_PHONG:
     case BRDF_BLINN_PHONG:
     case BRDF_MEASURED:
@@ -84,6 +93,7 @@ MaterialGpu surface_brdf(MaterialGpu m, SurfaceSample s, vec4 base) {
     case BRDF_BLINN_PHONG:
     case BRDF_WARD:
     case BRDF_MEASURED:
+    case BRDF_GLTF:
         if (m.tex[TEX_METALLIC_ROUGHNESS].texture.x != NO_TEXTURE) {
             vec4 t = material_texture(m.tex[TEX_METALLIC_ROUGHNESS], s);
             metallic = metallic * t.b;

@@ -221,6 +221,7 @@ const MIRRORED: &[(&str, &[&str], &str)] = &[
     ("brdf/phong.glsl", &["src/shading/brdf/phong.rs"], ""),
     ("brdf/blinn_phong.glsl", &["src/shading/brdf/blinn_phong.rs"], ""),
     ("brdf/ward.glsl", &["src/shading/brdf/ward.rs"], ""),
+    ("brdf/metallic_roughness.glsl", &["src/shading/brdf/metallic_roughness.rs"], ""),
     ("shade.glsl", &["src/shading/shade.rs"], ""),
     ("lobe.glsl", &["src/shading/lobe.rs"], ""),
     ("sky_lune.glsl", &["src/shading/sky_lune.rs"], ""),

@@ -19,6 +19,11 @@ fn specular_models() -> Vec<(String, Brdf)> {
         v.push((format!("Ward α={a}"), Brdf::Ward { kd: z, ks: o, alpha_x: a, alpha_y: a }));
     }
     v.push(("Ward αx=0.02 αy=0.3".into(), Brdf::Ward { kd: z, ks: o, alpha_x: 0.02, alpha_y: 0.3 }));
+    // glTF's white metal: its lobe is the whole BRDF, GGX with Fresnel 1 (its dielectric's lobe can be negative:
+    // shading::brdf::metallic_roughness's tests).
+    for a in [0.001f32, 0.01, 0.1, 0.5, 1.0] {
+        v.push((format!("glTF metal α={a}"), Brdf::Gltf { base_color: o, metallic: 1.0, alpha: a }));
+    }
     v
 }
 

@@ -35,7 +35,8 @@ const DIRECTION_ERROR: f64 = 2.5e-7;
 /// - Phong: `x = |r − v|²/2`, `δx = |r − v| δ(r − v)` and `δ(r − v) ≤ 2δn + δv`, so
 ///   `δf/f = e δx ≤ √(2 e ln 100) · 3δ`;
 /// - Blinn-Phong: `x = |n − h|²/2`, `δ(n − h) ≤ 2δ`: `δf/f ≤ √(2 e ln 100) · 2δ`;
-/// - Ward: `exp(−tan²θh/α²)` moves by `2 tanθh/α² δθh ≤ 2√(ln 100)/α · 2δ` with the smaller α.
+/// - Ward: `exp(−tan²θh/α²)` moves by `2 tanθh/α² δθh ≤ 2√(ln 100)/α · 2δ` with the smaller α;
+/// - glTF (GGX): `α²/(π(θh² + α²)²)` moves by `4θh/(θh² + α²) δθh ≤ 2/α · 2δ`.
 fn lobe_tolerance(extras: &serde_json::Value) -> f64 {
     let spread = (2.0 * 100f64.ln()).sqrt();
     let bound = match extras["brdf"].as_str().unwrap() {
@@ -46,6 +47,11 @@ fn lobe_tolerance(extras: &serde_json::Value) -> f64 {
             let ax = extras.get("alpha_x").and_then(|a| a.as_f64()).or(a).unwrap();
             let ay = extras.get("alpha_y").and_then(|a| a.as_f64()).or(a).unwrap();
             2.0 * 100f64.ln().sqrt() / ax.min(ay) * 2.0 * DIRECTION_ERROR
+        }
+        // GGX's D = α²/(π (θ² + α²)²) near its peak moves by 4θ/(θ² + α²) δθh ≤ 2/α δθh, δθh ≤ 2δ.
+        "gltf" => {
+            let alpha = extras["roughness"].as_f64().unwrap().powi(2);
+            2.0 / alpha * 2.0 * DIRECTION_ERROR
         }
         _ => 0.0,
     };

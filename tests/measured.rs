@@ -326,6 +326,26 @@ fn fit_recovers_the_parameters_of_tabulated_brdfs() {
     }
 }
 
+/// `fit_brdf --model gltf` recovers the base colour, metallic and roughness of a tabulated glTF BRDF: a measured
+/// material turned into a glTF one.
+#[test]
+fn fit_recovers_a_tabulated_gltf_material() {
+    use sunshade::scene::measured::MeasuredBrdf;
+    use sunshade::scene::BrdfKind;
+    use sunshade::shading::brdf_fit::fit_brdf;
+    let truth = Brdf::Gltf { base_color: [0.7, 0.4, 0.2], metallic: 0.3, alpha: 0.09 };
+    let table = MeasuredBrdf::from_planes("gltf", &tabulate(|l, v| analytic(&truth, l, v))).unwrap();
+    let t = std::time::Instant::now();
+    let fit = fit_brdf(&table, BrdfKind::Gltf);
+    println!("{:?}, relative RMS {:.2e} ({:.2} s)", fit.brdf, fit.relative_rms[0], t.elapsed().as_secs_f64());
+    let Brdf::Gltf { base_color, metallic, alpha } = fit.brdf else { panic!("fitted {:?}", fit.brdf) };
+    for c in 0..3 {
+        assert!((base_color[c] - [0.7, 0.4, 0.2][c]).abs() < 0.02, "{:?}", fit.brdf);
+    }
+    assert!((metallic - 0.3).abs() < 0.02 && ((alpha - 0.09) / 0.09).abs() < 0.02, "{:?}", fit.brdf);
+    assert!(fit.relative_rms.iter().all(|&e| e < 1e-3), "{:?}", fit.relative_rms);
+}
+
 fn sunshade(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_sunshade"))
         .args(args)

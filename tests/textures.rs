@@ -3,11 +3,12 @@
 //! docs/textures.md (not through sunshade's own lookup code), and deformed meshes against pre-posed twins.
 //!
 //! The scenes are a unit-facing square seen orthographically so that pixel (x, y) of an N × N image sees
-//! `uv = ((x + ½)/N, (y + ½)/N)`, lit by a delta sun straight on: `L = base/π · E⊥`.
+//! `uv = ((x + ½)/N, (y + ½)/N)`, lit by a delta sun straight on: `L = base/π · E⊥` (materials read as
+//! Lambertian, `--brdf lambert`; glTF's own BRDF is tests/gltf_brdf.rs's).
 
 mod common;
 
-use common::{load, rel, CheckedRenderer, TempDir};
+use common::{rel, CheckedRenderer, TempDir};
 use glam::{DVec3, Vec3};
 use serde_json::json;
 use std::f64::consts::PI;
@@ -20,6 +21,14 @@ use sunshade::shading::{Shadows, SunModel};
 use sunshade::Image;
 
 const E_PERP: f32 = 1000.0;
+
+/// Loads a scene with its glTF materials read as Lambertian (`--brdf lambert`: the base colour, its texture and
+/// vertex colours as the albedo), the BRDF the formulas here assume.
+fn load(path: &std::path::Path) -> Scene {
+    let mut scene = common::load(path);
+    scene.map_brdfs(sunshade::scene::BrdfKind::Lambert);
+    scene
+}
 
 /// The square (−1, −1)..(1, 1) in z = `z`, facing +z, UV (0, 0) at its top-left corner.
 fn square(z: f32, material: usize, colors: Option<Vec<[f32; 4]>>) -> Primitive {

@@ -24,10 +24,11 @@ float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
 // integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
 // lobe's inverse CDF, each sample weighted by lobe/pdf, shadow rays for the samples above the horizontal only
 // (see the Rust).
-vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
+vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint asked_per_axis, bool shadowed) {
     vec3 axis = sampling_axis(p);
     vec3 t = orthonormal_to(axis);
     vec3 b = cross(axis, t);
+    uint per_axis = sky_grid_per_axis(asked_per_axis);
     float k = float(per_axis);
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < per_axis; ++i) {
@@ -38,7 +39,7 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
             vec3 omega;
             vec3 value = lobe_sample(m, p, axis, t, b, xi1, phi, omega);
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
-            if (!any(greaterThan(value, vec3(0.0))) || !shadowed || omega.y <= 0.0
+            if (!any(notEqual(value, vec3(0.0))) || !shadowed || omega.y <= 0.0
                 || visible_along(p.shadow_origin, omega)) {
                 sum += value;
             }
@@ -49,14 +50,26 @@ vec3 sky_lobe_hemisphere_grid(MaterialGpu m, Frame p, uint per_axis, bool shadow
 
 // integral of lobe (n.w)+ over the sky (the hemisphere above the horizontal, per unit radiance): the hemisphere's
 // inverse-CDF grid less the lower lune while the lobe's peak is above the horizontal, the upper lune's own grid
-// once it is below, a blend between; at least 0 (see the Rust).
+// once it is below, a blend between; at least 0 where the lobe cannot be negative (see the Rust).
 vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shadowed) {
     float s = sky_lune_blend(m, p);
     vec3 direct = s > 0.0 ? sky_lobe_in_lune(m, p, per_axis, LUNE_ABOVE, shadowed) : vec3(0.0);
     vec3 by_difference = vec3(0.0);
     if (s < 1.0) {
-        by_difference = max(sky_lobe_hemisphere_grid(m, p, per_axis, shadowed)
-            - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false), vec3(0.0));
+        by_difference = sky_lobe_hemisphere_grid(m, p, per_axis, shadowed)
+            - sky_lobe_in_lune(m, p, per_axis, LUNE_BELOW, false);
+        // At least 0 where the lobe cannot be negative (Brdf::lobe_can_be_negative).
+        switch (VARIANT_BRDF) {
+        case BRDF_GLTF:
+            break;
+        case BRDF_LAMBERT:
+        case BRDF_PHONG:
+        case BRDF_BLINN_PHONG:
+        case BRDF_WARD:
+        case BRDF_MEASURED:
+            by_difference = max(by_difference, vec3(0.0));
+            break;
+        }
     }
     return (1.0 - s) * by_difference + s * direct;
 }

@@ -151,6 +151,7 @@ fn brdf_name(brdf: &Brdf) -> String {
         Brdf::Ward { alpha_x, alpha_y, .. } if alpha_x == alpha_y => format!("Ward α={alpha_x}"),
         Brdf::Ward { alpha_x, alpha_y, .. } => format!("Ward αx={alpha_x} αy={alpha_y}"),
         Brdf::Measured { ref table, .. } => format!("measured {}", table.name),
+        Brdf::Gltf { metallic, alpha, .. } => format!("glTF metallic={metallic} α={alpha}"),
     }
 }
 
@@ -212,6 +213,8 @@ fn scene_lobes(scene: &Scene) -> Vec<SceneLobe> {
             let (kd_max, ks_max) = match m.mapping {
                 None => (largest(m.brdf.kd()), largest(m.brdf.ks())),
                 Some(crate::scene::BrdfKind::Lambert) => (largest(m.pbr.base_color), 0.0),
+                // glTF's lobe carries its own Fresnel weights: ks = 1.
+                Some(crate::scene::BrdfKind::Gltf) => (largest(m.pbr.base_color), 1.0),
                 Some(_) => (largest(m.pbr.base_color), largest(m.pbr.base_color).max(0.04)),
             };
             match v.iter_mut().find(|o| brdf_name(&o.brdf) == brdf_name(&brdf)) {

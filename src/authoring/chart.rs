@@ -25,7 +25,8 @@ pub fn sun_direction(degrees: f64) -> [f64; 3] {
     [0.8 * t.sin(), 0.6 * t.sin(), t.cos()]
 }
 
-/// Lambert; Phong and Blinn-Phong at exponents 0, 1, 100, 1e4, 1e6; Ward at α = 0.01, 0.05, 0.2 and anisotropic.
+/// Lambert; Phong and Blinn-Phong at exponents 0, 1, 100, 1e4, 1e6; Ward at α = 0.01, 0.05, 0.2 and anisotropic;
+/// glTF's dielectric at roughness 0.15 and metal at 0.5.
 pub fn brdf_chart() -> Vec<ChartMaterial> {
     let (kd, ks) = ([0.3, 0.2, 0.1], [0.7, 0.7, 0.7]);
     let mut v =
@@ -50,6 +51,12 @@ pub fn brdf_chart() -> Vec<ChartMaterial> {
         name: "Ward αx=0.02 αy=0.3".into(),
         extras: json!({ "brdf": "ward", "kd": kd, "ks": ks, "alpha_x": 0.02, "alpha_y": 0.3 }),
     });
+    for (metallic, roughness) in [(0.0, 0.15), (1.0, 0.5)] {
+        v.push(ChartMaterial {
+            name: format!("glTF metallic={metallic} roughness={roughness}"),
+            extras: json!({ "brdf": "gltf", "base_color": [0.9, 0.6, 0.3], "metallic": metallic, "roughness": roughness }),
+        });
+    }
     v
 }
 

@@ -212,7 +212,9 @@ impl GltfBuilder {
         self.meshes.len() - 1
     }
 
-    /// Adds a material with a Lambertian albedo (`baseColorFactor` RGB); returns its index.
+    /// Adds a material with a Lambertian albedo (`baseColorFactor` RGB, and the extras `{"sunshade": {"brdf":
+    /// "lambert"}}` where `extras` is `None`, so that sunshade reads it as Lambertian rather than as glTF's
+    /// metallic-roughness BRDF); returns its index.
     pub fn add_material(&mut self, name: &str, albedo: [f32; 3], double_sided: bool, extras: Option<Value>) -> usize {
         let mut m = json!({
             "name": name,
@@ -221,9 +223,7 @@ impl GltfBuilder {
         if double_sided {
             m["doubleSided"] = json!(true);
         }
-        if let Some(e) = extras {
-            m["extras"] = e;
-        }
+        m["extras"] = extras.unwrap_or_else(|| json!({ "sunshade": { "brdf": "lambert" } }));
         self.materials.push(m);
         self.materials.len() - 1
     }

@@ -52,6 +52,8 @@ fn lobe(kind: &str, p: f64, q: f64) -> (String, Brdf) {
     match kind {
         "phong" => (format!("Phong e={p}"), Brdf::Phong { kd, ks, exponent: p as f32 }),
         "blinn-phong" => (format!("Blinn-Phong e={p}"), Brdf::BlinnPhong { kd, ks, exponent: p as f32 }),
+        // A white metal: the GGX lobe with Fresnel 1, whose albedo below 1 is what single scattering loses.
+        "gltf" => (format!("glTF metal α={p}"), Brdf::Gltf { base_color: [1.0; 3], metallic: 1.0, alpha: p as f32 }),
         _ if p == q => (format!("Ward α={p}"), Brdf::Ward { kd, ks, alpha_x: p as f32, alpha_y: q as f32 }),
         _ => (format!("Ward αx={p} αy={q}"), Brdf::Ward { kd, ks, alpha_x: p as f32, alpha_y: q as f32 }),
     }
@@ -68,6 +70,9 @@ fn standard_lobes() -> Vec<(String, Brdf)> {
         v.push(lobe("ward", a, a));
     }
     v.push(lobe("ward", 0.02, 0.3));
+    for a in [0.01, 0.04, 0.25, 0.5, 1.0] {
+        v.push(lobe("gltf", a, a));
+    }
     v
 }
 
@@ -156,6 +161,20 @@ fn scene_table(materials: &[(String, Brdf)]) -> String {
         let (kd, ks) = match *brdf {
             Brdf::Lambert { albedo } => (albedo, [0.0; 3]),
             Brdf::Phong { kd, ks, .. } | Brdf::BlinnPhong { kd, ks, .. } | Brdf::Ward { kd, ks, .. } => (kd, ks),
+            Brdf::Gltf { base_color, metallic, alpha } => {
+                // Per channel: the base colour enters the lobe (the metal's Fresnel, the dielectric's darkening).
+                s += &format!("| {name} (glTF) |");
+                for d in INCIDENCES_DEGREES {
+                    let a = base_color.map(|b| {
+                        let channel = Brdf::Gltf { base_color: [b; 3], metallic, alpha };
+                        let lobe = lobe_albedo(&channel, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0;
+                        channel.kd()[0] as f64 + lobe
+                    });
+                    s += &format!(" {:.4}, {:.4}, {:.4} |", a[0], a[1], a[2]);
+                }
+                s += "\n";
+                continue;
+            }
             Brdf::Measured { ref table, lookup } => {
                 // The table's own albedo (no kd/ks split): quadrature over the light's hemisphere.
                 s += &format!("| {name} (measured, {}) |", table.name);

@@ -17,7 +17,7 @@ pub struct FitBrdfArgs {
     /// A MERL BRDF file (`.binary`: 90 × 90 × 180 samples per channel).
     pub file: PathBuf,
     /// The model to fit.
-    #[arg(long, value_name = "lambert|phong|blinn-phong|ward")]
+    #[arg(long, value_name = "lambert|phong|blinn-phong|ward|gltf")]
     pub model: BrdfKind,
     /// Print the result as JSON (parameters, errors, the extras snippet).
     #[arg(long)]
@@ -40,6 +40,9 @@ pub fn extras_snippet(brdf: &Brdf) -> Value {
         Brdf::Ward { kd, ks, alpha_x, .. } => {
             json!({ "brdf": "ward", "kd": rgb(kd), "ks": rgb(ks), "alpha": sig(alpha_x) })
         }
+        Brdf::Gltf { base_color, metallic, alpha } => json!({
+            "brdf": "gltf", "base_color": rgb(base_color), "metallic": r(metallic), "roughness": sig(alpha.sqrt())
+        }),
         Brdf::Measured { .. } => unreachable!("fits are analytic"),
     };
     json!({ "sunshade": inner })

@@ -99,7 +99,7 @@ enum Command {
     /// Energy check of the BRDFs (directional albedo by converged quadrature) and the error of the sampled
     /// light integrals per sample count; with a scene, the albedo of its materials.
     Albedo(albedo::AlbedoArgs),
-    /// Fit an analytic BRDF (lambert, phong, blinn-phong, ward) to a measured MERL table: its parameters, the
+    /// Fit an analytic BRDF (lambert, phong, blinn-phong, ward, gltf) to a measured MERL table: its parameters, the
     /// fit's error, and a material extras snippet.
     FitBrdf(fit_brdf::FitBrdfArgs),
     /// Write an analytic BRDF as a MERL table (for tests and comparisons with measured materials).

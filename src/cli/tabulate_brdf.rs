@@ -17,9 +17,9 @@ use crate::shading::measured::{brdf_about_z, tabulate};
 #[derive(Args, Debug)]
 pub struct TabulateBrdfArgs {
     /// The analytic model.
-    #[arg(long, value_name = "lambert|phong|blinn-phong|ward")]
+    #[arg(long, value_name = "lambert|phong|blinn-phong|ward|gltf")]
     pub model: BrdfKind,
-    /// Diffuse reflectance kd (the albedo for Lambert): one value or r,g,b.
+    /// Diffuse reflectance kd (the albedo for Lambert, the base colour for glTF): one value or r,g,b.
     #[arg(long, value_parser = parse_radiance, value_name = "KD|R,G,B")]
     pub kd: [f64; 3],
     /// Specular reflectance ks: one value or r,g,b.
@@ -28,9 +28,12 @@ pub struct TabulateBrdfArgs {
     /// Phong / Blinn-Phong exponent.
     #[arg(long, default_value_t = 0.0)]
     pub exponent: f64,
-    /// Ward α (isotropic).
+    /// Ward α (isotropic); glTF's GGX α (roughness²).
     #[arg(long, default_value_t = 0.1)]
     pub alpha: f64,
+    /// glTF's metallic.
+    #[arg(long, default_value_t = 0.0)]
+    pub metallic: f64,
     /// The MERL file to write (atomically).
     #[arg(short, long, value_name = "FILE.binary")]
     pub output: PathBuf,
@@ -38,7 +41,8 @@ pub struct TabulateBrdfArgs {
 
 pub fn run(a: &TabulateBrdfArgs) -> Result<(), CliError> {
     let (kd, ks) = (a.kd.map(|x| x as f32), a.ks.map(|x| x as f32));
-    let shape = if a.model == BrdfKind::Ward { a.alpha } else { a.exponent };
+    let shape = if matches!(a.model, BrdfKind::Ward | BrdfKind::Gltf) { a.alpha } else { a.exponent };
+    let ks = if a.model == BrdfKind::Gltf { [a.metallic as f32; 3] } else { ks };
     let brdf = Brdf::of_kind(a.model, kd, ks, shape as f32);
     brdf.validate().map_err(CliError::Usage)?;
     let planes = tabulate(|l, v| brdf_about_z(&brdf, l, v));

@@ -12,6 +12,7 @@ pub const BRDF_PHONG: u32 = 1;
 pub const BRDF_BLINN_PHONG: u32 = 2;
 pub const BRDF_WARD: u32 = 3;
 pub const BRDF_MEASURED: u32 = 4;
+pub const BRDF_GLTF: u32 = 5;
 pub const LIGHT_ABSENT: u32 = 0;
 pub const SUN_DISK: u32 = 1;
 pub const SUN_DELTA: u32 = 2;
@@ -356,6 +357,7 @@ pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
             let nearest = f32::from(u8::from(lookup == crate::shading::measured::MeasuredLookup::Nearest));
             (BRDF_MEASURED, table.lobe_width, [f[0], f[1], f[2], nearest])
         }
+        Brdf::Gltf { metallic, alpha, .. } => (BRDF_GLTF, 0.0, [alpha, metallic, 0.0, 0.0]),
     };
     let slot = |r: Option<&TextureRef>| match r {
         Some(r) => {
@@ -372,7 +374,15 @@ pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
         AlphaMode::Mask(c) => c,
         AlphaMode::Opaque | AlphaMode::Blend => 0.0,
     };
-    let b = m.pbr.base_color;
+    // glTF's lobe reads its base colour here (the mapping writes the pixel's; shaders/surface.glsl).
+    let b = match m.brdf {
+        Brdf::Gltf { base_color, .. } => base_color,
+        Brdf::Lambert { .. }
+        | Brdf::Phong { .. }
+        | Brdf::BlinnPhong { .. }
+        | Brdf::Ward { .. }
+        | Brdf::Measured { .. } => m.pbr.base_color,
+    };
     MaterialGpu {
         kd: [kd[0], kd[1], kd[2], 0.0],
         ks: [ks[0], ks[1], ks[2], exponent],
@@ -512,6 +522,7 @@ mod tests {
             ("BRDF_BLINN_PHONG", BRDF_BLINN_PHONG),
             ("BRDF_WARD", BRDF_WARD),
             ("BRDF_MEASURED", BRDF_MEASURED),
+            ("BRDF_GLTF", BRDF_GLTF),
             ("LIGHT_ABSENT", LIGHT_ABSENT),
             ("SUN_DISK", SUN_DISK),
             ("SUN_DELTA", SUN_DELTA),

@@ -9,7 +9,7 @@ use super::gltf::document::{lookup, MaterialDef, Root, TextureInfo};
 use super::gltf::files::AssetFiles;
 use super::gltf::image::{check, decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
 use super::gltf::uri::{resolve, UriTarget};
-use super::material::{AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
+use super::material::{brdf_from_metallic_roughness, AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
 use super::measured::{parse_merl, SharedMeasuredBrdf, MERL_FILE_BYTES};
 use super::texture::{uv_transform, Sampler, Texture, TextureRef, IDENTITY_UV_TRANSFORM};
 
@@ -72,8 +72,14 @@ impl<'a> MaterialReader<'a> {
             Some(x) if x.get("brdf").and_then(|v| v.as_str()) == Some("merl") => {
                 (self.measured_brdf(x).map_err(|e| format!("{name} extras: {e}"))?, None)
             }
+            // "lambert" alone: the metallic-roughness mapping onto Lambert (the base colour, its texture and vertex
+            // colours), as `--brdf lambert` does.
+            Some(x) if x.get("brdf").and_then(|v| v.as_str()) == Some("lambert") && x.get("albedo").is_none() => {
+                (Brdf::Lambert { albedo }, Some(BrdfKind::Lambert))
+            }
             Some(x) => (brdf_from_extras(x, albedo).map_err(|e| format!("{name} extras: {e}"))?, None),
-            None => (Brdf::Lambert { albedo }, Some(BrdfKind::Lambert)),
+            // The glTF specification's own BRDF.
+            None => (Brdf::from_metallic_roughness(BrdfKind::Gltf, metallic_roughness), Some(BrdfKind::Gltf)),
         };
         brdf.validate().map_err(|e| format!("{name}: {e}"))?;
         let mut ignored = Vec::new();
@@ -297,7 +303,8 @@ impl MaterialReader<'_> {
 }
 
 /// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
-/// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor).
+/// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor); `{"brdf": "gltf",
+/// "metallic": m, "roughness": r}` with `"base_color"` (else baseColorFactor), the glTF specification's BRDF.
 fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
     let kind = x.get("brdf").and_then(|v| v.as_str()).ok_or("\"brdf\" must be a string")?;
     let color = |key: &str| -> Result<[f32; 3], String> {
@@ -323,7 +330,15 @@ fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
             };
             Brdf::Ward { kd: color("kd")?, ks: color("ks")?, alpha_x, alpha_y }
         }
-        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward, merl")),
+        "gltf" => {
+            let base = if x.get("base_color").is_some() { color("base_color")? } else { base_color };
+            let (metallic, roughness) = (number("metallic")?, number("roughness")?);
+            if !(0.0..=1.0).contains(&metallic) || !(0.0..=1.0).contains(&roughness) {
+                return Err(format!("gltf metallic {metallic} and roughness {roughness} must lie in [0, 1]"));
+            }
+            brdf_from_metallic_roughness(BrdfKind::Gltf, base, metallic, roughness)
+        }
+        other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward, gltf, merl")),
     })
 }
 

@@ -25,6 +25,7 @@ fn lobe_width(brdf: &Brdf) -> f64 {
         Brdf::BlinnPhong { exponent, .. } => (1.0 / (exponent as f64 + 1.0).sqrt()).min(1.0),
         Brdf::Ward { alpha_x, alpha_y, .. } => (alpha_x.min(alpha_y) as f64).min(1.0),
         Brdf::Measured { ref table, .. } => (0.5 * table.lobe_width as f64).min(1.0),
+        Brdf::Gltf { alpha, .. } => (alpha as f64).min(1.0),
     }
 }
 

@@ -3,7 +3,7 @@
 //! Each model is a Lambertian part plus, for the specular models, a lobe scaled by `ks`; `kd + ks ≤ 1` per channel
 //! (checked when a scene is loaded) keeps every model energy-conserving. Vectors are unit, in world space: `n` the
 //! shading normal, `l` towards the light, `v` towards the viewer. Each specular model has its own file (its lobe,
-//! width, sampling and kink: `phong`, `blinn_phong`, `ward`; a measured table's in `shading::measured`); this one
+//! width, sampling and kink: `phong`, `blinn_phong`, `ward`, `metallic_roughness` (glTF's); a measured table's in `shading::measured`); this one
 //! keeps the Lambertian term and the arithmetic they share. `shaders/brdf.glsl` and `shaders/brdf/` mirror them
 //! name for name.
 //!
@@ -17,6 +17,7 @@ use std::f64::consts::FRAC_1_PI;
 use glam::DVec3;
 
 pub mod blinn_phong;
+pub mod metallic_roughness;
 pub mod phong;
 pub mod ward;
 

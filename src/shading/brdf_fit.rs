@@ -19,14 +19,22 @@
 //! search: a logarithmic grid over its range, then golden-section search on its logarithm in the bracket about the
 //! grid's best (variable projection; Golub & Pereyra 1973). Ward is fitted isotropic (αx = αy): the table is
 //! isotropic.
+//!
+//! **glTF** (`--model gltf`) is not `kd/π + ks · lobe`: its ρ is affine in the base colour for a fixed metallic
+//! and α, so the base colour is solved exactly per channel and (metallic, ln α) searched (`fit_gltf`): a way to
+//! turn a measured material into a glTF one.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::brdf::metallic_roughness::{
+    ggx_distribution, one_minus_v_dot_h, schlick_weight, smith_visibility, GLTF_DIELECTRIC_F0,
+};
 use super::lobe::lobe_about_z;
 use super::measured::{brdf_about_z, half_diff_directions};
+use crate::scene::material::MIN_MAPPED_ALPHA;
 use crate::scene::measured::{merl_index, MeasuredBrdf, PHI_D_BINS, THETA_D_BINS, THETA_H_BINS};
 use crate::scene::{Brdf, BrdfKind};
 
@@ -172,6 +180,7 @@ fn shape_range(kind: BrdfKind) -> (f64, f64) {
     match kind {
         BrdfKind::Phong | BrdfKind::BlinnPhong => (0.1, 1e5),
         BrdfKind::Ward => (0.002, 1.0),
+        BrdfKind::Gltf => (MIN_MAPPED_ALPHA as f64, 1.0),
         BrdfKind::Lambert => (0.0, 0.0),
     }
 }
@@ -187,10 +196,145 @@ fn fit_shape(samples: &[FitSample], fixed: &FixedSums, kind: BrdfKind, shape: f6
 const GRID_POINTS: usize = 36;
 const GOLDEN_STEPS: usize = 30;
 
+/// Golden-section search for the minimum of `f` on `[a, b]`, `GOLDEN_STEPS` steps; returns the abscissa.
+fn golden_section(f: impl Fn(f64) -> f64, (mut a, mut b): (f64, f64)) -> f64 {
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..GOLDEN_STEPS {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    if fc < fd {
+        c
+    } else {
+        d
+    }
+}
+
+/// Metallic values of the glTF fit's first grid.
+const GLTF_METALLIC_GRID: usize = 11;
+
+/// The glTF BRDF's sums of the normal equations for one metallic m: ρ is affine in the base colour b,
+/// `ρ = b P + Q` with `P = (1 − m)(1 − F_d)/π + m (1 − s) D V` and `Q = (1 − m) F_d D V + m s D V` (s Schlick's
+/// weight, `F_d = 0.04 + 0.96 s`): `Σ w P²`, `Σ w P Q`, `Σ w Q²`, `Σ w P ρ_c`, `Σ w Q ρ_c`.
+#[derive(Clone, Copy, Default)]
+struct GltfSums {
+    pp: f64,
+    pq: f64,
+    qq: f64,
+    pr: [f64; 3],
+    qr: [f64; 3],
+}
+
+impl GltfSums {
+    fn add(self, o: GltfSums) -> GltfSums {
+        GltfSums {
+            pp: self.pp + o.pp,
+            pq: self.pq + o.pq,
+            qq: self.qq + o.qq,
+            pr: [0, 1, 2].map(|c| self.pr[c] + o.pr[c]),
+            qr: [0, 1, 2].map(|c| self.qr[c] + o.qr[c]),
+        }
+    }
+
+    /// The least-squares base colour per channel, `Σ w P (ρ − Q) / Σ w P²` clamped to [0, 1] (the objective is
+    /// a parabola in b), and the summed objective `Σ w (b P + Q − ρ)²` there.
+    fn solve(&self, fixed: &FixedSums) -> ([f64; 3], f64) {
+        let mut total = 0.0;
+        let base = [0, 1, 2].map(|c| {
+            let b = if self.pp > 0.0 { ((self.pr[c] - self.pq) / self.pp).clamp(0.0, 1.0) } else { 0.0 };
+            total +=
+                b * b * self.pp + 2.0 * b * self.pq + self.qq - 2.0 * b * self.pr[c] - 2.0 * self.qr[c] + fixed.rr[c];
+            b
+        });
+        (base, total)
+    }
+}
+
+/// [`GltfSums`] for each metallic of `metallics` at one α: D V and Schlick's weight are computed once per sample.
+fn gltf_sums(samples: &[FitSample], alpha: f64, metallics: &[f64]) -> Vec<GltfSums> {
+    let zero = || vec![GltfSums::default(); metallics.len()];
+    samples
+        .par_chunks(8192)
+        .map(|chunk| {
+            let mut t = zero();
+            for s in chunk {
+                let (dv, weight) = gltf_terms(s.l, s.v, alpha);
+                let fd = GLTF_DIELECTRIC_F0 + (1.0 - GLTF_DIELECTRIC_F0) * weight;
+                for (sums, &m) in t.iter_mut().zip(metallics) {
+                    let p = (1.0 - m) * (1.0 - fd) / PI + m * (1.0 - weight) * dv;
+                    let q = (1.0 - m) * fd * dv + m * weight * dv;
+                    sums.pp += s.weight * p * p;
+                    sums.pq += s.weight * p * q;
+                    sums.qq += s.weight * q * q;
+                    for c in 0..3 {
+                        sums.pr[c] += s.weight * p * s.rho[c];
+                        sums.qr[c] += s.weight * q * s.rho[c];
+                    }
+                }
+            }
+            t
+        })
+        .reduce(zero, |a, b| a.into_iter().zip(b).map(|(x, y)| x.add(y)).collect())
+}
+
+/// GGX's `D V` and Schlick's `(1 − v·h)⁵` for light l and viewer v about +z (`shading::brdf::metallic_roughness`).
+fn gltf_terms(l: DVec3, v: DVec3, alpha: f64) -> (f64, f64) {
+    let h = l + v;
+    if h.length_squared() == 0.0 {
+        return (0.0, 0.0);
+    }
+    let dv = ggx_distribution(DVec3::Z, h, alpha) * smith_visibility(l.z, v.z, alpha);
+    (dv, schlick_weight(one_minus_v_dot_h(l, v)))
+}
+
+/// Fits the glTF BRDF (base colour, metallic, roughness) to the table: the base colour exactly for each
+/// (metallic, α) ([`GltfSums::solve`]); a grid over metallic × ln α, then golden-section search on ln α at the best
+/// metallic and on metallic at that α.
+fn fit_gltf(samples: &[FitSample], fixed: &FixedSums) -> Brdf {
+    let (lo, hi) = shape_range(BrdfKind::Gltf);
+    let (lo, hi) = (lo.ln(), hi.ln());
+    let alphas: Vec<f64> = (0..GRID_POINTS).map(|i| lo + (hi - lo) * i as f64 / (GRID_POINTS - 1) as f64).collect();
+    let metallics: Vec<f64> = (0..GLTF_METALLIC_GRID).map(|i| i as f64 / (GLTF_METALLIC_GRID - 1) as f64).collect();
+    let mut best = (f64::INFINITY, 0, 0);
+    for (ai, &t) in alphas.iter().enumerate() {
+        for (mi, sums) in gltf_sums(samples, t.exp(), &metallics).iter().enumerate() {
+            let value = sums.solve(fixed).1;
+            if value < best.0 {
+                best = (value, mi, ai);
+            }
+        }
+    }
+    let at = |m: f64, t: f64| gltf_sums(samples, t.exp(), &[m])[0].solve(fixed);
+    let m0 = metallics[best.1];
+    let bracket = (alphas[best.2.saturating_sub(1)], alphas[(best.2 + 1).min(GRID_POINTS - 1)]);
+    let t = golden_section(|t| at(m0, t).1, bracket);
+    let step = 1.0 / (GLTF_METALLIC_GRID - 1) as f64;
+    let m = golden_section(|m| at(m, t).1, ((m0 - step).max(0.0), (m0 + step).min(1.0)));
+    let base = at(m, t).0;
+    Brdf::Gltf { base_color: base.map(|b| b as f32), metallic: m as f32, alpha: t.exp() as f32 }
+}
+
 /// Fits `kind` to the table (see the module text).
 pub fn fit_brdf(table: &MeasuredBrdf, kind: BrdfKind) -> Fit {
     let samples = fit_samples(table);
     let fixed = fixed_sums(&samples);
+    if kind == BrdfKind::Gltf {
+        let brdf = fit_gltf(&samples, &fixed);
+        return Fit { relative_rms: relative_rms(&samples, &brdf), brdf, samples: samples.len() };
+    }
     let (channels, shape) = if kind == BrdfKind::Lambert {
         let none = LobeSums::default();
         ([0, 1, 2].map(|c| solve_channel(&fixed, &none, c)), 0.0)
@@ -201,27 +345,8 @@ pub fn fit_brdf(table: &MeasuredBrdf, kind: BrdfKind) -> Fit {
         let grid: Vec<f64> = (0..GRID_POINTS).map(|i| lo + (hi - lo) * i as f64 / (GRID_POINTS - 1) as f64).collect();
         let values: Vec<f64> = grid.iter().map(|&t| at(t)).collect();
         let best = (0..GRID_POINTS).min_by(|&a, &b| values[a].total_cmp(&values[b])).unwrap();
-        let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(GRID_POINTS - 1)]);
-        // Golden-section search on ln(shape) in [a, b].
-        let g = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-        let (mut fc, mut fd) = (at(c), at(d));
-        for _ in 0..GOLDEN_STEPS {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - g * (b - a);
-                fc = at(c);
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + g * (b - a);
-                fd = at(d);
-            }
-        }
-        let t = if fc < fd { c } else { d };
+        // Golden-section search on ln(shape) in the bracket about the grid's best.
+        let t = golden_section(at, (grid[best.saturating_sub(1)], grid[(best + 1).min(GRID_POINTS - 1)]));
         let shape = t.exp();
         (fit_shape(&samples, &fixed, kind, shape).0, shape)
     };

@@ -12,6 +12,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use super::brdf::blinn_phong::{blinn_phong_lobe, blinn_phong_lobe_sample, blinn_phong_lobe_width};
+use super::brdf::metallic_roughness::{gltf_lobe_rgb, gltf_lobe_sample, gltf_lobe_width};
 use super::brdf::mirror;
 use super::brdf::phong::{phong_lobe, phong_lobe_kink, phong_lobe_sample, phong_lobe_width};
 use super::brdf::ward::{ward_lobe, ward_lobe_sample, ward_lobe_width};
@@ -56,10 +57,14 @@ pub fn orthonormal_to(v: DVec3) -> DVec3 {
 }
 
 /// The specular lobe of a material (without ks) per channel for light from `l`: the analytic lobes' one value in
-/// each channel; a measured table's part above its floor ([`measured_residual`]).
+/// each channel; a measured table's part above its floor ([`measured_residual`]); glTF's, whose metal's Fresnel
+/// follows the base colour.
 pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
     match brdf {
         Brdf::Measured { table, lookup } => measured_residual(table, *lookup, p.normal, l, p.to_viewer),
+        Brdf::Gltf { base_color, metallic, alpha } => {
+            gltf_lobe_rgb(p.normal, l, p.to_viewer, base_color.map(f64::from), *metallic as f64, *alpha as f64)
+        }
         Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } => {
             [specular_lobe(brdf, p, l); 3]
         }
@@ -69,13 +74,21 @@ pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
 /// A material's specular lobe (without ks) for light from `l` seen from `v` about the normal +z, tangent +x,
 /// bitangent +y: the frame of the bounds' scans and of tabulated tables.
 pub fn lobe_about_z(brdf: &Brdf, l: DVec3, v: DVec3) -> f64 {
-    let p =
-        SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v };
-    specular_lobe(brdf, &p, l)
+    specular_lobe(brdf, &point_about_z(v), l)
 }
 
-/// The specular lobe of a material (without ks) for light from `l`; a measured table's, the mean of its
-/// channels'.
+/// [`lobe_about_z`] per channel ([`specular_lobe_rgb`]).
+pub fn lobe_about_z_rgb(brdf: &Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
+    specular_lobe_rgb(brdf, &point_about_z(v), l)
+}
+
+/// The surface point at the origin with normal +z, tangent +x, bitangent +y, seen from `v`.
+fn point_about_z(v: DVec3) -> SurfacePoint {
+    SurfacePoint { position: DVec3::ZERO, normal: DVec3::Z, tangent: DVec3::X, bitangent: DVec3::Y, to_viewer: v }
+}
+
+/// The specular lobe of a material (without ks) for light from `l`; a measured table's and glTF's, the mean of
+/// their channels'.
 pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
     let (n, v) = (p.normal, p.to_viewer);
     match *brdf {
@@ -85,7 +98,7 @@ pub fn specular_lobe(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> f64 {
         Brdf::Ward { alpha_x, alpha_y, .. } => {
             ward_lobe(n, p.tangent, p.bitangent, l, v, alpha_x as f64, alpha_y as f64)
         }
-        Brdf::Measured { .. } => specular_lobe_rgb(brdf, p, l).iter().sum::<f64>() / 3.0,
+        Brdf::Measured { .. } | Brdf::Gltf { .. } => specular_lobe_rgb(brdf, p, l).iter().sum::<f64>() / 3.0,
     }
 }
 
@@ -98,6 +111,7 @@ pub fn lobe_width(brdf: &Brdf) -> f64 {
         Brdf::BlinnPhong { exponent, .. } => blinn_phong_lobe_width(exponent as f64),
         Brdf::Ward { alpha_x, alpha_y, .. } => ward_lobe_width(alpha_x as f64, alpha_y as f64),
         Brdf::Measured { ref table, .. } => table.lobe_width as f64,
+        Brdf::Gltf { alpha, .. } => gltf_lobe_width(alpha as f64),
     }
 }
 
@@ -138,17 +152,39 @@ pub fn lobe_sample(
             ([weight; 3], omega)
         }
         Brdf::Measured { ref table, lookup } => measured_lobe_sample(table, lookup, (n, v), (t, b), xi1, phi),
+        Brdf::Gltf { base_color, metallic, alpha } => {
+            let params = (base_color.map(f64::from), metallic as f64, alpha as f64);
+            gltf_lobe_sample((n, t, b), v, params, xi1, phi)
+        }
+    }
+}
+
+/// The count per axis of the sky's inverse-CDF grid for a lobe asked `per_axis`: glTF's draws half its azimuths
+/// from each of two densities (`gltf_lobe_sample`), so its count is made even, each half then a whole grid.
+pub fn sky_grid_per_axis(brdf: &Brdf, per_axis: u32) -> u32 {
+    match brdf {
+        Brdf::Gltf { .. } => per_axis + per_axis % 2,
+        Brdf::Lambert { .. }
+        | Brdf::Phong { .. }
+        | Brdf::BlinnPhong { .. }
+        | Brdf::Ward { .. }
+        | Brdf::Measured { .. } => per_axis,
     }
 }
 
 /// The slope jump of the lobe where the light crosses its zero, relative to its peak, for the error bounds
 /// (`accuracy::bounds`; `None`: unbounded, no claim). Sampled scans do not find a kink (it is a line, the scan's
 /// points a lattice), so each model says its own: Phong's at α = 90° (`phong_lobe_kink`); Blinn-Phong's `n·h` stays
-/// positive for light and viewer above the horizon, Ward's lobe is smooth, a table is linear between its bins.
+/// positive for light and viewer above the horizon, Ward's and glTF's lobes are smooth, a table is linear between
+/// its bins.
 pub fn lobe_kink(brdf: &Brdf) -> Option<f64> {
     match *brdf {
         Brdf::Phong { exponent, .. } => phong_lobe_kink(exponent as f64),
-        Brdf::Lambert { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } | Brdf::Measured { .. } => Some(0.0),
+        Brdf::Lambert { .. }
+        | Brdf::BlinnPhong { .. }
+        | Brdf::Ward { .. }
+        | Brdf::Measured { .. }
+        | Brdf::Gltf { .. } => Some(0.0),
     }
 }
 

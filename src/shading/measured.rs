@@ -213,11 +213,11 @@ pub fn measured_albedo(table: &MeasuredBrdf, lookup: MeasuredLookup, theta: f64,
     sum.map(|x| PI * x / (k * k))
 }
 
-/// An analytic BRDF's value `kd/π + ks lobe` [1/sr] per channel about the normal +z ([`super::lobe_about_z`]), the
-/// frame [`half_diff_directions`] and [`tabulate`] use.
+/// An analytic BRDF's value `kd/π + ks lobe` [1/sr] per channel about the normal +z ([`super::lobe_about_z_rgb`]),
+/// the frame [`half_diff_directions`] and [`tabulate`] use.
 pub fn brdf_about_z(brdf: &crate::scene::Brdf, l: DVec3, v: DVec3) -> [f64; 3] {
-    let (kd, ks, lobe) = (brdf.kd(), brdf.ks(), super::lobe_about_z(brdf, l, v));
-    [0, 1, 2].map(|c| kd[c] as f64 / PI + ks[c] as f64 * lobe)
+    let (kd, ks, lobe) = (brdf.kd(), brdf.ks(), super::lobe_about_z_rgb(brdf, l, v));
+    [0, 1, 2].map(|c| kd[c] as f64 / PI + ks[c] as f64 * lobe[c])
 }
 
 /// A table of `rho(l, v)` per channel [1/sr] at each sample's angles (normal +z), as [`MeasuredBrdf::from_planes`]

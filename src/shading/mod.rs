@@ -29,7 +29,8 @@ pub use lights::disk::{disk_geometry, disk_lobe_integral};
 pub use lights::sky::sky_lobe_integral;
 pub use lights::sun::sun_lobe_integral;
 pub use lobe::{
-    lobe_about_z, lobe_width, normalized_lobe_integral, orthonormal_to, safe_normalize, specular_lobe, SurfacePoint,
+    lobe_about_z, lobe_about_z_rgb, lobe_width, normalized_lobe_integral, orthonormal_to, safe_normalize,
+    specular_lobe, SurfacePoint,
 };
 pub use options::{
     DiskModel, ShadingOptions, SunChoice, SunModel, DEFAULT_SAMPLES_PER_AXIS, DEFAULT_SUN_SAMPLES_PER_AXIS,

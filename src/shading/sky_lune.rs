@@ -105,7 +105,11 @@ pub fn grazing_narrowing(brdf: &Brdf, p: &SurfacePoint, u: DVec3) -> f64 {
     // Every model by name, so that a new one says whether its lobe narrows.
     let isotropic_ward = match *brdf {
         Brdf::Ward { alpha_x, alpha_y, .. } => alpha_x == alpha_y,
-        Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Measured { .. } => false,
+        Brdf::Lambert { .. }
+        | Brdf::Phong { .. }
+        | Brdf::BlinnPhong { .. }
+        | Brdf::Measured { .. }
+        | Brdf::Gltf { .. } => false,
     };
     if !isotropic_ward {
         return 1.0;

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 use glam::DVec3;
 
 use crate::scene::Brdf;
-use crate::shading::lobe::{lobe_sample, sampling_axis};
+use crate::shading::lobe::{lobe_sample, sampling_axis, sky_grid_per_axis};
 use crate::shading::sky_lune::{sky_lobe_in_lune, sky_lune_blend, Lune};
 use crate::shading::visibility::{grid_fraction, sky_lune, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
@@ -45,7 +45,8 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
     let by_difference = if s < 1.0 {
         let whole = sky_lobe_hemisphere_grid(brdf, p, per_axis, shadow);
         let below = sky_lobe_in_lune(brdf, p, per_axis, Lune::Below, None);
-        [0, 1, 2].map(|c| (whole[c] - below[c]).max(0.0))
+        let floor = if brdf.lobe_can_be_negative() { f64::NEG_INFINITY } else { 0.0 };
+        [0, 1, 2].map(|c| (whole[c] - below[c]).max(floor))
     } else {
         [0.0; 3]
     };
@@ -53,7 +54,7 @@ pub fn sky_lobe_integral_visible(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, s
 }
 
 /// `∫ lobe(ω) (n·ω)+ dω` over the surface's whole hemisphere, per unit radiance, per channel, by a stratified grid
-/// of `per_axis²` cells through the lobe's inverse CDF, each sample weighted by lobe/pdf; each sample above the
+/// of `per_axis²` cells (`lobe::sky_grid_per_axis`) through the lobe's inverse CDF, each sample weighted by lobe/pdf; each sample above the
 /// horizontal that contributes casts its shadow ray (`shadow`), those below count as unoccluded (the lower lune's
 /// unoccluded integral takes them out again).
 pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, shadow: Option<&Shadowing>) -> [f64; 3] {
@@ -61,6 +62,7 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
     let axis = sampling_axis(brdf, p);
     let t = orthonormal_to(axis);
     let b = axis.cross(t);
+    let per_axis = sky_grid_per_axis(brdf, per_axis);
     let k = per_axis as f64;
     let mut sum = [0.0; 3];
     for i in 0..per_axis {
@@ -70,7 +72,7 @@ pub fn sky_lobe_hemisphere_grid(brdf: &Brdf, p: &SurfacePoint, per_axis: u32, sh
             let phi = 2.0 * PI * xi2;
             let (value, omega) = lobe_sample(brdf, p, (axis, t, b), xi1, phi);
             // A sample that contributes casts its shadow ray; adding the 0 of a blocked one is skipped.
-            if !value.iter().any(|&x| x > 0.0) || visible(omega) {
+            if !value.iter().any(|&x| x != 0.0) || visible(omega) {
                 for (s, x) in sum.iter_mut().zip(value) {
                     *s += x;
                 }
