@@ -1331,3 +1331,53 @@ fn renders_say_what_they_drew_and_warn_about_light_the_flags_may_not_mean() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("empty.glb: empty file (0 bytes)"), "{}", stderr(&o));
 }
+
+/// `--emission-scale S` gives S W/(m²·sr) per unit emissiveFactor: a Lambertian square emitting [1, 0.5, 0]
+/// renders brighter by exactly (S − 1) × that; `-v` says when the emission is under 1% of the image's peak.
+#[test]
+fn emission_scale_makes_emission_visible_and_v_says_when_it_is_not() {
+    let dir = TempDir::new("emission-scale");
+    let mut b = GltfBuilder::new();
+    let m = b.add_material_json(json!({
+        "name": "glow",
+        "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0 },
+        "emissiveFactor": [1.0, 0.5, 0.0],
+        "extras": { "sunshade": { "brdf": "lambert" } },
+    }));
+    let mesh = b.add_mesh("square", &[quad(Vec3::ZERO, Vec3::X, Vec3::Y).primitive(Some(m))]);
+    let n = b.add_node(Node { mesh: Some(mesh), ..Default::default() });
+    b.add_scene(&[n], None);
+    let scene = dir.write("glow.glb", &b);
+    let scene = scene.to_str().unwrap();
+    let view = [
+        "--eye",
+        "0,0,3",
+        "--target",
+        "0,0,0",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--shadows",
+        "none",
+        "--sun-dir",
+        "0.2,0.3,1",
+    ];
+    let (plain, scaled) = (dir.path("plain.exr"), dir.path("scaled.exr"));
+    let o = sunshade(&[&["render", scene, "-v", "-o", plain.to_str().unwrap()][..], &view].concat());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && e.contains("emission: at most 1.000e0") && e.contains("--emission-scale"), "{e}");
+    let o = sunshade(
+        &[&["render", scene, "-v", "--emission-scale", "500", "-o", scaled.to_str().unwrap()][..], &view].concat(),
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && !e.contains("emission: at most"), "{e}");
+    let (a, b) = (sunshade::film::read_image(&plain).unwrap(), sunshade::film::read_image(&scaled).unwrap());
+    let (pa, pb) = (a.get(8, 8), b.get(8, 8));
+    for (c, e) in [1.0f64, 0.5, 0.0].iter().enumerate() {
+        let added = pb[c] as f64 - pa[c] as f64;
+        assert!((added - 499.0 * e).abs() <= 1e-5 * pb[c] as f64, "channel {c}: {pa:?} → {pb:?}");
+    }
+    let o = sunshade(&["render", scene, "--emission-scale", "-1", "-o", scaled.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}

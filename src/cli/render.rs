@@ -228,6 +228,7 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             super::metadata::sun_position_line(&job.render.settings, session.scene_ref(job.scene), scene_flags);
         let camera_line = super::metadata::camera_line(&job.render.settings, session.scene_ref(job.scene), scene_flags);
         let lobe_line = super::metadata::lobe_model_line(&job.render.settings, session.scene_ref(job.scene));
+        let emission = emission_line(session.scene_ref(job.scene).largest_emission(), &job.render.image);
         let cache_dir = session.pipeline_cache_dir.clone();
         let renderer = session.renderer_mut(job.renderer);
         let created = renderer.take_created_pipelines();
@@ -248,6 +249,9 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
             job.render.image.covered_count()
         );
         eprintln!("sunshade: {camera_line}");
+        if let Some(line) = &emission {
+            eprintln!("sunshade: {line}");
+        }
         if let Some(line) = sun_position {
             eprintln!("sunshade: {line}");
         }
@@ -335,4 +339,16 @@ fn run_accumulation(session: &mut Session, a: &RenderArgs, started: Instant) -> 
         &session.renderer_description(renderer),
         a.verbose.then_some((&phases[..], started)),
     )
+}
+
+/// `-v`'s note where the scene emits but its brightest emission is under 1% of the image's peak (invisible beside
+/// the reflected light): how to make it visible.
+fn emission_line(largest_emission: f32, image: &crate::Image) -> Option<String> {
+    let peak = image.pixels().iter().flat_map(|p| p[..3].iter().copied()).fold(0.0f32, f32::max);
+    (largest_emission > 0.0 && largest_emission < 0.01 * peak).then(|| {
+        format!(
+            "emission: at most {largest_emission:.3e} W/(m²·sr), under 1% of the image's peak {peak:.3e}: \
+             --emission-scale S gives S W/(m²·sr) per unit emissiveFactor"
+        )
+    })
 }

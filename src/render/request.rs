@@ -66,6 +66,9 @@ pub fn load(a: &SceneArgs) -> Result<(Scene, Duration), RenderError> {
     if let Some(lookup) = a.merl_lookup {
         scene.set_measured_lookup(lookup);
     }
+    if let Some(scale) = a.emission_scale {
+        scene.scale_emission(scale as f32);
+    }
     let load_time = t.elapsed();
     for w in &scene.warnings {
         warn(&format!("{}: {w}", a.scene.display()));

@@ -100,6 +100,24 @@ impl Scene {
         }
     }
 
+    /// Multiplies every material's emitted radiance by `scale` (`--emission-scale`: W/(m²·sr) per unit of glTF's
+    /// emissive factor).
+    pub fn scale_emission(&mut self, scale: f32) {
+        for m in &mut self.materials {
+            m.emission = m.emission.map(|e| e * scale);
+        }
+    }
+
+    /// The largest emitted radiance [W/(m²·sr)] of any channel of any material a mesh uses (an emissive texture
+    /// only multiplies it by at most 1).
+    pub fn largest_emission(&self) -> f32 {
+        self.meshes
+            .iter()
+            .filter_map(|mesh| self.materials.get(mesh.material))
+            .flat_map(|m| m.emission)
+            .fold(0.0, f32::max)
+    }
+
     /// Gives every material the measured BRDF `table` (`--merl`), read with `lookup`: its textures and factors
     /// no longer set the BRDF (emission, normal maps and alpha still apply).
     pub fn use_measured(&mut self, table: &measured::SharedMeasuredBrdf, lookup: measured::MeasuredLookup) {

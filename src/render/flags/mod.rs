@@ -266,8 +266,9 @@ pub struct SceneArgs {
     #[arg(help_heading = "Disk lights and sky", long, value_parser = parse_radiance, value_name = "L0|R,G,B")]
     pub sky_radiance: Option<[f64; 3]>,
 
-    /// Map every material's glTF metallic-roughness onto this BRDF (docs/brdf.md); `lambert` forces Lambert.
-    #[arg(help_heading = "Materials", long, value_name = "lambert|phong|blinn-phong|ward")]
+    /// Map every material's glTF metallic-roughness onto this BRDF (docs/brdf.md); `gltf` is the glTF
+    /// specification's own, `lambert` forces Lambert.
+    #[arg(help_heading = "Materials", long, value_name = "lambert|phong|blinn-phong|ward|gltf")]
     pub brdf: Option<BrdfKind>,
 
     /// Give every material this measured BRDF: a MERL `.binary` file (docs/measured.md).
@@ -278,6 +279,12 @@ pub struct SceneArgs {
     /// below, as the database's own reader does (docs/measured.md compares them).
     #[arg(help_heading = "Materials", long, value_name = "linear|nearest")]
     pub merl_lookup: Option<crate::shading::measured::MeasuredLookup>,
+
+    /// Emitted radiance [W/(m²·sr)] per unit of glTF's `emissiveFactor` (times KHR_materials_emissive_strength and
+    /// the emissive texture); 1 by default, which the default sun (about 300 W/(m²·sr) off a white surface)
+    /// outshines: `-v` says when the scene's emission is under 1% of the image's peak.
+    #[arg(help_heading = "Materials", long, value_parser = parse_non_negative, value_name = "W/(m²·sr)")]
+    pub emission_scale: Option<f64>,
 
     /// Samples for integrating specular lobes over disk lights and the sky (a stratified grid; rounded up to a
     /// square).
