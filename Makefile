@@ -97,11 +97,11 @@ images: build
 		VertexColorTest/VertexColorTest.glb; do \
 		n=$$(basename $${m%.*}); \
 		$(SUNSHADE) render models/gltf-samples/$$m -o docs/images/sample-$$n.png --width 320 --height 240 \
-			--sun-dir -1,1.2,1.5 -q || exit 1; \
+			--sun-dir -1,1.2,1.5 --sky-radiance 100 -q || exit 1; \
 	done; \
 	$(SUNSHADE) render models/gltf-samples/AlphaBlendModeTest/AlphaBlendModeTest.glb \
 		-o docs/images/sample-AlphaBlendModeTest.png --width 320 --height 240 --sun-dir -1,1.2,1.5 \
-		--eye 0,1.6,7.5 --target 0,0.9,0 -q
+		--sky-radiance 100 --eye 0,1.6,7.5 --target 0,0.9,0 -q
 
 # Regenerates the generated scenes in models/.
 models:
