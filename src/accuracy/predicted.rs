@@ -289,6 +289,19 @@ pub fn predict(scene: &Scene, settings: &RenderSettings, renderer: Renderer, can
     predict_with_peak(scene, settings, renderer, can_occlude, None, None)
 }
 
+/// [`predict`] for the GPU's pixels where the pixels of the lobes flagged in `refined_lobes` ([`Choice`]) are
+/// refined on the reference: their sun terms are not the image's (the refined pixels' claim is,
+/// [`Prediction::add_refined_pixels`]).
+pub fn predict_refining(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    refined_lobes: &[bool],
+) -> Prediction {
+    predict_terms(scene, settings, renderer, can_occlude, (None, None), refined_lobes)
+}
+
 /// [`predict`], where a delta sun's render is known to peak at `rendered` [W/(m²·sr)] (its own image's peak): the
 /// horizon term is then taken against that peak (`horizon_terms`) instead of the material's own response.
 /// `lobes`: the refinement's estimate of the lobe grids under disk lights and the sky where one was made
@@ -300,6 +313,18 @@ pub fn predict_with_peak(
     can_occlude: bool,
     rendered: Option<f64>,
     lobes: Option<&LobeEstimate>,
+) -> Prediction {
+    predict_terms(scene, settings, renderer, can_occlude, (rendered, lobes), &[])
+}
+
+/// [`predict_with_peak`]'s terms, the sun's of the lobes flagged in `refined_lobes` left out ([`predict_refining`]).
+fn predict_terms(
+    scene: &Scene,
+    settings: &RenderSettings,
+    renderer: Renderer,
+    can_occlude: bool,
+    (rendered, lobes): (Option<f64>, Option<&LobeEstimate>),
+    refined_lobes: &[bool],
 ) -> Prediction {
     if settings.shading.quantity == Quantity::Irradiance {
         return predict_irradiance(settings, renderer, can_occlude);
@@ -326,6 +351,13 @@ pub fn predict_with_peak(
             (SunModel::Disk, _) => format!("disk sun {}²", m.sun_samples_per_axis),
         };
         for (i, (brdf, m)) in brdfs.iter().zip(&models).enumerate() {
+            if refined_lobes.get(i) == Some(&true) {
+                p.terms.push((
+                    format!("{}: no sun grid reaches the tolerance, its pixels refined:", brdf_name(brdf)),
+                    0.0,
+                ));
+                continue;
+            }
             let horizon = horizons.as_ref().map_or(0.0, |h| h[i]);
             let b = sun_bound(brdf, m, r, horizon, angles);
             p.terms.push((format!("{}, {}:", model(m), brdf_name(brdf)), b));
@@ -448,12 +480,27 @@ fn occlusion_and_arithmetic(
 pub struct Choice {
     pub shading: ShadingOptions,
     pub sun_per_material: Vec<Option<SunChoice>>,
+    /// Per lobe of the scene (`scene_brdfs`' order), whether no sun grid up to 64² reaches the tolerance, so
+    /// that its materials' pixels are refined on the reference (only where the caller refines pixels:
+    /// [`choose_sun_for_bounded_pixels`]); empty where none is.
+    pub refined_lobes: Vec<bool>,
 }
 
 impl Choice {
     /// The same models for every material.
     fn uniform(shading: ShadingOptions) -> Self {
-        Self { shading, sun_per_material: Vec::new() }
+        Self { shading, sun_per_material: Vec::new(), refined_lobes: Vec::new() }
+    }
+
+    /// Per material of `scene`, whether its lobe is one of [`Choice::refined_lobes`].
+    pub fn refined_materials(&self, scene: &Scene) -> Vec<bool> {
+        if !self.refined_lobes.contains(&true) {
+            return Vec::new();
+        }
+        let brdfs = scene_brdfs(scene);
+        (0..scene.materials.len())
+            .map(|m| lobe_of(scene, &brdfs, m).is_some_and(|i| self.refined_lobes.get(i) == Some(&true)))
+            .collect()
     }
 
     /// Renders with these models from now on.
@@ -605,12 +652,13 @@ pub(crate) fn choose_sun_within(
         ));
     }
     let shading = techniques_within(settings, renderer, can_occlude, false, tolerance)?;
-    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), tolerance, delta_peak)
+    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), (tolerance, false), delta_peak)
 }
 
 /// `--tolerance` where the pixels no bound covers are refined on the reference (`render::refined_pixels`): the
 /// disk lights' exact model, and the sun's models of the analytic lobes as [`choose_sun_within`] chooses them; a
-/// measured material's pixels and the light of the sky through occluders are the refined pixels' part.
+/// measured material's pixels, the light of the sky through occluders and the pixels of a lobe too narrow for any
+/// sun grid ([`Choice::refined_lobes`], a near-mirror metal) are the refined pixels' part.
 pub(crate) fn choose_sun_for_bounded_pixels(
     scene: &Scene,
     settings: &RenderSettings,
@@ -619,7 +667,7 @@ pub(crate) fn choose_sun_for_bounded_pixels(
     tolerance: f64,
 ) -> Result<Choice, String> {
     let shading = techniques_within(settings, renderer, can_occlude, true, tolerance)?;
-    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), tolerance, None)
+    choose_sun_of_lobes(scene, settings, shading, (renderer, can_occlude), (tolerance, true), None)
 }
 
 /// Whether the pixels of material `material` have no derived bound under the lights of `settings`, so that
@@ -645,7 +693,7 @@ fn choose_sun_of_lobes(
     settings: &RenderSettings,
     mut shading: ShadingOptions,
     (renderer, can_occlude): (Renderer, bool),
-    tolerance: f64,
+    (tolerance, refine_unreachable): (f64, bool),
     delta_peak: Option<f64>,
 ) -> Result<Choice, String> {
     let lights = &settings.lights;
@@ -657,6 +705,7 @@ fn choose_sun_of_lobes(
     let horizons = horizon_terms(scene, settings, arithmetic, delta_peak);
     let brdfs = scene_brdfs(scene);
     let mut chosen = Vec::with_capacity(brdfs.len());
+    let mut refined_lobes = vec![false; brdfs.len()];
     for (i, brdf) in brdfs.iter().enumerate() {
         let bound =
             |s: &ShadingOptions| sun_bound(brdf, s, r, horizons.as_ref().map_or(0.0, |h| h[i]), angles) + arithmetic;
@@ -673,6 +722,12 @@ fn choose_sun_of_lobes(
             bound(&s) <= tolerance
         });
         let Some(k) = grid else {
+            if refine_unreachable {
+                // Its pixels are taken from the reference; the GPU's grid for them is the cheapest.
+                refined_lobes[i] = true;
+                chosen.push(SunChoice { sun: SunModel::Disk, sun_samples_per_axis: MIN_GRID_FOR_BOUND });
+                continue;
+            }
             return Err(format!(
                 "--tolerance {tolerance:e}: the sun's bound for {} is {:.1e} at {MAX_TOLERANCE_SUN_GRID}² samples, \
                  over the tolerance (the lobe is too narrow for the sun's grid; docs/accuracy.md, \"Error bounds\")",
@@ -685,12 +740,13 @@ fn choose_sun_of_lobes(
     let finest = chosen.iter().filter(|c| c.sun == SunModel::Disk).map(|c| c.sun_samples_per_axis).max();
     shading.sun = if finest.is_some() { SunModel::Disk } else { SunModel::Delta };
     shading.sun_samples_per_axis = finest.unwrap_or(shading.sun_samples_per_axis);
+    let refined_lobes = if refined_lobes.contains(&true) { refined_lobes } else { Vec::new() };
     if chosen.windows(2).all(|w| w[0] == w[1]) {
-        return Ok(Choice::uniform(shading));
+        return Ok(Choice { refined_lobes, ..Choice::uniform(shading) });
     }
     // Each material gets its lobe's choice.
     let sun_per_material = (0..scene.materials.len()).map(|m| lobe_of(scene, &brdfs, m).map(|i| chosen[i])).collect();
-    Ok(Choice { shading, sun_per_material })
+    Ok(Choice { shading, sun_per_material, refined_lobes })
 }
 
 /// What `--tolerance`'s choice and a render's prediction are for: the scene, the renderer whose error is

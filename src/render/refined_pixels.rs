@@ -35,8 +35,8 @@ use super::RenderError;
 use crate::accuracy::converged::{refine, with_exact_models, ConvergenceOptions, Criterion};
 use crate::accuracy::interpolation::f32_interpolation_bound;
 use crate::accuracy::predicted::{
-    choose_sun_for_bounded_pixels, material_unbounded, predict, Barycentrics, Prediction, Renderer as Predicted,
-    Request,
+    choose_sun_for_bounded_pixels, material_unbounded, predict_refining, Barycentrics, Prediction,
+    Renderer as Predicted, Request,
 };
 use crate::accuracy::trial::Tolerance;
 use crate::compare::default_floor;
@@ -66,13 +66,24 @@ pub struct Refined {
 }
 
 /// Whether `--tolerance` (`tolerance`) takes this path: it holds in penumbrae in a scene that shadows itself with
-/// shadow rays, or some material's pixels have no bound under its lights.
+/// shadow rays, or some material's pixels have no bound under its lights, or some lobe is too narrow for every sun
+/// grid ([`Choice::refined_lobes`](crate::accuracy::predicted::Choice)).
 pub fn wanted(request: Request, settings: &RenderSettings, tolerance: Tolerance) -> bool {
     let penumbrae = tolerance.in_penumbrae
         && request.can_occlude()
         && settings.shading.shadows == Shadows::Ray
         && !settings.lights.is_empty();
-    penumbrae || any_mesh_of(request.scene, &unbounded_materials(request.scene, settings))
+    let scene = request.scene;
+    penumbrae
+        || any_mesh_of(scene, &unbounded_materials(scene, settings))
+        || choose_sun_for_bounded_pixels(
+            scene,
+            settings,
+            request.renderer,
+            request.can_occlude(),
+            tolerance.max_relative,
+        )
+        .is_ok_and(|c| c.refined_lobes.contains(&true))
 }
 
 /// For each material of `scene`, whether its pixels have no derived bound under `settings`' lights
@@ -116,10 +127,11 @@ pub fn render(
         _ => None,
     };
     let gpu_share = t - 1.5 * f32_bound.unwrap_or(0.0);
-    choose_sun_for_bounded_pixels(scene, settings, request.renderer, can_occlude, gpu_share)
-        .map_err(RenderError::Usage)?
-        .apply(settings);
-    let mut prediction = predict(scene, settings, request.renderer, can_occlude);
+    let choice = choose_sun_for_bounded_pixels(scene, settings, request.renderer, can_occlude, gpu_share)
+        .map_err(RenderError::Usage)?;
+    let (refined_lobes, too_narrow) = (choice.refined_lobes.clone(), choice.refined_materials(scene));
+    choice.apply(settings);
+    let mut prediction = predict_refining(scene, settings, request.renderer, can_occlude, &refined_lobes);
     if let Some(bound) = f32_bound {
         prediction.add_f32_bound(bound);
     }
@@ -141,7 +153,10 @@ pub fn render(
             (Image::new(settings.width, settings.height), FrameTimings::default(), vec![true; n])
         }
     };
-    let unbounded = unbounded_materials(scene, settings);
+    let mut unbounded = unbounded_materials(scene, settings);
+    for (flag, narrow) in unbounded.iter_mut().zip(&too_narrow) {
+        *flag |= narrow;
+    }
     if any_mesh_of(scene, &unbounded) {
         let materials = cpu::material_map(scene, settings, reference);
         for (flag, m) in selected.iter_mut().zip(materials) {
