@@ -482,7 +482,7 @@ pub struct Choice {
     pub sun_per_material: Vec<Option<SunChoice>>,
     /// Per lobe of the scene (`scene_brdfs`' order), whether no sun grid up to 64² reaches the tolerance, so
     /// that its materials' pixels are refined on the reference (only where the caller refines pixels:
-    /// [`choose_sun_for_bounded_pixels`]); empty where none is.
+    /// `choose_sun_for_bounded_pixels`); empty where none is.
     pub refined_lobes: Vec<bool>,
 }
 
