@@ -11,7 +11,7 @@
 mod common;
 
 use common::{CheckedRenderer, TempDir};
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DVec3, Vec3};
 use serde_json::json;
 use std::f64::consts::PI;
 use sunshade::authoring::shapes::quad;
@@ -42,17 +42,6 @@ fn specification(n: DVec3, l: DVec3, v: DVec3, base: [f64; 3], metallic: f64, ro
         let dielectric = (1.0 - fr) * c / PI + fr * vis * d;
         (1.0 - metallic) * dielectric + metallic * metal
     })
-}
-
-/// A ray through the point (x, y) of the window [pixels]: origin and unit direction, from the f64 camera matrix.
-fn pixel_ray(inv: &DMat4, x: f64, y: f64, w: u32, h: u32) -> (DVec3, DVec3) {
-    let ndc = DVec3::new(x / w as f64 * 2.0 - 1.0, y / h as f64 * 2.0 - 1.0, 0.0);
-    let unproject = |z: f64| {
-        let p = *inv * DVec4::new(ndc.x, ndc.y, z, 1.0);
-        p.truncate() / p.w
-    };
-    let (a, b) = (unproject(0.0), unproject(0.5));
-    (a, (b - a).normalize())
 }
 
 /// A 4 × 4 m square through the origin with normal `normal` (+Z or +Y), of a glTF metallic-roughness material.
@@ -91,7 +80,7 @@ fn worst_against(
             if !image.covered(x, y) {
                 continue;
             }
-            let (o, d) = pixel_ray(&inv, x as f64 + 0.5, y as f64 + 0.5, w, h);
+            let (o, d) = common::pixel_ray(&inv, x as f64 + 0.5, y as f64 + 0.5, w, h);
             let t = -o.dot(plane_normal) / d.dot(plane_normal);
             expected.push(((x, y), want(o + t * d, -d)));
         }

@@ -169,17 +169,6 @@ fn square_in_perspective_covers_its_projected_area() {
     }
 }
 
-/// A ray through a pixel centre: origin and direction in world space, from the f64 camera matrices.
-fn pixel_ray(inv: &DMat4, x: f64, y: f64, w: u32, h: u32) -> (DVec3, DVec3) {
-    let ndc = DVec3::new(x / w as f64 * 2.0 - 1.0, y / h as f64 * 2.0 - 1.0, 0.0);
-    let unproject = |z: f64| {
-        let p = *inv * DVec4::new(ndc.x, ndc.y, z, 1.0);
-        p.truncate() / p.w
-    };
-    let (a, b) = (unproject(0.0), unproject(0.5));
-    (a, (b - a).normalize())
-}
-
 /// The face (axis, sign) of the cube [-0.5, 0.5]³ a local-space ray enters first, if it hits.
 fn cube_face(origin: DVec3, dir: DVec3) -> Option<(usize, i32)> {
     let (mut t0, mut t1, mut face) = (f64::NEG_INFINITY, f64::INFINITY, None);
@@ -223,7 +212,7 @@ fn turned_cube_faces_are_constant_and_analytic() {
     let (to_local, rot) = (model.inverse(), DQuat::from_array(rotation.to_array().map(f64::from)));
     let inv = s.camera.clip_from_world(s.aspect()).inverse();
     let face_at = |x: f64, y: f64| {
-        let (o, d) = pixel_ray(&inv, x, y, 300, 300);
+        let (o, d) = common::pixel_ray(&inv, x, y, 300, 300);
         cube_face(to_local.transform_point3(o), to_local.transform_vector3(d))
     };
     let mut per_face = std::collections::HashMap::new();

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::{DMat4, DVec3, DVec4};
 use sunshade::authoring::GltfBuilder;
 use sunshade::scene::Scene;
 use sunshade::Image;
@@ -183,4 +184,16 @@ pub fn sliced(model: &str, (width, height): (u32, u32), k: u32) -> (Scene, sunsh
     s.shading.shadow_samples_per_axis = k;
     s.shading.visibility_rule = sunshade::shading::VisibilityRule::Slices;
     (scene, s)
+}
+
+/// A ray through the point (x, y) of a w × h window [pixels]: origin and unit direction in world space, from the
+/// inverse `inv` of the f64 clip-from-world matrix.
+pub fn pixel_ray(inv: &DMat4, x: f64, y: f64, w: u32, h: u32) -> (DVec3, DVec3) {
+    let ndc = DVec3::new(x / w as f64 * 2.0 - 1.0, y / h as f64 * 2.0 - 1.0, 0.0);
+    let unproject = |z: f64| {
+        let p = *inv * DVec4::new(ndc.x, ndc.y, z, 1.0);
+        p.truncate() / p.w
+    };
+    let (a, b) = (unproject(0.0), unproject(0.5));
+    (a, (b - a).normalize())
 }
