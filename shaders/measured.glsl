@@ -1,6 +1,6 @@
 // Measured (MERL) BRDFs in f32. Mirrors src/shading/measured.rs name for name (conventions and precision notes
 // there): Rusinkiewicz's angles by atan2 of |a x b| and a.b, the table's coordinates with samples at the bins'
-// lower edges, and a trilinear (default) or nearest lookup in the same order as the Rust.
+// centres, and a trilinear lookup over the valid corners (default) or nearest, in the same order as the Rust.
 #ifndef SUNSHADE_MEASURED_GLSL
 #define SUNSHADE_MEASURED_GLSL
 
@@ -43,14 +43,23 @@ vec3 measured_coordinates(float theta_h, float theta_d, float phi_d) {
     return vec3(u_h, u_d, u_phi >= float(PHI_D_BINS) ? 0.0 : u_phi);
 }
 
-// (i, next, t) on an axis of `bins` samples: the sample below u, the one after (the last held, or the first where
-// periodic) and the fraction past i.
+// (i, next, t) on an axis of `bins` samples, sample i at u = i + 1/2: the sample below u, the one after (the
+// theta axes hold their first and last samples; phi wraps from its last to its first) and the fraction past i.
 vec3 measured_axis(float u, uint bins, bool periodic) {
     uint last = bins - 1u;
-    uint i = min(uint(max(floor(u), 0.0)), last);
-    float t = clamp(u - float(i), 0.0, 1.0);
+    float s = u - 0.5;
+    if (periodic && s < 0.0) {
+        s += float(bins);
+    }
+    uint i = min(uint(max(floor(s), 0.0)), last);
+    float t = clamp(s - float(i), 0.0, 1.0);
     uint next = i < last ? i + 1u : (periodic ? 0u : last);
     return vec3(float(i), float(next), t);
+}
+
+// The bin u falls in (truncation): the sample whose centre is nearest.
+float measured_bin(float u, uint bins) {
+    return float(min(uint(max(floor(u), 0.0)), bins - 1u));
 }
 
 // a + t (b - a), in that order (GLSL's mix may be a (1 - t) + b t).
@@ -58,14 +67,27 @@ vec3 lerp(vec3 a, vec3 b, float t) {
     return a + t * (b - a);
 }
 
-// The table's rgb at bins (i, j, k) of the table starting at sample `offset` of measured_values[].
+vec4 lerp4(vec4 a, vec4 b, float t) {
+    return a + t * (b - a);
+}
+
+// The table's rgb at bins (i, j, k) of the table starting at sample `offset` of measured_values[] (a missing
+// sample's: its nearest valid sample's).
 vec3 measured_sample(uint offset, float i, float j, float k) {
     uint index = uint(k) + PHI_D_BINS * (uint(j) + THETA_D_BINS * uint(i));
     return measured_values[offset + index].rgb;
 }
 
+// (a rho, a) at bins (i, j, k): a (the stored alpha) 1 for a valid sample, 0 for a missing one.
+vec4 measured_weighted_sample(uint offset, float i, float j, float k) {
+    uint index = uint(k) + PHI_D_BINS * (uint(j) + THETA_D_BINS * uint(i));
+    vec4 s = measured_values[offset + index];
+    return vec4(s.rgb * s.a, s.a);
+}
+
 // rho [1/sr] per channel of the table at `offset` for light from l seen from v about n (0 below the horizon);
-// `nearest` truncates to the bin, else trilinear (along phi, then theta_d, then theta_h).
+// `nearest` truncates to the bin, else trilinear over the valid corners (along phi, then theta_d, then theta_h),
+// renormalised, or over the held values where no corner is valid.
 vec3 measured_brdf(uint offset, bool nearest, vec3 n, vec3 l, vec3 v) {
     if (!(dot(n, l) > 0.0 && dot(n, v) > 0.0)) {
         return vec3(0.0);
@@ -75,11 +97,20 @@ vec3 measured_brdf(uint offset, bool nearest, vec3 n, vec3 l, vec3 v) {
         return vec3(0.0);
     }
     vec3 u = measured_coordinates(a.x, a.y, a.z);
+    if (nearest) {
+        float i = measured_bin(u.x, THETA_H_BINS);
+        return measured_sample(offset, i, measured_bin(u.y, THETA_D_BINS), measured_bin(u.z, PHI_D_BINS));
+    }
     vec3 h = measured_axis(u.x, THETA_H_BINS, false);
     vec3 d = measured_axis(u.y, THETA_D_BINS, false);
     vec3 p = measured_axis(u.z, PHI_D_BINS, true);
-    if (nearest) {
-        return measured_sample(offset, h.x, d.x, p.x);
+    vec4 w00 = lerp4(measured_weighted_sample(offset, h.x, d.x, p.x), measured_weighted_sample(offset, h.x, d.x, p.y), p.z);
+    vec4 w01 = lerp4(measured_weighted_sample(offset, h.x, d.y, p.x), measured_weighted_sample(offset, h.x, d.y, p.y), p.z);
+    vec4 w10 = lerp4(measured_weighted_sample(offset, h.y, d.x, p.x), measured_weighted_sample(offset, h.y, d.x, p.y), p.z);
+    vec4 w11 = lerp4(measured_weighted_sample(offset, h.y, d.y, p.x), measured_weighted_sample(offset, h.y, d.y, p.y), p.z);
+    vec4 weighted = lerp4(lerp4(w00, w01, d.z), lerp4(w10, w11, d.z), h.z);
+    if (weighted.a > 0.0) {
+        return weighted.rgb / weighted.a;
     }
     vec3 h0d0 = lerp(measured_sample(offset, h.x, d.x, p.x), measured_sample(offset, h.x, d.x, p.y), p.z);
     vec3 h0d1 = lerp(measured_sample(offset, h.x, d.y, p.x), measured_sample(offset, h.x, d.y, p.y), p.z);

@@ -1,6 +1,7 @@
 //! `sunshade tabulate-brdf --model M ... -o FILE.binary`: an analytic BRDF written as a MERL table, sampled at
-//! each bin's lower edge as sunshade's lookup places its samples (`shading::measured`). For testing measured
-//! materials against their analytic source, and for comparing lookups (docs/measured.md).
+//! each bin's centre, where sunshade's lookup places its samples (`shading::measured`), and missing (negative)
+//! where the light or the view is below the horizon, as the database's files are. For testing measured materials
+//! against their analytic source, and for comparing lookups (docs/measured.md).
 
 use std::io::Write;
 use std::path::PathBuf;

@@ -315,8 +315,9 @@ pub struct PushConstants {
 }
 
 /// The measured buffer's floats (binding 11): each distinct table the materials use once (materials naming the
-/// same file share its `Arc`, and here its one copy), one after another, each sample as RGBA (A unused: one 16-byte
-/// load per sample, measured 20–24% faster frames on lavapipe than three scalar loads, for 4/3 the memory); and per
+/// same file share its `Arc`, and here its one copy), one after another, each sample as RGBA (A: 1 for a valid
+/// sample, 0 for a missing one, the linear lookup's weight; one 16-byte load per sample, measured 20–24% faster
+/// frames on lavapipe than three scalar loads, for 4/3 the memory); and per
 /// material the offset \[samples\] of its table (0 for the others). One zero sample where no material is measured
 /// (a binding needs a buffer).
 pub fn measured_tables(materials: &[Material]) -> (Vec<f32>, Vec<u32>) {
@@ -329,7 +330,9 @@ pub fn measured_tables(materials: &[Material]) -> (Vec<f32>, Vec<u32>) {
                 Some(&(_, offset)) => offset,
                 None => {
                     let offset = (data.len() / 4) as u32;
-                    data.extend(table.values.chunks_exact(3).flat_map(|rgb| [rgb[0], rgb[1], rgb[2], 0.0]));
+                    let valid = |i: usize| if table.is_missing(i) { 0.0 } else { 1.0 };
+                    let samples = table.values.chunks_exact(3).enumerate();
+                    data.extend(samples.flat_map(|(i, rgb)| [rgb[0], rgb[1], rgb[2], valid(i)]));
                     seen.push((table, offset));
                     offset
                 }

@@ -61,6 +61,7 @@ pub fn load(a: &SceneArgs) -> Result<(Scene, Duration), RenderError> {
     }
     if let Some(path) = &a.merl {
         let table = scene::measured::read_merl_file(path).map_err(|e| RenderError::Failure(anyhow::anyhow!(e)))?;
+        scene.warnings.extend(table.missing_warning());
         scene.use_measured(&std::sync::Arc::new(table), a.merl_lookup.unwrap_or_default());
     }
     if let Some(lookup) = a.merl_lookup {

@@ -287,13 +287,7 @@ impl MaterialReader<'_> {
                         .map_err(|e| format!("MERL BRDF {e}"))?,
                 };
                 let table = SharedMeasuredBrdf::new(parse_merl(uri, &bytes)?);
-                if table.missing > 0 {
-                    self.warnings.push(format!(
-                        "{uri}: {} of {} samples are missing (negative in the file); they are taken as 0",
-                        table.missing,
-                        3 * super::measured::MERL_SAMPLES
-                    ));
-                }
+                self.warnings.extend(table.missing_warning());
                 self.measured.insert(uri.to_string(), table.clone());
                 table
             }
