@@ -144,6 +144,7 @@ struct MaterialGpu {
     vec4 base;   // base colour factor (rgb linear, alpha); glTF's lobe reads the pixel's (surface.glsl)
     vec4 pbr;    // x metallic, y roughness factors; z normal-map scale; w alpha cutoff
     vec4 emission; // rgb: emitted radiance [W/(m^2 sr)] before the emissive texture
+    vec4 specular; // glTF's dielectric Fresnel: rgb f0, w f90 (KHR_materials_ior and KHR_materials_specular)
     TextureRefGpu tex[4]; // TEX_BASE, TEX_METALLIC_ROUGHNESS, TEX_NORMAL, TEX_EMISSIVE
 };
 #define TEX_BASE 0
@@ -162,12 +163,12 @@ struct DiskGpu {
     vec4 radiance;      // rgb: L0 [W/(m^2 sr)]; w unused
 };
 
-// The materials (gpu::layout::MaterialGpu, 304 bytes) as RGBA32UI texels, nineteen a material (floats by their
-// bits): kd, ks, params, kind, base, pbr, emission, then each texture reference's row0, row1, texture. Read by
+// The materials (gpu::layout::MaterialGpu, 320 bytes) as RGBA32UI texels, twenty a material (floats by their
+// bits): kd, ks, params, kind, base, pbr, emission, specular, then each texture reference's row0, row1, texture. Read by
 // material_at: llvmpipe loads a storage buffer's words lane by lane even where every lane reads the same, and
 // fetches a texel in one gather (docs/platform.md, "Loads in the walks").
 layout(set = 0, binding = 0) uniform usamplerBuffer material_texels;
-#define MATERIAL_TEXELS 19u
+#define MATERIAL_TEXELS 20u
 MaterialGpu material_at(uint m) {
     int at = int(MATERIAL_TEXELS * m);
     MaterialGpu g;
@@ -178,11 +179,12 @@ MaterialGpu material_at(uint m) {
     g.base = uintBitsToFloat(texelFetch(material_texels, at + 4));
     g.pbr = uintBitsToFloat(texelFetch(material_texels, at + 5));
     g.emission = uintBitsToFloat(texelFetch(material_texels, at + 6));
+    g.specular = uintBitsToFloat(texelFetch(material_texels, at + 7));
     // The four references written out, not looped over: llvmpipe's loop budget counts a loop's iterations.
 #define MATERIAL_TEXTURE_REF(k) \
-    g.tex[k].row0 = uintBitsToFloat(texelFetch(material_texels, at + 7 + 3 * k)); \
-    g.tex[k].row1 = uintBitsToFloat(texelFetch(material_texels, at + 8 + 3 * k)); \
-    g.tex[k].texture = texelFetch(material_texels, at + 9 + 3 * k);
+    g.tex[k].row0 = uintBitsToFloat(texelFetch(material_texels, at + 8 + 3 * k)); \
+    g.tex[k].row1 = uintBitsToFloat(texelFetch(material_texels, at + 9 + 3 * k)); \
+    g.tex[k].texture = texelFetch(material_texels, at + 10 + 3 * k);
     MATERIAL_TEXTURE_REF(0)
     MATERIAL_TEXTURE_REF(1)
     MATERIAL_TEXTURE_REF(2)

@@ -55,7 +55,7 @@ float specular_lobe(MaterialGpu m, Frame p, vec3 l) {
         return (rgb.r + rgb.g + rgb.b) / 3.0;
     }
     case BRDF_GLTF: {
-        vec3 rgb = gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x);
+        vec3 rgb = gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x, m.specular.rgb, m.specular.w);
         return (rgb.r + rgb.g + rgb.b) / 3.0;
     }
     }
@@ -69,7 +69,7 @@ vec3 specular_lobe_rgb(MaterialGpu m, Frame p, vec3 l) {
     case BRDF_MEASURED:
         return measured_residual(m, p.normal, l, p.to_viewer);
     case BRDF_GLTF:
-        return gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x);
+        return gltf_lobe_rgb(p.normal, l, p.to_viewer, m.base.rgb, m.params.y, m.params.x, m.specular.rgb, m.specular.w);
     case BRDF_LAMBERT:
     case BRDF_PHONG:
     case BRDF_BLINN_PHONG:
@@ -132,7 +132,8 @@ vec3 lobe_sample(MaterialGpu m, Frame p, vec3 axis, vec3 t, vec3 b, float xi1, f
     case BRDF_MEASURED:
         return measured_lobe_sample(m, n, v, t, b, xi1, phi, omega);
     case BRDF_GLTF:
-        return gltf_lobe_sample(n, t, b, v, m.base.rgb, m.params.y, m.params.x, xi1, phi, omega);
+        return gltf_lobe_sample(n, t, b, v, m.base.rgb, m.params.y, m.params.x, m.specular.rgb, m.specular.w, xi1, phi,
+                                omega);
     }
     omega = n;
     return vec3(0.0);

@@ -61,8 +61,10 @@ MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metalli
         m.params = vec4(vec2(alpha), 0.0, 0.0);
         break;
     case BRDF_GLTF: {
-        // Its own model (shading::brdf::gltf): kd = (1 - m)(1 - 0.04) base, ks = 1, and the lobe's parameters.
-        precise vec3 gltf_kd = base * (1.0 - mm) * 0.96;
+        // Its own model (shading::brdf::metallic_roughness): kd = (1 - m)(1 - max f0) base, ks = 1, and the lobe's
+        // parameters (f0 and f90 stay the material's).
+        precise float keep = 1.0 - max(max(m.specular.r, m.specular.g), m.specular.b);
+        precise vec3 gltf_kd = base * (1.0 - mm) * keep;
         m.kd = vec4(gltf_kd, 0.0);
         m.ks = vec4(1.0, 1.0, 1.0, 0.0);
         m.params = vec4(alpha, mm, 0.0, 0.0);

@@ -2,6 +2,7 @@
 //! and 89.9° incidence by converged quadrature), finite values at grazing angles and extreme exponents.
 
 use glam::DVec3;
+use sunshade::scene::material::DielectricSpecular;
 use sunshade::scene::Brdf;
 use sunshade::shading::albedo::lobe_albedo;
 use sunshade::shading::{specular_lobe, SurfacePoint};
@@ -22,7 +23,10 @@ fn specular_models() -> Vec<(String, Brdf)> {
     // glTF's white metal: its lobe is the whole BRDF, GGX with Fresnel 1 (its dielectric's lobe can be negative:
     // shading::brdf::metallic_roughness's tests).
     for a in [0.001f32, 0.01, 0.1, 0.5, 1.0] {
-        v.push((format!("glTF metal α={a}"), Brdf::Gltf { base_color: o, metallic: 1.0, alpha: a }));
+        v.push((
+            format!("glTF metal α={a}"),
+            Brdf::Gltf { base_color: o, metallic: 1.0, alpha: a, specular: DielectricSpecular::DEFAULT },
+        ));
     }
     v
 }

@@ -29,7 +29,12 @@ const E_PERP: f32 = 1000.0;
 fn material(double_sided: bool) -> Material {
     Material {
         double_sided,
-        pbr: MetallicRoughness { base_color: [1.0; 3], metallic: 0.0, roughness: 1.0 },
+        pbr: MetallicRoughness {
+            base_color: [1.0; 3],
+            metallic: 0.0,
+            roughness: 1.0,
+            specular: sunshade::scene::material::DielectricSpecular::DEFAULT,
+        },
         ..Material::with_brdf("white", Brdf::Lambert { albedo: [1.0; 3] })
     }
 }

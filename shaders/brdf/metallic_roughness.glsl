@@ -9,6 +9,11 @@
 
 #define GLTF_DIELECTRIC_F0 0.04
 
+// The largest of the dielectric's f0 over the channels.
+float f0_max(vec3 f0) {
+    return max(max(f0.r, f0.g), f0.b);
+}
+
 // 1 - v.h for unit l and v: |l - v|^2 / (2 (2 + |l + v|)), without cancellation where l = v.
 float one_minus_v_dot_h(vec3 l, vec3 v) {
     vec3 d = l - v;
@@ -44,18 +49,20 @@ float smith_visibility(float n_dot_l, float n_dot_v, float alpha) {
     return 1.0 / (one_l * one_v);
 }
 
-// The lobe per channel: D V ((1 - m) F_d + m F_m) - (1 - m)(1 - f0)(1 - v.h)^5 base/pi; 0 where l = -v.
-vec3 gltf_lobe_rgb(vec3 n, vec3 l, vec3 v, vec3 base, float metallic, float alpha) {
+// The lobe per channel: D V ((1 - m) F_d + m F_m) - (1 - m)(f90 - max f0)(1 - v.h)^5 base/pi, F_d = f0 + (f90 - f0)
+// (1 - v.h)^5 the dielectric's Fresnel (0.04 and 1 without KHR_materials_ior/specular); 0 where l = -v.
+vec3 gltf_lobe_rgb(vec3 n, vec3 l, vec3 v, vec3 base, float metallic, float alpha, vec3 f0, float f90) {
     vec3 h = l + v;
     if (dot(h, h) == 0.0) {
         return vec3(0.0);
     }
     float specular = ggx_distribution(n, h, alpha) * smith_visibility(dot(n, l), dot(n, v), alpha);
     float s = schlick_weight(one_minus_v_dot_h(l, v));
-    float dielectric_f = GLTF_DIELECTRIC_F0 + (1.0 - GLTF_DIELECTRIC_F0) * s;
     float m = metallic;
+    float darkening = (1.0 - m) * (f90 - f0_max(f0)) * s;
+    vec3 dielectric_f = f0 + (f90 - f0) * s;
     vec3 metal_f = base + (1.0 - base) * s;
-    return specular * ((1.0 - m) * dielectric_f + m * metal_f) - (1.0 - m) * (1.0 - GLTF_DIELECTRIC_F0) * s * base * INV_PI;
+    return specular * ((1.0 - m) * dielectric_f + m * metal_f) - darkening * base * INV_PI;
 }
 
 // The angular width [rad] about the lobe's peak over which the lights' grids crowd their samples: 2 alpha.
@@ -76,8 +83,8 @@ float gltf_half_vector_pdf(vec3 n, vec3 omega, vec3 v, float alpha) {
 
 // One sample of the sky's grid from the even mixture of GGX's half vector (phi < pi) and the cosine (the others),
 // weighted by lobe (n.w)+ / pdf_mix per channel (see the Rust). (n, t, b): the frame about the normal.
-vec3 gltf_lobe_sample(vec3 n, vec3 t, vec3 b, vec3 v, vec3 base, float metallic, float alpha, float xi1, float phi,
-                      out vec3 omega) {
+vec3 gltf_lobe_sample(vec3 n, vec3 t, vec3 b, vec3 v, vec3 base, float metallic, float alpha, vec3 f0, float f90,
+                      float xi1, float phi, out vec3 omega) {
     if (phi < PI) {
         float a2 = alpha * alpha;
         float tan2 = a2 * xi1 / (1.0 - xi1);
@@ -103,7 +110,7 @@ vec3 gltf_lobe_sample(vec3 n, vec3 t, vec3 b, vec3 v, vec3 base, float metallic,
         return vec3(0.0);
     }
     float pdf = 0.5 * gltf_half_vector_pdf(n, omega, v, alpha) + 0.5 * c * INV_PI;
-    return gltf_lobe_rgb(n, omega, v, base, metallic, alpha) * c / pdf;
+    return gltf_lobe_rgb(n, omega, v, base, metallic, alpha, f0, f90) * c / pdf;
 }
 
 #endif

@@ -329,7 +329,12 @@ pub fn sharpest_brdf(material: &Material, scene: &Scene) -> Brdf {
         BrdfKind::BlinnPhong => Brdf::BlinnPhong { kd, ks, exponent },
         BrdfKind::Ward => Brdf::Ward { kd, ks, alpha_x: alpha, alpha_y: alpha },
         // A white metal: the largest lobe of that α.
-        BrdfKind::Gltf => Brdf::Gltf { base_color: [1.0; 3], metallic: 1.0, alpha },
+        BrdfKind::Gltf => Brdf::Gltf {
+            base_color: [1.0; 3],
+            metallic: 1.0,
+            alpha,
+            specular: crate::scene::material::DielectricSpecular::DEFAULT,
+        },
     }
 }
 

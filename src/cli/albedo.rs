@@ -53,7 +53,10 @@ fn lobe(kind: &str, p: f64, q: f64) -> (String, Brdf) {
         "phong" => (format!("Phong e={p}"), Brdf::Phong { kd, ks, exponent: p as f32 }),
         "blinn-phong" => (format!("Blinn-Phong e={p}"), Brdf::BlinnPhong { kd, ks, exponent: p as f32 }),
         // A white metal: the GGX lobe with Fresnel 1, whose albedo below 1 is what single scattering loses.
-        "gltf" => (format!("glTF metal α={p}"), Brdf::Gltf { base_color: [1.0; 3], metallic: 1.0, alpha: p as f32 }),
+        "gltf" => {
+            let specular = crate::scene::material::DielectricSpecular::DEFAULT;
+            (format!("glTF metal α={p}"), Brdf::Gltf { base_color: [1.0; 3], metallic: 1.0, alpha: p as f32, specular })
+        }
         _ if p == q => (format!("Ward α={p}"), Brdf::Ward { kd, ks, alpha_x: p as f32, alpha_y: q as f32 }),
         _ => (format!("Ward αx={p} αy={q}"), Brdf::Ward { kd, ks, alpha_x: p as f32, alpha_y: q as f32 }),
     }
@@ -161,14 +164,33 @@ fn scene_table(materials: &[(String, Brdf)]) -> String {
         let (kd, ks) = match *brdf {
             Brdf::Lambert { albedo } => (albedo, [0.0; 3]),
             Brdf::Phong { kd, ks, .. } | Brdf::BlinnPhong { kd, ks, .. } | Brdf::Ward { kd, ks, .. } => (kd, ks),
-            Brdf::Gltf { base_color, metallic, alpha } => {
-                // Per channel: the base colour enters the lobe (the metal's Fresnel, the dielectric's darkening).
+            Brdf::Gltf { base_color, metallic, alpha, specular } => {
+                // Per channel: the base colour enters the lobe (the metal's Fresnel, the dielectric's darkening),
+                // and so does f0 (the dielectric's Fresnel).
                 s += &format!("| {name} (glTF) |");
                 for d in INCIDENCES_DEGREES {
-                    let a = base_color.map(|b| {
-                        let channel = Brdf::Gltf { base_color: [b; 3], metallic, alpha };
-                        let lobe = lobe_albedo(&channel, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0;
-                        channel.kd()[0] as f64 + lobe
+                    let albedo = |b: f32, f0: f32, f90: f32| {
+                        let specular = crate::scene::material::DielectricSpecular { f0: [f0; 3], f90 };
+                        let channel = Brdf::Gltf { base_color: [b; 3], metallic, alpha, specular };
+                        channel.kd()[0] as f64 + lobe_albedo(&channel, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0
+                    };
+                    let a: [f64; 3] = std::array::from_fn(|c| {
+                        let tinted = albedo(base_color[c], specular.f0[c], specular.f90);
+                        // The base keeps `1 − max F` of every channel, where the one-channel BRDF keeps its own:
+                        // the difference is `(1 − m) b (f0_c − max f0) (1 − X)`, `X = ∫ (1 − v·h)⁵ cos/π dω`, which
+                        // is `1 + A(0) − A(1)` for the albedos A of a dielectric with f0 0, f90 1, metallic 0 and
+                        // base 0 or 1.
+                        let gap = (specular.f0[c] - specular.f0_max()) as f64;
+                        if gap == 0.0 {
+                            return tinted;
+                        }
+                        let plain = |b: f32| {
+                            let specular = crate::scene::material::DielectricSpecular { f0: [0.0; 3], f90: 1.0 };
+                            let brdf = Brdf::Gltf { base_color: [b; 3], metallic: 0.0, alpha, specular };
+                            brdf.kd()[0] as f64 + lobe_albedo(&brdf, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0
+                        };
+                        let schlick = 1.0 + plain(0.0) - plain(1.0);
+                        tinted + (1.0 - metallic as f64) * base_color[c] as f64 * gap * (1.0 - schlick)
                     });
                     s += &format!(" {:.4}, {:.4}, {:.4} |", a[0], a[1], a[2]);
                 }
@@ -256,7 +278,32 @@ fn convergence_lobes() -> Vec<(String, Brdf)> {
         lobe("ward", 0.01, 0.01),
         lobe("ward", 0.2, 0.2),
         lobe("ward", 0.02, 0.3),
+        lobe("gltf", 0.01, 0.01),
+        lobe("gltf", 0.0625, 0.0625),
+        lobe("gltf", 0.25, 0.25),
+        lobe("gltf", 1.0, 1.0),
     ]
+}
+
+/// What `--tolerance` claims for the sun's grid (`accuracy::bounds`): the delta sun's bound and the k × k grid's, per
+/// lobe, for any camera, under the 0.53° sun.
+fn sun_bound_table() -> String {
+    use crate::accuracy::bounds::{sun_delta_bound, sun_grid_bound, SunViewAngles};
+    let r = 0.5 * 0.53f64.to_radians();
+    let mut s = "\n**The sun's bounds** that `--tolerance` chooses by (`src/accuracy/bounds.rs`; docs/accuracy.md, \
+                 \"Error bounds\"), for any camera, under the 0.53° sun: the delta sun's relative error bound against \
+                 the disk, and the graded grid's per size (1: no claim, a grid under 4² or cells wider than a quarter \
+                 of the lobe). The table above measures the same grids:\n\n"
+        .to_string();
+    s += &table_header(&["lobe (ks = 1)", "delta"], GRIDS.iter().map(|k| format!("{k}×{k}")));
+    for (name, brdf) in convergence_lobes() {
+        s += &format!("| {name} | {:.1e} |", sun_delta_bound(&brdf, r, SunViewAngles::ALL));
+        for &k in &GRIDS {
+            s += &format!(" {:.1e} |", sun_grid_bound(&brdf, r, k, SunViewAngles::ALL));
+        }
+        s += "\n";
+    }
+    s
 }
 
 /// Relative errors of the sampled integrals `∫ lobe (n·ω)+ dω` over each light, per grid size.
@@ -294,6 +341,7 @@ fn convergence_tables() -> String {
             .collect();
         s += &statistics_row(&name, &cases, 0.0);
     }
+    s += &sun_bound_table();
     // Disk skylights: the lecture's disk (R = 0.6 m at f = 2.5 m, facing down) over receivers on the floor within
     // 3 m of its axis, tilted up to ~35°, viewed from the mirror of a point within 1 m of the disk's centre (the
     // lobe's peak on the disk, near its rim or off it).

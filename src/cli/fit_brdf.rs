@@ -40,7 +40,7 @@ pub fn extras_snippet(brdf: &Brdf) -> Value {
         Brdf::Ward { kd, ks, alpha_x, .. } => {
             json!({ "brdf": "ward", "kd": rgb(kd), "ks": rgb(ks), "alpha": sig(alpha_x) })
         }
-        Brdf::Gltf { base_color, metallic, alpha } => json!({
+        Brdf::Gltf { base_color, metallic, alpha, .. } => json!({
             "brdf": "gltf", "base_color": rgb(base_color), "metallic": r(metallic), "roughness": sig(alpha.sqrt())
         }),
         Brdf::Measured { .. } => unreachable!("fits are analytic"),

@@ -254,6 +254,8 @@ pub struct MaterialGpu {
     pub pbr: [f32; 4],
     /// Emitted radiance [W/(m²·sr)] before the emissive texture.
     pub emission: [f32; 4],
+    /// glTF's dielectric Fresnel: f0 (rgb) and f90.
+    pub specular: [f32; 4],
     /// Base colour, metallic-roughness, normal, emissive.
     pub tex: [TextureRefGpu; 4],
 }
@@ -377,7 +379,16 @@ pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
         AlphaMode::Mask(c) => c,
         AlphaMode::Opaque | AlphaMode::Blend => 0.0,
     };
-    // glTF's lobe reads its base colour here (the mapping writes the pixel's; shaders/surface.glsl).
+    // glTF's lobe reads its base colour here (the mapping writes the pixel's; shaders/surface.glsl), and its
+    // dielectric's Fresnel (a material's own, also where the mapping follows textures).
+    let s = match m.brdf {
+        Brdf::Gltf { specular, .. } => specular,
+        Brdf::Lambert { .. }
+        | Brdf::Phong { .. }
+        | Brdf::BlinnPhong { .. }
+        | Brdf::Ward { .. }
+        | Brdf::Measured { .. } => m.pbr.specular,
+    };
     let b = match m.brdf {
         Brdf::Gltf { base_color, .. } => base_color,
         Brdf::Lambert { .. }
@@ -394,6 +405,7 @@ pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
         base: [b[0], b[1], b[2], m.base_alpha],
         pbr: [m.pbr.metallic, m.pbr.roughness, m.normal_texture.map_or(1.0, |(_, s)| s), cutoff],
         emission: [m.emission[0], m.emission[1], m.emission[2], 0.0],
+        specular: [s.f0[0], s.f0[1], s.f0[2], s.f90],
         tex: [
             slot(m.base_color_texture.as_ref()),
             slot(m.metallic_roughness_texture.as_ref()),
@@ -624,8 +636,8 @@ mod tests {
 
     #[test]
     fn sizes_match_std430() {
-        assert_eq!(std::mem::size_of::<MaterialGpu>(), 304);
-        assert_eq!(std::mem::offset_of!(MaterialGpu, tex), 112);
+        assert_eq!(std::mem::size_of::<MaterialGpu>(), 320);
+        assert_eq!(std::mem::offset_of!(MaterialGpu, tex), 128);
         assert_eq!(std::mem::size_of::<TextureRefGpu>(), 48);
         // The shader reads a material as texels of 16 bytes, its fields in this order (material_at).
         let glsl = include_str!("../../shaders/bindings.glsl");
@@ -637,6 +649,7 @@ mod tests {
             ("base", std::mem::offset_of!(MaterialGpu, base)),
             ("pbr", std::mem::offset_of!(MaterialGpu, pbr)),
             ("emission", std::mem::offset_of!(MaterialGpu, emission)),
+            ("specular", std::mem::offset_of!(MaterialGpu, specular)),
         ] {
             let at = if texel == 0 { "at".to_string() } else { format!("at + {}", texel / 16) };
             let read = format!("g.{field} = uintBitsToFloat(texelFetch(material_texels, {at}));");

@@ -9,15 +9,18 @@ use super::gltf::document::{lookup, MaterialDef, Root, TextureInfo};
 use super::gltf::files::AssetFiles;
 use super::gltf::image::{check, decode, image_bytes, ColorSpace, MAX_SCENE_TEXELS};
 use super::gltf::uri::{resolve, UriTarget};
-use super::material::{brdf_from_metallic_roughness, AlphaMode, Brdf, BrdfKind, Material, MetallicRoughness};
+use super::material::{
+    brdf_from_metallic_roughness, AlphaMode, Brdf, BrdfKind, DielectricSpecular, Material, MetallicRoughness,
+};
 use super::measured::{parse_merl, SharedMeasuredBrdf, MERL_FILE_BYTES};
 use super::texture::{uv_transform, Sampler, Texture, TextureRef, IDENTITY_UV_TRANSFORM};
 
 /// Texture sources other than PNG/JPEG that a texture may name in an extension (sunshade decodes none of them).
 const UNDECODED_SOURCES: [&str; 3] = ["KHR_texture_basisu", "EXT_texture_webp", "MSFT_texture_dds"];
 
-/// Material extensions sunshade draws.
-pub const DRAWN_MATERIAL_EXTENSIONS: [&str; 1] = ["KHR_materials_emissive_strength"];
+/// Material extensions sunshade draws (KHR_materials_specular without its textures).
+pub const DRAWN_MATERIAL_EXTENSIONS: [&str; 3] =
+    ["KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_specular"];
 
 /// Reads materials and the textures they use, each (texture, colour space) decoded once.
 pub struct MaterialReader<'a> {
@@ -61,8 +64,12 @@ impl<'a> MaterialReader<'a> {
         if albedo.iter().chain([&a]).any(|c| !(0.0..=1.0).contains(c)) {
             return Err(format!("{name}: baseColorFactor {:?} is outside [0, 1]", pbr.base_color_factor));
         }
+        let mut ignored = Vec::new();
+        let specular = super::load_specular::dielectric_specular(&material.extensions, &mut ignored)
+            .map_err(|e| format!("{name}: {e}"))?;
         let metallic_roughness = MetallicRoughness {
             base_color: albedo,
+            specular,
             metallic: pbr.metallic_factor as f32,
             roughness: pbr.roughness_factor as f32,
         };
@@ -77,12 +84,11 @@ impl<'a> MaterialReader<'a> {
             Some(x) if x.get("brdf").and_then(|v| v.as_str()) == Some("lambert") && x.get("albedo").is_none() => {
                 (Brdf::Lambert { albedo }, Some(BrdfKind::Lambert))
             }
-            Some(x) => (brdf_from_extras(x, albedo).map_err(|e| format!("{name} extras: {e}"))?, None),
+            Some(x) => (brdf_from_extras(x, albedo, specular).map_err(|e| format!("{name} extras: {e}"))?, None),
             // The glTF specification's own BRDF.
             None => (Brdf::from_metallic_roughness(BrdfKind::Gltf, metallic_roughness), Some(BrdfKind::Gltf)),
         };
         brdf.validate().map_err(|e| format!("{name}: {e}"))?;
-        let mut ignored = Vec::new();
         let mut texture = |info: &Option<TextureInfo>, slot: &str, space: ColorSpace, this: &mut Self| {
             let Some(info) = info else { return Ok(None) };
             this.texture_ref(info, space, &format!("{name} {slot}")).inspect(|t| {
@@ -298,8 +304,9 @@ impl MaterialReader<'_> {
 
 /// `{"brdf": "lambert" | "phong" | "blinn-phong" | "ward", "kd": [..], "ks": [..], "exponent": e,
 /// "alpha": a | "alpha_x": ax, "alpha_y": ay}`; Lambert may give `"albedo"` (else baseColorFactor); `{"brdf": "gltf",
-/// "metallic": m, "roughness": r}` with `"base_color"` (else baseColorFactor), the glTF specification's BRDF.
-fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
+/// "metallic": m, "roughness": r}` with `"base_color"` (else baseColorFactor), the glTF specification's BRDF with the
+/// material's dielectric `specular` (KHR_materials_ior and KHR_materials_specular).
+fn brdf_from_extras(x: &Value, base_color: [f32; 3], specular: DielectricSpecular) -> Result<Brdf, String> {
     let kind = x.get("brdf").and_then(|v| v.as_str()).ok_or("\"brdf\" must be a string")?;
     let color = |key: &str| -> Result<[f32; 3], String> {
         rgb(x.get(key).ok_or_else(|| format!("{kind} needs \"{key}\""))?).map_err(|e| format!("{key} {e}"))
@@ -330,7 +337,7 @@ fn brdf_from_extras(x: &Value, base_color: [f32; 3]) -> Result<Brdf, String> {
             if !(0.0..=1.0).contains(&metallic) || !(0.0..=1.0).contains(&roughness) {
                 return Err(format!("gltf metallic {metallic} and roughness {roughness} must lie in [0, 1]"));
             }
-            brdf_from_metallic_roughness(BrdfKind::Gltf, base, metallic, roughness)
+            brdf_from_metallic_roughness(BrdfKind::Gltf, base, metallic, roughness, specular)
         }
         other => return Err(format!("brdf '{other}' is not one of lambert, phong, blinn-phong, ward, gltf, merl")),
     })

@@ -16,6 +16,7 @@ pub mod light;
 mod load;
 mod load_material;
 mod load_mesh;
+mod load_specular;
 pub mod material;
 pub mod measured;
 pub mod tangent;

@@ -324,7 +324,12 @@ fn fit_gltf(samples: &[FitSample], fixed: &FixedSums) -> Brdf {
     let step = 1.0 / (GLTF_METALLIC_GRID - 1) as f64;
     let m = golden_section(|m| at(m, t).1, ((m0 - step).max(0.0), (m0 + step).min(1.0)));
     let base = at(m, t).0;
-    Brdf::Gltf { base_color: base.map(|b| b as f32), metallic: m as f32, alpha: t.exp() as f32 }
+    Brdf::Gltf {
+        base_color: base.map(|b| b as f32),
+        metallic: m as f32,
+        alpha: t.exp() as f32,
+        specular: crate::scene::material::DielectricSpecular::DEFAULT,
+    }
 }
 
 /// Fits `kind` to the table (see the module text).

@@ -62,8 +62,9 @@ pub fn orthonormal_to(v: DVec3) -> DVec3 {
 pub fn specular_lobe_rgb(brdf: &Brdf, p: &SurfacePoint, l: DVec3) -> [f64; 3] {
     match brdf {
         Brdf::Measured { table, lookup } => measured_residual(table, *lookup, p.normal, l, p.to_viewer),
-        Brdf::Gltf { base_color, metallic, alpha } => {
-            gltf_lobe_rgb(p.normal, l, p.to_viewer, base_color.map(f64::from), *metallic as f64, *alpha as f64)
+        Brdf::Gltf { base_color, metallic, alpha, specular } => {
+            let (base, d) = (base_color.map(f64::from), dielectric_of(specular));
+            gltf_lobe_rgb(p.normal, l, p.to_viewer, base, *metallic as f64, *alpha as f64, d)
         }
         Brdf::Lambert { .. } | Brdf::Phong { .. } | Brdf::BlinnPhong { .. } | Brdf::Ward { .. } => {
             [specular_lobe(brdf, p, l); 3]
@@ -152,11 +153,16 @@ pub fn lobe_sample(
             ([weight; 3], omega)
         }
         Brdf::Measured { ref table, lookup } => measured_lobe_sample(table, lookup, (n, v), (t, b), xi1, phi),
-        Brdf::Gltf { base_color, metallic, alpha } => {
-            let params = (base_color.map(f64::from), metallic as f64, alpha as f64);
+        Brdf::Gltf { base_color, metallic, alpha, specular } => {
+            let params = (base_color.map(f64::from), metallic as f64, alpha as f64, dielectric_of(&specular));
             gltf_lobe_sample((n, t, b), v, params, xi1, phi)
         }
     }
+}
+
+/// A glTF material's dielectric Fresnel `(f0, f90)` in f64.
+pub fn dielectric_of(specular: &crate::scene::material::DielectricSpecular) -> ([f64; 3], f64) {
+    (specular.f0.map(f64::from), specular.f90 as f64)
 }
 
 /// The count per axis of the sky's inverse-CDF grid for a lobe asked `per_axis`: glTF's draws half its azimuths

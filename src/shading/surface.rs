@@ -95,7 +95,7 @@ pub fn surface_brdf(material: &Material, textures: &[Texture], s: &SurfaceSample
         metallic *= t[2];
         roughness *= t[1];
     }
-    brdf_from_metallic_roughness(kind, [base[0], base[1], base[2]], metallic, roughness)
+    brdf_from_metallic_roughness(kind, [base[0], base[1], base[2]], metallic, roughness, material.pbr.specular)
 }
 
 /// Whether the pixel is covered under the material's alpha mode: MASK keeps `alpha ≥ cutoff`.
@@ -175,10 +175,15 @@ mod tests {
     #[test]
     fn mapping_is_the_scene_mapping() {
         for kind in [BrdfKind::Lambert, BrdfKind::Phong, BrdfKind::BlinnPhong, BrdfKind::Ward] {
-            let p = crate::scene::MetallicRoughness { base_color: [0.9, 0.5, 0.1], metallic: 0.3, roughness: 0.6 };
+            let p = crate::scene::MetallicRoughness {
+                base_color: [0.9, 0.5, 0.1],
+                metallic: 0.3,
+                roughness: 0.6,
+                specular: crate::scene::material::DielectricSpecular::DEFAULT,
+            };
             assert_eq!(
                 Brdf::from_metallic_roughness(kind, p),
-                brdf_from_metallic_roughness(kind, p.base_color, 0.3, 0.6)
+                brdf_from_metallic_roughness(kind, p.base_color, 0.3, 0.6, p.specular)
             );
         }
     }

@@ -20,8 +20,14 @@ use files::{AssetFiles, UriScope};
 use uri::UriTarget;
 
 /// Extensions sunshade implements.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform", "KHR_materials_emissive_strength"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+];
 
 /// Extensions whose whole effect is on appearance that sunshade does not draw yet: texture transforms (textures
 /// are not drawn), emission strength (emission is not drawn) and material lobes (KHR_materials_*: materials are
