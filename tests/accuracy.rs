@@ -94,7 +94,7 @@ fn the_final_check_reports_grids_that_agree_by_chance() {
 /// (the sun) and room.gltf's (a disk skylight) converged references converge where the located grid leaves pixels
 /// moving (its error falls as O(1/k²) in the rays per axis, k² rays a pixel; the slices' as O(1/rows²)), and agree
 /// with a located grid of 2k shadow rays per axis within that grid's step from k (second order: about a third of
-/// it; rays, not planes: an independent method). Measured 2026-12-04: overcast.glb at 32 × 24 (a 1e-3 claim),
+/// it; rays, not planes: an independent method). Measured (AMD EPYC): overcast.glb at 32 × 24 (a 1e-3 claim),
 /// slices converged everywhere in five doublings, the grid left 389 of 432 pixels moving (up to 4.9e-3), 8.0e-4
 /// from 128² rays whose step from 64² is 1.7e-3; sunset.glb at 48 × 36, slices converged after two doublings
 /// (last change 6.9e-7), the grid left 22 of 1040 pixels moving after six (up to 9.4e-5), 1.2e-5 from 96² rays
@@ -141,7 +141,7 @@ fn penumbrae_converge_by_slices() {
 /// `--tolerance` on the reference where it takes the sky through occluders by slices (`reference --tolerance`'s
 /// default): overcast.glb, refused on the located grid without `--tolerance-in-penumbrae`, now meets T = 1e-2,
 /// 1e-3 and 1e-4 over every pixel against its converged reference (by slices, every pixel's last doubling under
-/// a tenth of the tightest T), penumbrae included, and costs more at tighter T. Measured 2026-12-04 at 32 × 24:
+/// a tenth of the tightest T), penumbrae included, and costs more at tighter T. Measured (AMD EPYC) at 32 × 24:
 /// 9², 19², 56² shadow grids (4k² rows each), 1.3e-3, 6.9e-5, 2.6e-6; since the study takes the slices' order up
 /// to 2 (`refinement`, "Penumbrae by slices"), 9², 19², 39², 1.3e-3, 6.9e-5, 8.0e-6.
 #[test]
@@ -316,8 +316,7 @@ fn sun_cost(shading: &ShadingOptions) -> u32 {
 /// name) and chart materials from three sun directions meet T against the converged reference for T = 1e-2, 1e-3,
 /// 1e-4 outside the penumbrae (and the pixels where the truth itself did not converge), what `--tolerance`
 /// promises; where only the sun can be partly hidden, over every converged pixel too (the penumbrae's hardest
-/// pixels are those the truth leaves unconverged); and cost no more at looser T. The light of disk lights through
-/// occluders was refused too before 2026-12-03.
+/// pixels are those the truth leaves unconverged); and cost no more at looser T.
 #[test]
 fn tolerance_meets_itself_on_the_reference() {
     use sunshade::accuracy::trial::{reference_within_tolerance, Tolerance};
@@ -864,9 +863,9 @@ fn f32_interpolation_stays_within_its_bound_on_the_gpu() {
 /// `render --tolerance --tolerance-outside-penumbrae` on scenes that shadow themselves, on any device: `auto` casts
 /// shadow rays (without ray queries, the fragment shader's walk of the BVH) instead of shadow maps, which have no
 /// bound, and the image meets T against the converged reference with shadow rays outside the penumbrae (and the truth's
-/// unconverged pixels), which `-v` names as not bounded (the promise `--tolerance` made alone before 2026-12-05; it
-/// holds in the penumbrae too since: `render_tolerance_in_penumbrae_meets_it_there`): under the sun (teapot.glb,
-/// sunset.glb) and a disk skylight (room.gltf, whose light through occluders was refused before 2026-12-03). The sky
+/// unconverged pixels), which `-v` names as not bounded (`--tolerance` alone holds in the penumbrae too:
+/// `render_tolerance_in_penumbrae_meets_it_there`): under the sun (teapot.glb, sunset.glb) and a disk skylight
+/// (room.gltf). The sky
 /// through occluders (overcast.glb): `render_tolerance_meets_it_on_the_sky_through_occluders`.
 #[test]
 fn render_tolerance_casts_shadow_rays_on_any_device() {
@@ -903,7 +902,7 @@ fn render_tolerance_casts_shadow_rays_on_any_device() {
 /// the sky is taken by slices in passes (`gpu::slice_passes`), the grids are
 /// studied on the reference (the same rows in f64), and the GPU's image, measured against the reference's at the
 /// kept settings, meets T = 1e-2 and 1e-3 over every pixel against a truth whose every pixel's last doubling moved
-/// it by less than a tenth of 1e-4. Measured 2026-12-05 at 32 × 24 on Mesa 22.3.6: 9², 19², measured 1.3e-3,
+/// it by less than a tenth of 1e-4. Measured at 32 × 24 on Mesa 22.3.6 (AMD EPYC): 9², 19², measured 1.3e-3,
 /// 6.9e-5, the GPU 8.1e-7 and 1.3e-6 from the reference at the kept settings (at 64 × 48 against `reference
 /// --converged --accuracy 1e-5`: 9.3e-4, 1.9e-4). With `--visibility grid --tolerance-outside-penumbrae` it is
 /// refused by name, pointing to the slices.
@@ -951,15 +950,13 @@ fn render_tolerance_meets_it_on_the_sky_through_occluders() {
 
 /// `render --tolerance T --tolerance-by-study` (the study; without the flag the penumbrae are refined on the
 /// reference: tests/tolerance_refined.rs) on sunset.glb (the sun's penumbrae) on any device, which holds T in
-/// penumbrae by default
-/// since 2026-12-05 (room.gltf below names `--tolerance-in-penumbrae`, still accepted): the shadow
+/// penumbrae by default (room.gltf below names `--tolerance-in-penumbrae`, still accepted): the shadow
 /// rays' grids join the study, `-v` says so, and the image meets T everywhere, penumbrae included, against the
 /// reference with the sun's and lobes' grids at 181² and the sun's visible fraction by 4 × 64² slices (an
 /// independent render, not the converged reference, whose per-pixel test two grids of a penumbra can pass by
-/// chance). The GPU takes the sun's penumbrae by slices (second order; on every device since 2026-12-05, with ray
-/// queries too), the grids studied on the reference's slices (f64) and the GPU's one image measured against the
-/// reference's at the kept settings (since 2026-12-05; the study had rendered its rungs on the GPU), and T = 1e-2,
-/// 1e-3 and 1e-4 are met (a grid of rays stopped at llvmpipe's loop budget short of 1e-3 before).
+/// chance). The GPU takes the sun's penumbrae by slices (second order; on every device, with ray queries too), the
+/// grids studied on the reference's slices (f64) and the GPU's one image measured against the reference's at the
+/// kept settings, and T = 1e-2, 1e-3 and 1e-4 are met.
 #[test]
 fn render_tolerance_in_penumbrae_meets_it_there() {
     let dir = common::TempDir::new("tolerance-penumbrae");
@@ -969,7 +966,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
     s.shading.sun_samples_per_axis = 181;
     for t in [1e-2, 1e-3, 1e-4] {
         let out = dir.path(&format!("sunset-{t:e}.exr"));
-        // `--tolerance` alone: it holds in penumbrae by default (since 2026-12-05).
+        // `--tolerance` alone: it holds in penumbrae by default.
         let flags = format!("models/sunset.glb --width 48 --height 36 --tolerance {t:e} -v --tolerance-by-study");
         let Some(e) = render_with_tolerance(&flags, &out) else {
             return; // a device without f64 interpolation has no bound to keep
@@ -987,9 +984,9 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
             "{line}"
         );
     }
-    // room.gltf, a disk skylight over a sphere: refused on llvmpipe before 2026-12-05 (at 9² the frame's own slices of
-    // the skylight ran past the loop budget at the penumbra's pixels); the disk's rows are now taken in passes where
-    // the frame runs out (gpu::slice_passes). Measured at 64² against `reference --converged`: 1e-2 5.6e-4, 1e-3
+    // room.gltf, a disk skylight over a sphere: at 9² the frame's own slices of the skylight would run past
+    // llvmpipe's loop budget at the penumbra's pixels; the disk's rows are taken in passes where the frame runs out
+    // (gpu::slice_passes). Measured at 64² against `reference --converged`: 1e-2 5.6e-4, 1e-3
     // 1.0e-4 (docs/accuracy.md); here 1e-2 at 32², against the reference with 64² shadow samples by slices.
     let (scene, s) = common::sliced("room.gltf", (32, 32), 64);
     let out = dir.path("room.exr");
@@ -1002,8 +999,7 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
         assert!(measured <= 1e-2, "{measured:.3e} over 1e-2\n{e}");
     }
     // cube.glb at 64²: its contact shadows put pixels a centimetre from the cube, where f32 corners leave the GPU's
-    // slices 1.5e-4 from the reference's at two pixels. Refused by name until 2026-12-05; now those pixels are taken
-    // from the reference's image, which the study rendered anyway (accuracy::from_reference), and T = 1e-4 is met
+    // slices 1.5e-4 from the reference's at two pixels. Those pixels are taken from the reference's image, which the study rendered anyway (accuracy::from_reference), and T = 1e-4 is met
     // (measured 2.2e-5 against `reference --converged --accuracy 1e-5`). A device without f64 interpolation may
     // still be refused, by name, where the other terms leave nothing for its f32.
     let (scene, mut s) = common::sliced("cube.glb", (64, 64), 64);
@@ -1033,11 +1029,10 @@ fn render_tolerance_in_penumbrae_meets_it_there() {
 }
 
 /// `reference --tolerance 1e-2 --tolerance-in-penumbrae` on overcast.glb, the sky through the teapot: the study
-/// converges there and keeps a grid (refused while the sky counted its rays), and the image meets T against the
+/// converges there and keeps a grid, and the image meets T against the
 /// reference with its shadow grid at 128² (located: second order, about 4e-4 from the truth by the 32²-to-64²
-/// differences). Measured 2026-12-03, the sky by the located grid: 56², 2.5e-3 (3.1e-3 against 64²), predicted
-/// 8.2e-3; 2026-12-04, by slices (`--tolerance`'s default in the reference since): 9², predicted 7.8e-3, 6.8e-4
-/// against the converged reference.
+/// differences). Measured (AMD EPYC, Mesa 22.3), the sky by slices (`--tolerance`'s default in the reference): 9²,
+/// predicted 7.8e-3, 6.8e-4 against the converged reference.
 #[test]
 fn reference_tolerance_in_penumbrae_keeps_the_sky_through_occluders() {
     let dir = common::TempDir::new("tolerance-sky-penumbrae");
@@ -1062,7 +1057,7 @@ fn reference_tolerance_in_penumbrae_keeps_the_sky_through_occluders() {
 /// The study's estimate covers the error where two rungs agree by chance: room.gltf at 48 × 36, its skylight's
 /// penumbra by slices, `--tolerance 1e-2` in penumbrae on the reference. Its rungs 4², 6², 9² err 6.0e-3, 1.5e-3,
 /// 2.3e-3 against the converged reference (not monotone); the maxima of their differences read an order of 2.6,
-/// and Roache's 1.25 on the order cut to 2 estimated 1.6e-3 at 9², short of the 2.3e-3 measured (2026-12-05). An
+/// and Roache's 1.25 on the order cut to 2 estimated 1.6e-3 at 9², short of the 2.3e-3 measured. An
 /// order past the midpoint's is not confirmed, and takes his factor of 3 (`accuracy::refinement`, "Orders past
 /// the midpoint's").
 #[test]

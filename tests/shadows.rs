@@ -1072,14 +1072,14 @@ fn tolerance_estimates_a_penumbra_against_its_circular_segment() {
         }
     }
     eprintln!("{report}");
-    // The sun's located edges (second order) keep 13 of the 18 cases (measured 2026-12-03); the count of points
+    // The sun's located edges (second order) keep 13 of the 18 cases (measured); the count of points
     // before them kept 5, refusing the widest penumbra even at 1e-2.
     assert!(kept >= 10, "{kept} kept:\n{report}");
 }
 
 /// The sky through occluders under `render --tolerance 1e-2 --tolerance-in-penumbrae --tolerance-by-study`
 /// (overcast.glb, the sky alone through the teapot): with ray queries the study keeps a grid and the image meets T against the reference with
-/// its shadow grid at 128² (measured 2026-12-03 on Mesa 25's lavapipe: 56², 3.1e-3, predicted 8.1e-3). On a device
+/// its shadow grid at 128² (measured on Mesa 25's lavapipe: 56², 3.1e-3, predicted 8.1e-3). On a device
 /// whose fragment shader walks the BVH the study's finer rungs pass llvmpipe's loop budget (overcast.glb fits 32²
 /// at 96 × 72 since the slab test lost its loop; 10² before), and the render must then refuse by name, not return a
 /// cut-short image.
@@ -1292,7 +1292,7 @@ fn gpu_disk_slices_agree_with_the_reference() {
     // At k = 9 (324 rows) the frame's own slices of the skylight run past Mesa 22's loop budget at the penumbra's
     // pixels (25 of them at 64 x 64, each cutting some 200 gathered triangles a row): the renderer takes the disk's
     // rows in passes before the frame (gpu::slice_passes) and draws the frame again, reading them. The same
-    // agreement with the reference's slices (measured 2026-12-05 on Mesa 22.3.6: see the eprintln).
+    // agreement with the reference's slices (measured on Mesa 22.3.6: see the eprintln).
     s.shading.shadow_samples_per_axis = 9;
     let (passed, timings) = gpu.render_timed(&scene, &s);
     let reference = cpu::render(&scene, &s, &gpu.reference_options());
