@@ -613,7 +613,7 @@ fn tolerance_estimates_measured_materials_by_refinement() {
     let reference = cpu::ReferenceOptions::default();
     let mut report = String::new();
     for (what, lights) in cases {
-        let mut s = settings(&scene, lights, ShadingOptions::default(), 48);
+        let mut s = settings(&scene, lights, ShadingOptions::default(), 32);
         s.shading.shadows = Shadows::None;
         let mut grids = Vec::new();
         for tolerance in [1e-2, 1e-3, 1e-4] {
