@@ -169,28 +169,23 @@ fn scene_table(materials: &[(String, Brdf)]) -> String {
                 // and so does f0 (the dielectric's Fresnel).
                 s += &format!("| {name} (glTF) |");
                 for d in INCIDENCES_DEGREES {
-                    let albedo = |b: f32, f0: f32, f90: f32| {
+                    // The directional albedo of a grey glTF BRDF (every channel alike).
+                    let albedo = |b: f32, metallic: f32, f0: f32, f90: f32| {
                         let specular = crate::scene::material::DielectricSpecular { f0: [f0; 3], f90 };
                         let channel = Brdf::Gltf { base_color: [b; 3], metallic, alpha, specular };
                         channel.kd()[0] as f64 + lobe_albedo(&channel, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0
                     };
+                    // The base keeps `1 − max F` of every channel, where the one-channel BRDF keeps its own: the
+                    // difference is `(1 − m) b (f0_c − max f0) (1 − X)`, `X = ∫ (1 − v·h)⁵ cos/π dω`, which is
+                    // `1 + A(0) − A(1)` for the albedos A of a dielectric with f0 0, f90 1, metallic 0 and base 0
+                    // or 1 (computed once, and only for a tinted f0).
+                    let tinted = specular.f0.iter().any(|&f| f != specular.f0_max());
+                    let schlick =
+                        if tinted { 1.0 + albedo(0.0, 0.0, 0.0, 1.0) - albedo(1.0, 0.0, 0.0, 1.0) } else { 0.0 };
                     let a: [f64; 3] = std::array::from_fn(|c| {
-                        let tinted = albedo(base_color[c], specular.f0[c], specular.f90);
-                        // The base keeps `1 − max F` of every channel, where the one-channel BRDF keeps its own:
-                        // the difference is `(1 − m) b (f0_c − max f0) (1 − X)`, `X = ∫ (1 − v·h)⁵ cos/π dω`, which
-                        // is `1 + A(0) − A(1)` for the albedos A of a dielectric with f0 0, f90 1, metallic 0 and
-                        // base 0 or 1.
+                        let own = albedo(base_color[c], metallic, specular.f0[c], specular.f90);
                         let gap = (specular.f0[c] - specular.f0_max()) as f64;
-                        if gap == 0.0 {
-                            return tinted;
-                        }
-                        let plain = |b: f32| {
-                            let specular = crate::scene::material::DielectricSpecular { f0: [0.0; 3], f90: 1.0 };
-                            let brdf = Brdf::Gltf { base_color: [b; 3], metallic: 0.0, alpha, specular };
-                            brdf.kd()[0] as f64 + lobe_albedo(&brdf, d.to_radians(), 0.0, QUADRATURE_TOLERANCE).0
-                        };
-                        let schlick = 1.0 + plain(0.0) - plain(1.0);
-                        tinted + (1.0 - metallic as f64) * base_color[c] as f64 * gap * (1.0 - schlick)
+                        own + (1.0 - metallic as f64) * base_color[c] as f64 * gap * (1.0 - schlick)
                     });
                     s += &format!(" {:.4}, {:.4}, {:.4} |", a[0], a[1], a[2]);
                 }

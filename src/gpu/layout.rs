@@ -381,21 +381,13 @@ pub fn material_gpu(m: &Material, measured_offset: u32) -> MaterialGpu {
     };
     // glTF's lobe reads its base colour here (the mapping writes the pixel's; shaders/surface.glsl), and its
     // dielectric's Fresnel (a material's own, also where the mapping follows textures).
-    let s = match m.brdf {
-        Brdf::Gltf { specular, .. } => specular,
+    let (b, s) = match m.brdf {
+        Brdf::Gltf { base_color, specular, .. } => (base_color, specular),
         Brdf::Lambert { .. }
         | Brdf::Phong { .. }
         | Brdf::BlinnPhong { .. }
         | Brdf::Ward { .. }
-        | Brdf::Measured { .. } => m.pbr.specular,
-    };
-    let b = match m.brdf {
-        Brdf::Gltf { base_color, .. } => base_color,
-        Brdf::Lambert { .. }
-        | Brdf::Phong { .. }
-        | Brdf::BlinnPhong { .. }
-        | Brdf::Ward { .. }
-        | Brdf::Measured { .. } => m.pbr.base_color,
+        | Brdf::Measured { .. } => (m.pbr.base_color, m.pbr.specular),
     };
     MaterialGpu {
         kd: [kd[0], kd[1], kd[2], 0.0],

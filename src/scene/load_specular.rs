@@ -41,16 +41,12 @@ pub fn dielectric_specular(
     let colour = match specular_ext.and_then(|x| x.get("specularColorFactor")) {
         None => [1.0; 3],
         Some(v) => {
-            let c: Option<Vec<f64>> =
-                v.as_array().filter(|a| a.len() == 3).map(|a| a.iter().filter_map(|x| x.as_f64()).collect());
-            match c {
-                Some(c) if c.len() == 3 && c.iter().all(|x| x.is_finite() && *x >= 0.0) => [c[0], c[1], c[2]],
-                _ => {
-                    return Err(format!(
-                        "KHR_materials_specular specularColorFactor {v} must be 3 non-negative numbers"
-                    ))
-                }
+            let c: Vec<f64> =
+                v.as_array().map_or(Vec::new(), |a| a.iter().map(|x| x.as_f64().unwrap_or(-1.0)).collect());
+            if c.len() != 3 || !c.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                return Err(format!("KHR_materials_specular specularColorFactor {v} must be 3 non-negative numbers"));
             }
+            [c[0], c[1], c[2]]
         }
     };
     if let Some(x) = specular_ext {

@@ -89,6 +89,11 @@ pub fn merl_index(theta_h: usize, theta_d: usize, phi_d: usize) -> usize {
     phi_d + PHI_D_BINS * (theta_d + THETA_D_BINS * theta_h)
 }
 
+/// The bins (θ_h, θ_d, φ_d) of sample `index`: the inverse of [`merl_index`].
+pub fn merl_bins(index: usize) -> (usize, usize, usize) {
+    (index / (PHI_D_BINS * THETA_D_BINS), (index / PHI_D_BINS) % THETA_D_BINS, index % PHI_D_BINS)
+}
+
 /// The angles \[rad\] at the centre of each bin, where a sample stands (`shading::measured`, docs/measured.md):
 /// `θ_h = ((i + ½)/90)² π/2` (the square-root scale), `θ_d = (j + ½) π/180`, `φ_d = (k + ½) π/180`.
 pub fn merl_bin_angles(i: usize, j: usize, k: usize) -> (f64, f64, f64) {
@@ -131,19 +136,15 @@ impl MeasuredBrdf {
                 }
             }
         }
-        let mut missing_above_horizon = 0;
         if missing > 0 {
             fill_from_nearest_valid(name, &mut values, &missing_mask)?;
-            for i in 0..THETA_H_BINS {
-                for j in 0..THETA_D_BINS {
-                    for k in 0..PHI_D_BINS {
-                        if missing_mask[merl_index(i, j, k)] && bin_centre_above_horizon(i, j, k) {
-                            missing_above_horizon += 1;
-                        }
-                    }
-                }
-            }
         }
+        let missing_above_horizon = (missing_mask.iter().enumerate())
+            .filter(|&(index, &m)| {
+                let (i, j, k) = merl_bins(index);
+                m && bin_centre_above_horizon(i, j, k)
+            })
+            .count();
         let mut floor = [f32::INFINITY; 3];
         for (i, s) in values.chunks_exact(3).enumerate() {
             if !missing_mask.get(i).copied().unwrap_or(false) {
@@ -190,7 +191,7 @@ fn fill_from_nearest_valid(name: &str, values: &mut [f32], missing: &[bool]) -> 
     }
     let mut reached: Vec<bool> = missing.iter().map(|m| !m).collect();
     while let Some(at) = queue.pop_front() {
-        let (k, j, i) = (at % PHI_D_BINS, (at / PHI_D_BINS) % THETA_D_BINS, at / (PHI_D_BINS * THETA_D_BINS));
+        let (i, j, k) = merl_bins(at);
         let mut neighbours = [None; 6];
         neighbours[0] = Some(merl_index(i, j, (k + 1) % PHI_D_BINS));
         neighbours[1] = Some(merl_index(i, j, (k + PHI_D_BINS - 1) % PHI_D_BINS));
@@ -314,6 +315,13 @@ mod tests {
         // The peak in red alone: the mean falls below e^{-1/2} of it at the next bin.
         assert!((t.lobe_width as f64 - 2.0 * merl_bin_angles(1, 0, 0).0).abs() < 1e-9);
         assert_eq!(parse_merl("c", &merl_bytes(&constant(0.2))).unwrap().lobe_width, std::f32::consts::PI);
+    }
+
+    #[test]
+    fn bins_and_index_are_inverses() {
+        for (i, j, k) in [(0, 0, 0), (89, 89, 179), (3, 40, 7), (45, 0, 179)] {
+            assert_eq!(merl_bins(merl_index(i, j, k)), (i, j, k));
+        }
     }
 
     #[test]
