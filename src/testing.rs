@@ -392,6 +392,19 @@ mod tests {
     }
 
     #[test]
+    fn a_comparison_can_hold_the_mean_flip() {
+        let (a, mut b) = (image(1.0), image(1.0));
+        b.set(1, 1, [3.0, 3.0, 3.0, 1.0]);
+        let loose = DiffOptions { fail_rel: Some(10.0), fail_peak: None, ..Default::default() };
+        let report = check_close(&a, &b, &loose).unwrap();
+        assert!(report.flip.is_none(), "FLIP only where asked");
+        let mean = check_close(&a, &b, &DiffOptions { fail_flip: Some(1.0), ..loose }).unwrap().flip.unwrap().mean;
+        assert!(mean > 0.0);
+        let e = check_close(&a, &b, &DiffOptions { fail_flip: Some(mean / 2.0), ..loose }).unwrap_err();
+        assert!(e.contains("FLIP (HDR-FLIP") && e.contains("allowed mean") && e.contains("FAIL"), "{e}");
+    }
+
+    #[test]
     #[should_panic(expected = "images differ")]
     fn assert_images_close_panics_with_the_report() {
         crate::assert_images_close!(image(1.0), image(2.0));

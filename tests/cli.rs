@@ -616,6 +616,84 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     let o = sunshade(&["test", s(&suite), "--filter", "re"]);
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(out.contains("PASS ref") && !out.contains("strict") && out.contains("1 passed"), "{out}");
+    // FLIP in a suite: a golden of the sun at 60° against a render at the default 30°, within any relative
+    // tolerance, fails on its mean FLIP where that is held low, and the failure says so.
+    let o = sunshade(&[
+        "render",
+        s(&dir.path("scene.glb")),
+        "-o",
+        s(&other),
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--sun-elevation",
+        "60",
+    ]);
+    assert!(o.status.success());
+    let flip_suite = |limit: f64| {
+        let path = dir.path("flip.json");
+        let case = json!([{ "name": "sun", "scene": "scene.glb", "width": 32, "height": 24, "golden": "goldens/a.exr",
+                            "tolerances": { "fail-rel": 100, "fail-flip": limit } }]);
+        std::fs::write(&path, case.to_string()).unwrap();
+        let o = sunshade(&["test", s(&path)]);
+        (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned())
+    };
+    let (code, out) = flip_suite(1e-3);
+    assert!(code == Some(1) && out.contains("0 px over tolerance") && out.contains("FLIP mean"), "{out}");
+    let (code, out) = flip_suite(0.99);
+    assert!(code == Some(0) && out.contains("PASS sun"), "{out}");
+}
+
+#[test]
+fn diff_reports_flip_fails_on_its_mean_and_writes_its_map() {
+    let dir = TempDir::new("diff-flip");
+    // A gradient, and the same with a bright square: FLIP sees the square, not the rest.
+    let mut a = sunshade::Image::new(64, 48);
+    for y in 0..48 {
+        for x in 0..64 {
+            let v = 1.0 + x as f32 / 8.0;
+            a.set(x, y, [v, v, 0.5 * v, 1.0]);
+        }
+    }
+    let mut b = a.clone();
+    for y in 10..20 {
+        for x in 10..20 {
+            b.set(x, y, [40.0, 40.0, 40.0, 1.0]);
+        }
+    }
+    let (pa, pb) = (dir.path("a.exr"), dir.path("b.exr"));
+    sunshade::film::write_image(&a, &pa, sunshade::film::Exposure::Auto).unwrap();
+    sunshade::film::write_image(&b, &pb, sunshade::film::Exposure::Auto).unwrap();
+    let json = |extra: &[&str]| {
+        let mut args = vec!["diff", s(&pa), s(&pb), "--fail-rel", "100", "--json"];
+        args.extend_from_slice(extra);
+        let o = sunshade(&args);
+        (o.status.code(), serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap())
+    };
+    let (code, report) = json(&[]);
+    let flip = &report["flip"];
+    let mean = flip["mean"].as_f64().unwrap();
+    assert_eq!((code, flip["kind"].as_str()), (Some(0), Some("hdr")), "{report}");
+    // About 100 of 3072 pixels differ, strongly, and their neighbours a little.
+    assert!(mean > 0.02 && mean < 0.2, "{report}");
+    assert!(flip["max"].as_f64().unwrap() > 0.5 && flip["median"].as_f64().unwrap() < 1e-3, "{report}");
+    assert!(flip["exposures"]["count"].as_u64().unwrap() >= 2, "{report}");
+    let (code, report) = json(&["--fail-flip", &format!("{}", mean * 0.9)]);
+    assert_eq!((code, report["pass"].as_bool()), (Some(1), Some(false)), "{report}");
+    let (code, _) = json(&["--fail-flip", &format!("{}", mean * 1.1)]);
+    assert_eq!(code, Some(0));
+    // The same pair against itself: FLIP 0.
+    let o = sunshade(&["diff", s(&pa), s(&pa)]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("mean 0.0000"), "{}", String::from_utf8_lossy(&o.stdout));
+    // The map: the images' size, dark where they agree, bright on the square.
+    let map = dir.path("flip.png");
+    assert_eq!(sunshade(&["diff", s(&pa), s(&pb), "--fail-rel", "100", "--flip-map", s(&map)]).status.code(), Some(0));
+    let png = image::open(&map).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (64, 48));
+    assert!(png.get_pixel(15, 15).0[0] > 200 && png.get_pixel(50, 40).0[0] < 10, "{:?}", png.get_pixel(15, 15));
+    let o = sunshade(&["diff", s(&pa), s(&pb), "--flip-map", s(&dir.path("flip.exr"))]);
+    assert!(o.status.code() == Some(2) && stderr(&o).contains("FLIP's error map is a PNG"), "{}", stderr(&o));
 }
 
 #[test]

@@ -6,6 +6,7 @@ use clap::Args;
 
 use super::args::parse_non_negative;
 use super::CliError;
+use crate::compare::flip::{FlipInput, FlipStats};
 use crate::compare::{self, DiffOptions, DiffReport, PixelDiff};
 use crate::film::{read_image, Image, ImageFormat};
 
@@ -44,6 +45,10 @@ pub struct ToleranceArgs {
     /// Pixels allowed to differ in coverage (alpha) [default: 0].
     #[arg(long, value_name = "N")]
     pub fail_coverage: Option<usize>,
+    /// Fail when the mean FLIP (NVIDIA's perceptual difference, in [0, 1]; HDR-FLIP for radiance, LDR-FLIP for
+    /// PNGs) exceeds this.
+    #[arg(long, value_parser = parse_non_negative, value_name = "MEAN")]
+    pub fail_flip: Option<f64>,
     /// Absolute floor of the relative error's denominator [W/(m²·sr)] [default: 0].
     #[arg(long, value_parser = parse_non_negative, value_name = "W/(M2·SR)")]
     pub floor: Option<f64>,
@@ -71,6 +76,8 @@ impl ToleranceArgs {
             hard_fail: self.hard_fail,
             warn_rel: self.warn_rel,
             warn_abs: self.warn_abs,
+            flip: None,
+            fail_flip: self.fail_flip,
         }
     }
 
@@ -86,6 +93,7 @@ impl ToleranceArgs {
             ("--warn-rel", self.warn_rel.is_some()),
             ("--warn-abs", self.warn_abs.is_some()),
             ("--fail-coverage", self.fail_coverage.is_some()),
+            ("--fail-flip", self.fail_flip.is_some()),
             ("--floor", self.floor.is_some()),
             ("--floor-fraction", self.floor_fraction.is_some()),
         ]
@@ -106,6 +114,9 @@ pub struct DiffCommand {
     /// Write a false-colour PNG of log10 relative error (viridis; coverage mismatches white), with a legend.
     #[arg(long, value_name = "PNG")]
     pub heatmap: Option<PathBuf>,
+    /// Write FLIP's error map: each pixel's FLIP on the magma scale (black 0 to pale yellow 1), the images' size.
+    #[arg(long, value_name = "PNG")]
+    pub flip_map: Option<PathBuf>,
     /// Write the difference image: |A − B| per channel, alpha included (so coverage mismatches show as alpha 1),
     /// the same size, as .exr or .pfm.
     #[arg(short, long, value_name = "EXR|PFM")]
@@ -140,17 +151,22 @@ impl ReportFormat {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 pub fn compare_and_report(
     a: &Image,
     b: &Image,
     names: (&str, &str),
     options: &DiffOptions,
+    flip: Option<(FlipStats, Option<f64>)>,
     heatmap: Option<&std::path::Path>,
     format: ReportFormat,
     excused: Option<(&[bool], &str, Option<f64>)>,
 ) -> Result<DiffReport, CliError> {
-    let (report, per_pixel): (DiffReport, Vec<PixelDiff>) = compare::diff_apart(a, b, options, excused)
+    let (mut report, per_pixel): (DiffReport, Vec<PixelDiff>) = compare::diff_apart(a, b, options, excused)
         .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
+    if let Some((stats, fail_flip)) = flip {
+        report.add_flip(stats, fail_flip);
+    }
     if let Some(path) = heatmap {
         compare::write_heatmap(path, a.width(), a.height(), &per_pixel)
             .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))?;
@@ -187,6 +203,9 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     }
     if let Some(h) = &a.heatmap {
         super::check_heatmap_path(h)?;
+    }
+    if let Some(m) = &a.flip_map {
+        super::check_png_path(m, "FLIP's error map")?;
     }
     if let Some(o) = &a.output {
         super::check_output_path(o)?;
@@ -229,11 +248,21 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
     let format = ReportFormat::new(a.json, &unit, Vec::new());
+    // FLIP once, for the report and the map: display values for PNGs, radiance otherwise.
+    let input = if fa == ImageFormat::Png { FlipInput::Ldr } else { FlipInput::Hdr };
+    let flip = compare::flip::flip(&ia, &ib, input, compare::flip::DEFAULT_PPD)
+        .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
+    if let Some(path) = &a.flip_map {
+        compare::flip::write_flip_map(path, &flip)
+            .map_err(|e| CliError::Failure(anyhow::anyhow!("{}: {e}", path.display())))?;
+    }
+    let options = DiffOptions { fail_flip: None, ..a.tolerances.options() };
     let report = compare_and_report(
         &ia,
         &ib,
         (&names.0, &names.1),
-        &a.tolerances.options(),
+        &options,
+        Some((flip.stats(), a.tolerances.fail_flip)),
         a.heatmap.as_deref(),
         format,
         None,

@@ -229,8 +229,13 @@ fn check_output_path(path: &std::path::Path) -> Result<(), CliError> {
 
 /// A heatmap is a PNG; its folder must exist.
 fn check_heatmap_path(path: &std::path::Path) -> Result<(), CliError> {
+    check_png_path(path, "the heatmap")
+}
+
+/// `what` is written as a PNG; its folder must exist.
+fn check_png_path(path: &std::path::Path, what: &str) -> Result<(), CliError> {
     if crate::film::ImageFormat::from_path(path) != Some(crate::film::ImageFormat::Png) {
-        return Err(CliError::Usage(format!("{}: the heatmap is a PNG (use .png)", path.display())));
+        return Err(CliError::Usage(format!("{}: {what} is a PNG (use .png)", path.display())));
     }
     check_folder_exists(path)
 }

@@ -177,6 +177,7 @@ pub fn check_job(session: &mut Session, a: &RenderArgs, job: &Rendered, verbose:
         &reference,
         ("gpu", "cpu reference"),
         &a.tolerances.options(),
+        None,
         a.heatmap.as_deref(),
         format,
         apart.as_ref().map(|c| (c.mask.as_slice(), c.name, c.allowed_fraction)),

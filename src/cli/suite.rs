@@ -307,8 +307,12 @@ fn run_case(session: &mut Session, case: &Case, a: &TestArgs, results: &Path) ->
             Expected::Golden(path) => format!("; {}", recorded_changes(path, &recorded)),
             Expected::Reference => String::new(),
         };
+        let flip = match (&report.flip, report.options.fail_flip) {
+            (Some(f), Some(t)) => format!(", FLIP mean {:.4} (allowed {t})", f.mean),
+            _ => String::new(),
+        };
         outcome.status = Status::Failed(format!(
-            "{} px over tolerance, {} coverage mismatches, max rel {:.3e} (actual: {}, heatmap: {}){changed}",
+            "{} px over tolerance, {} coverage mismatches, max rel {:.3e}{flip} (actual: {}, heatmap: {}){changed}",
             report.over_tolerance.total,
             report.coverage_mismatches.total,
             report.max_rel,
@@ -468,8 +472,9 @@ fn html(suite: &str, outcomes: &[Outcome]) -> String {
             Status::Error(m) => ("fail", format!("ERROR: {m}")),
         };
         let metrics = o.report.as_ref().map_or(String::new(), |r| {
+            let flip = r.flip.map_or(String::new(), |f| format!(", FLIP mean {:.4}", f.mean));
             format!(
-                "<br><code>max rel {:.2e}, RMSE {:.2e}, {} px over, {} coverage</code>",
+                "<br><code>max rel {:.2e}, RMSE {:.2e}, {} px over, {} coverage{flip}</code>",
                 r.max_rel, r.rmse, r.over_tolerance.total, r.coverage_mismatches.total
             )
         });

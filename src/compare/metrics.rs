@@ -20,6 +20,7 @@
 
 use serde_json::json;
 
+use super::flip::{FlipInput, FlipStats};
 use crate::film::Image;
 
 /// The absolute error a renderer shading in f32 can carry, as a fraction of the peak radiance: 8u, u = 2⁻²⁴
@@ -61,6 +62,11 @@ pub struct DiffOptions {
     /// comparison that passes with such pixels is a WARN (still a pass).
     pub warn_rel: Option<f64>,
     pub warn_abs: Option<f64>,
+    /// Compute FLIP for images of this kind ([`super::flip`]): LDR-FLIP for display values, HDR-FLIP for radiance.
+    /// `None` computes it only where `fail_flip` is given, as HDR-FLIP.
+    pub flip: Option<FlipInput>,
+    /// The comparison fails where the mean FLIP exceeds this (in [0, 1]).
+    pub fail_flip: Option<f64>,
 }
 
 impl Default for DiffOptions {
@@ -77,6 +83,8 @@ impl Default for DiffOptions {
             hard_fail: None,
             warn_rel: None,
             warn_abs: None,
+            flip: None,
+            fail_flip: None,
         }
     }
 }
@@ -147,6 +155,8 @@ pub struct DiffReport {
     pub warn: bool,
     /// The class of pixels counted apart, if the comparison was given one ([`diff_excusing`]).
     pub excused: Option<Excused>,
+    /// FLIP over every pixel's RGB, where the options ask for it.
+    pub flip: Option<FlipStats>,
 }
 
 /// Pixels counted apart from the tolerances: a class where the two images are known to differ by the models
@@ -310,6 +320,7 @@ pub fn diff_excusing(
             max_rel: 0.0,
             allowed: None,
         }),
+        flip: None,
     };
     let mut per_pixel = Vec::with_capacity((w * h) as usize);
     let mut sum_sq = 0.0;
@@ -383,10 +394,23 @@ pub fn diff_excusing(
         && report.coverage_mismatches.total <= options.fail_coverage
         && report.hard_failures == 0;
     report.warn = report.pass && report.over_warn.total > 0;
+    if let Some(input) = options.flip.or(options.fail_flip.map(|_| FlipInput::Hdr)) {
+        report.add_flip(super::flip::flip(a, b, input, super::flip::DEFAULT_PPD)?.stats(), options.fail_flip);
+    }
     Ok((report, per_pixel))
 }
 
 impl DiffReport {
+    /// Adds FLIP's summary; the comparison fails where its mean exceeds `fail_flip`.
+    pub fn add_flip(&mut self, stats: FlipStats, fail_flip: Option<f64>) {
+        self.options.fail_flip = fail_flip;
+        if fail_flip.is_some_and(|t| stats.mean > t) {
+            self.pass = false;
+            self.warn = false;
+        }
+        self.flip = Some(stats);
+    }
+
     /// Fails the comparison where more of the pixels counted apart are over tolerance than `fraction` of the
     /// compared pixels (rounded down): a class that excuses a few rays grazing an edge, not a region.
     pub fn cap_excused(&mut self, fraction: f64) {
@@ -465,6 +489,10 @@ impl DiffReport {
                 e.compared, e.class, e.over_tolerance, e.max_rel
             );
         }
+        if let Some(f) = &self.flip {
+            let limit = o.fail_flip.map_or(String::new(), |t| format!(" (allowed mean {t})"));
+            s += &format!("{}{limit}\n", f.text());
+        }
         if let Some(wp) = &self.worst {
             s += &format!(
                 "worst pixel: ({}, {}) rel {:.3e} abs {:.3e}\n  A = [{:e}, {:e}, {:e}, {}]\n  B = [{:e}, {:e}, {:e}, {}]\n",
@@ -499,8 +527,10 @@ impl DiffReport {
                 "fail_rel": self.options.fail_rel, "fail_abs": self.options.fail_abs, "fail_peak": self.options.fail_peak,
                 "fail_count": self.options.fail_count, "fail_percent": self.options.fail_percent,
                 "fail_coverage": self.options.fail_coverage, "hard_fail": self.options.hard_fail,
-                "warn_rel": self.options.warn_rel, "warn_abs": self.options.warn_abs
+                "warn_rel": self.options.warn_rel, "warn_abs": self.options.warn_abs,
+                "fail_flip": self.options.fail_flip
             },
+            "flip": self.flip.as_ref().map(|f| f.json()),
             "pass": self.pass,
             "warn": self.warn,
             "excused": self.excused.as_ref().map(|e| json!({ "class": e.class, "compared": e.compared, "over_tolerance": e.over_tolerance, "allowed": e.allowed, "max_rel": finite(e.max_rel) })),

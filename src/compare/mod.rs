@@ -1,5 +1,7 @@
-//! Comparing two images: metrics ([`diff`]) and a false-colour heatmap ([`heatmap`]).
+//! Comparing two images: metrics ([`diff`]), a false-colour heatmap ([`heatmap`]) and the perceptual FLIP
+//! ([`flip`]).
 
+pub mod flip;
 mod heatmap;
 mod metrics;
 
