@@ -136,8 +136,13 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     return partial ? (past_rays ? SUN_CONE_UNKNOWN : SUN_CONE_PARTIAL) : SUN_CONE_MISSES;
 }
 
-// The most triangles a penumbra's sun rays test from a list (sun_cone_list) rather than the cell's whole range.
-#define MAX_SUN_LISTED 32u
+// The most triangles a penumbra's sun rays test from a list (sun_cone_list) rather than the cell's whole range: as
+// many as a cell's range may hold for its rays (MAX_SUN_CELL_TRIANGLES), so that a point past its cell's bound
+// whose cone meets at most this many tests them rather than walking the tree (on sunset.glb, where the low sun
+// gives most penumbra pixels 65 to 256 such triangles above 257 to 1024 in their cells, a linear scan of the list
+// is faster than the walk: docs/accuracy.md, "What the default shadows cost"). A kilobyte of private memory an
+// invocation.
+#define MAX_SUN_LISTED 256u
 // The entries of the shaded point's cell that its sun cone does not provably miss, where sun_cone_list found at
 // most MAX_SUN_LISTED (sun_listed_count of them; sun_listed_valid), for sun_cells_occluded.
 uint sun_listed[MAX_SUN_LISTED];
