@@ -20,6 +20,7 @@
 pub mod barycentric;
 pub mod checked;
 pub mod clip;
+mod cone_occluders;
 pub mod disk_costs;
 mod fragment;
 pub mod interpolate;

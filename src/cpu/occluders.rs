@@ -14,6 +14,8 @@ use crate::shading::visibility::SliceReach;
 use crate::shading::{Occlusion, ShadowedLights, Shadowing};
 use crate::visibility::{occluder_bvh, Bvh, WatertightRay};
 
+use super::cone_occluders::{ConeOccluders, LISTED_AT_MOST};
+
 /// A masked triangle's material, corners [m], texture coordinates per set, and vertex alphas (if the mesh has
 /// colours).
 struct MaskedTriangle {
@@ -95,6 +97,16 @@ impl Occlusion for Occluders<'_> {
     /// The slices need opaque triangles: with an alpha-masked occluder the reference casts rays instead.
     fn slice_triangles(&self, reach: &SliceReach, visit: &mut dyn FnMut([DVec3; 3])) -> bool {
         self.masked.is_empty() && self.bvh.slice_triangles(reach, visit)
+    }
+
+    /// The triangles within reach (`cpu::cone_occluders`), where the occluders are opaque and they are few.
+    fn narrowed(&self, reach: &SliceReach) -> Option<Box<dyn Occlusion + '_>> {
+        if !self.masked.is_empty() {
+            return None;
+        }
+        let found = self.bvh.within_reach_at_most(reach, LISTED_AT_MOST)?;
+        let triangles = found.into_iter().map(|i| self.bvh.triangle(i)).collect();
+        Some(Box::new(ConeOccluders { reach: *reach, triangles, whole: self }))
     }
 }
 

@@ -171,6 +171,14 @@ pub trait Occlusion: Sync {
         let _ = (reach, visit);
         false
     }
+
+    /// These occluders for the many rays of one point that all leave within `reach`'s cone and half-spaces (a
+    /// light's grid): where they can, the few triangles those rays can meet, gathered once, which answer each such
+    /// ray as the whole would (and pass any other ray to the whole); `None` keeps the whole.
+    fn narrowed(&self, reach: &SliceReach) -> Option<Box<dyn Occlusion + '_>> {
+        let _ = reach;
+        None
+    }
 }
 
 /// What the slices of a light (`sky_slices`, `sun_slices`, `disk_slices`) from the rays' origin `origin` \[m\] can

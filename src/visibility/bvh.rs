@@ -346,23 +346,45 @@ impl Bvh {
     /// its centre's signed distance plus its half-extent projected on the normal is positive; the boxes' padding
     /// (a relative 1e-9) covers the rounding of those tests.
     pub fn within_reach(&self, reach: &SliceReach, mut visit: impl FnMut(usize)) {
-        let origin = reach.origin;
-        let reaches = |centre: DVec3, half: DVec3, k: DVec3| centre.dot(k) + half.dot(k.abs()) > 0.0;
-        let enter = |node: &Node| {
-            let centre = 0.5 * (node.min + node.max) - origin;
-            let half = 0.5 * (node.max - node.min);
-            // The culls as written (a NaN distance keeps the box: no comparison culls it).
-            let culled = !reach.above.iter().all(|&k| reaches(centre, half, k))
-                || reach.cone.is_some_and(|(axis, cos, sin)| !sphere_meets_cone(centre, half.length(), axis, cos, sin))
-                || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b)
-                || reach.row.is_some_and(|(p, m)| !within_row(centre, half, p, m));
-            !culled
-        };
-        self.descend(enter, |i| {
-            visit(i);
-            false
-        });
+        self.descend(
+            |node| node_within_reach(node, reach),
+            |i| {
+                visit(i);
+                false
+            },
+        );
     }
+
+    /// The triangles [`Bvh::within_reach`] visits, where they are at most `limit`; `None` (the walk cut short)
+    /// where they are more.
+    pub fn within_reach_at_most(&self, reach: &SliceReach, limit: usize) -> Option<Vec<usize>> {
+        let mut found = Vec::new();
+        let mut over = false;
+        self.descend(
+            |node| node_within_reach(node, reach),
+            |i| {
+                over = found.len() == limit;
+                if !over {
+                    found.push(i);
+                }
+                over
+            },
+        );
+        (!over).then_some(found)
+    }
+}
+
+/// Whether a node's box may hold a part of what `reach` bounds ([`Bvh::within_reach`]).
+fn node_within_reach(node: &Node, reach: &SliceReach) -> bool {
+    let reaches = |centre: DVec3, half: DVec3, k: DVec3| centre.dot(k) + half.dot(k.abs()) > 0.0;
+    let centre = 0.5 * (node.min + node.max) - reach.origin;
+    let half = 0.5 * (node.max - node.min);
+    // The culls as written (a NaN distance keeps the box: no comparison culls it).
+    let culled = !reach.above.iter().all(|&k| reaches(centre, half, k))
+        || reach.cone.is_some_and(|(axis, cos, sin)| !sphere_meets_cone(centre, half.length(), axis, cos, sin))
+        || reach.beyond.is_some_and(|(k, b)| centre.dot(k) + half.dot(k.abs()) <= b)
+        || reach.row.is_some_and(|(p, m)| !within_row(centre, half, p, m));
+    !culled
 }
 
 /// Whether a box (centre relative to a point's rays' origin, half-extent) may hold a part of a row's half-plane
