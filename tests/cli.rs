@@ -683,6 +683,10 @@ fn diff_reports_flip_fails_on_its_mean_and_writes_its_map() {
     assert_eq!((code, report["pass"].as_bool()), (Some(1), Some(false)), "{report}");
     let (code, _) = json(&["--fail-flip", &format!("{}", mean * 1.1)]);
     assert_eq!(code, Some(0));
+    // --no-flip skips it, and refuses to be asked for it.
+    let (code, report) = json(&["--no-flip"]);
+    assert!(code == Some(0) && report["flip"].is_null(), "{report}");
+    assert_eq!(sunshade(&["diff", s(&pa), s(&pb), "--no-flip", "--fail-flip", "0.1"]).status.code(), Some(2));
     // The same pair against itself: FLIP 0.
     let o = sunshade(&["diff", s(&pa), s(&pa)]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("mean 0.0000"), "{}", String::from_utf8_lossy(&o.stdout));
