@@ -265,16 +265,8 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
         Some((map.stats(), a.tolerances.fail_flip))
     };
     let options = DiffOptions { fail_flip: None, ..a.tolerances.options() };
-    let report = compare_and_report(
-        &ia,
-        &ib,
-        (&names.0, &names.1),
-        &options,
-        flip,
-        a.heatmap.as_deref(),
-        format,
-        None,
-    )?;
+    let report =
+        compare_and_report(&ia, &ib, (&names.0, &names.1), &options, flip, a.heatmap.as_deref(), format, None)?;
     if report.pass {
         Ok(())
     } else {

@@ -200,6 +200,23 @@ mod tests {
     }
 
     #[test]
+    fn tiny_and_hostile_images_give_values_in_the_unit_interval() {
+        for (w, h) in [(1, 1), (1, 7), (5, 1)] {
+            let mut a = Image::new(w, h);
+            let mut b = Image::new(w, h);
+            for (i, (p, q)) in a.pixels_mut().iter_mut().zip(b.pixels_mut()).enumerate() {
+                *p = [i as f32, f32::NAN, -1.0, 1.0];
+                *q = [f32::INFINITY, 0.5, 1e30, 1.0];
+            }
+            for input in [FlipInput::Ldr, FlipInput::Hdr] {
+                let m = flip(&a, &b, input, DEFAULT_PPD).unwrap();
+                assert!(m.values.iter().all(|v| (0.0..=1.0).contains(v)), "{w}x{h} {input:?}: {:?}", m.values);
+            }
+        }
+        assert!(flip(&Image::new(2, 2), &Image::new(2, 3), FlipInput::Hdr, DEFAULT_PPD).is_err());
+    }
+
+    #[test]
     fn magma_runs_from_black_to_pale_yellow() {
         assert_eq!(magma(0.0), [0, 0, 4]);
         assert_eq!(magma(1.0), [252, 253, 191]);
