@@ -251,12 +251,13 @@ pub fn run(a: &DiffCommand) -> Result<(), CliError> {
     }
     let names = (a.a.display().to_string(), a.b.display().to_string());
     let format = ReportFormat::new(a.json, &unit, Vec::new());
-    // FLIP once, for the report and the map: display values for PNGs, radiance otherwise.
+    // FLIP once, for the report and the map: display values for PNGs, radiance otherwise; B is its reference, as
+    // in the comparisons of `render --check`, suites and the testing API (the expected image second).
     let input = if fa == ImageFormat::Png { FlipInput::Ldr } else { FlipInput::Hdr };
     let flip = if a.no_flip {
         None
     } else {
-        let map = compare::flip::flip(&ia, &ib, input, compare::flip::DEFAULT_PPD)
+        let map = compare::flip::flip(&ib, &ia, input, compare::flip::DEFAULT_PPD)
             .map_err(|e| CliError::Usage(format!("{} vs {}: {e}", names.0, names.1)))?;
         if let Some(path) = &a.flip_map {
             compare::flip::write_flip_map(path, &map)

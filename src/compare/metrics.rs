@@ -394,8 +394,9 @@ pub fn diff_excusing(
         && report.coverage_mismatches.total <= options.fail_coverage
         && report.hard_failures == 0;
     report.warn = report.pass && report.over_warn.total > 0;
+    // FLIP's reference is B, the expected image (HDR-FLIP chooses its exposures from it).
     if let Some(input) = options.flip.or(options.fail_flip.map(|_| FlipInput::Hdr)) {
-        report.add_flip(super::flip::flip(a, b, input, super::flip::DEFAULT_PPD)?.stats(), options.fail_flip);
+        report.add_flip(super::flip::flip(b, a, input, super::flip::DEFAULT_PPD)?.stats(), options.fail_flip);
     }
     Ok((report, per_pixel))
 }
