@@ -562,19 +562,12 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     }
     // A changed image fails, and leaves the actual image and heatmap in the report folder.
     let other = dir.path("goldens/a.exr");
-    let o = sunshade(&[
-        "render",
-        s(&dir.path("scene.glb")),
-        "-o",
-        s(&other),
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--sun-elevation",
-        "60",
-    ]);
-    assert!(o.status.success());
+    let golden_of_a_sun_at_60 = || {
+        let (scene, out) = (dir.path("scene.glb"), s(&other));
+        let o = sunshade(&["render", s(&scene), "-o", out, "--width", "32", "--height", "24", "--sun-elevation", "60"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    };
+    golden_of_a_sun_at_60();
     let o = sunshade(&["test", s(&suite), "--report", s(&dir.path("report")), "--junit", s(&dir.path("j.xml"))]);
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert_eq!(o.status.code(), Some(1), "{out}");
@@ -618,19 +611,7 @@ fn test_suites_fail_on_missing_goldens_update_them_and_report() {
     assert!(out.contains("PASS ref") && !out.contains("strict") && out.contains("1 passed"), "{out}");
     // FLIP in a suite: a golden of the sun at 60° against a render at the default 30°, within any relative
     // tolerance, fails on its mean FLIP where that is held low, and the failure says so.
-    let o = sunshade(&[
-        "render",
-        s(&dir.path("scene.glb")),
-        "-o",
-        s(&other),
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--sun-elevation",
-        "60",
-    ]);
-    assert!(o.status.success());
+    golden_of_a_sun_at_60();
     let flip_suite = |limit: f64| {
         let path = dir.path("flip.json");
         let case = json!([{ "name": "sun", "scene": "scene.glb", "width": 32, "height": 24, "golden": "goldens/a.exr",

@@ -59,18 +59,11 @@ fn scene(variant: u32, scale: f32, bright: f32) -> Image {
     Image::from_pixels(W, H, pixels).unwrap()
 }
 
-/// Writes an image as a PFM (RGB floats, rows from the bottom), for the reference implementation.
+/// Writes an image as a PFM (RGB floats), for the reference implementation.
 fn dump(name: &str, image: &Image) {
     let Some(dir) = std::env::var_os("SUNSHADE_FLIP_DUMP") else { return };
-    let mut bytes = format!("PF\n{} {}\n-1.0\n", image.width(), image.height()).into_bytes();
-    for y in (0..image.height()).rev() {
-        for x in 0..image.width() {
-            for c in &image.get(x, y)[..3] {
-                bytes.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-    }
-    std::fs::write(std::path::Path::new(&dir).join(format!("{name}.pfm")), bytes).unwrap();
+    let path = std::path::Path::new(&dir).join(format!("{name}.pfm"));
+    sunshade::film::write_image(image, &path, sunshade::film::Exposure::Ev(0.0)).unwrap();
 }
 
 /// The map of `test` against `reference`, after dumping both.

@@ -76,7 +76,6 @@ impl ToleranceArgs {
             hard_fail: self.hard_fail,
             warn_rel: self.warn_rel,
             warn_abs: self.warn_abs,
-            flip: None,
             fail_flip: self.fail_flip,
         }
     }

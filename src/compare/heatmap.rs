@@ -36,10 +36,15 @@ pub fn colour_scale(t: f64) -> [u8; 3] {
         [170.0, 220.0, 50.0],
         [253.0, 231.0, 37.0],
     ];
-    let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) } * (STOPS.len() - 1) as f64;
-    let i = (t.floor() as usize).min(STOPS.len() - 2);
+    sampled_scale(&STOPS, t)
+}
+
+/// Colour of `t` in [0, 1] (NaN: 1) on a scale given by samples evenly spaced over it, interpolated linearly.
+pub(super) fn sampled_scale(stops: &[[f64; 3]], t: f64) -> [u8; 3] {
+    let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) } * (stops.len() - 1) as f64;
+    let i = (t.floor() as usize).min(stops.len() - 2);
     let f = t - i as f64;
-    let c: [f64; 3] = std::array::from_fn(|k| STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f);
+    let c: [f64; 3] = std::array::from_fn(|k| stops[i][k] * (1.0 - f) + stops[i + 1][k] * f);
     c.map(|v| v.round() as u8)
 }
 

@@ -62,10 +62,8 @@ pub struct DiffOptions {
     /// comparison that passes with such pixels is a WARN (still a pass).
     pub warn_rel: Option<f64>,
     pub warn_abs: Option<f64>,
-    /// Compute FLIP for images of this kind ([`super::flip`]): LDR-FLIP for display values, HDR-FLIP for radiance.
-    /// `None` computes it only where `fail_flip` is given, as HDR-FLIP.
-    pub flip: Option<FlipInput>,
-    /// The comparison fails where the mean FLIP exceeds this (in [0, 1]).
+    /// The comparison fails where the mean HDR-FLIP ([`super::flip`], in [0, 1]) exceeds this; given, FLIP is
+    /// computed and reported.
     pub fail_flip: Option<f64>,
 }
 
@@ -83,7 +81,6 @@ impl Default for DiffOptions {
             hard_fail: None,
             warn_rel: None,
             warn_abs: None,
-            flip: None,
             fail_flip: None,
         }
     }
@@ -273,9 +270,7 @@ pub fn diff_excusing(
     options: &DiffOptions,
     excused: Option<(&[bool], &str)>,
 ) -> Result<(DiffReport, Vec<PixelDiff>), String> {
-    if (a.width(), a.height()) != (b.width(), b.height()) {
-        return Err(format!("sizes differ: {}x{} and {}x{}", a.width(), a.height(), b.width(), b.height()));
-    }
+    super::same_size(a, b)?;
     let (w, h) = (a.width(), a.height());
     let covered = |img: &Image, x: i64, y: i64| {
         x >= 0 && y >= 0 && x < w as i64 && y < h as i64 && img.get(x as u32, y as u32)[3] > 0.0
@@ -395,8 +390,8 @@ pub fn diff_excusing(
         && report.hard_failures == 0;
     report.warn = report.pass && report.over_warn.total > 0;
     // FLIP's reference is B, the expected image (HDR-FLIP chooses its exposures from it).
-    if let Some(input) = options.flip.or(options.fail_flip.map(|_| FlipInput::Hdr)) {
-        report.add_flip(super::flip::flip(b, a, input, super::flip::DEFAULT_PPD)?.stats(), options.fail_flip);
+    if options.fail_flip.is_some() {
+        report.add_flip(super::flip::flip(b, a, FlipInput::Hdr, super::flip::DEFAULT_PPD)?.stats(), options.fail_flip);
     }
     Ok((report, per_pixel))
 }

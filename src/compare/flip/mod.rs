@@ -46,15 +46,7 @@ pub struct FlipMap {
 /// The FLIP map of `test` against `reference` (their RGB; alpha is not read), at `ppd` pixels per degree.
 /// `Err` where the sizes differ.
 pub fn flip(reference: &Image, test: &Image, input: FlipInput, ppd: f32) -> Result<FlipMap, String> {
-    if (reference.width(), reference.height()) != (test.width(), test.height()) {
-        return Err(format!(
-            "sizes differ: {}x{} and {}x{}",
-            reference.width(),
-            reference.height(),
-            test.width(),
-            test.height()
-        ));
-    }
+    super::same_size(reference, test)?;
     let (w, h) = (reference.width() as usize, reference.height() as usize);
     let rgb = |img: &Image| -> Vec<[f32; 3]> {
         img.pixels()
@@ -150,7 +142,7 @@ impl FlipStats {
 
 /// matplotlib's magma (van der Walt & Smith), nine samples interpolated linearly.
 fn magma(t: f32) -> [u8; 3] {
-    const STOPS: [[f32; 3]; 9] = [
+    const STOPS: [[f64; 3]; 9] = [
         [0.0, 0.0, 4.0],
         [29.0, 17.0, 71.0],
         [81.0, 18.0, 124.0],
@@ -161,10 +153,7 @@ fn magma(t: f32) -> [u8; 3] {
         [254.0, 196.0, 136.0],
         [252.0, 253.0, 191.0],
     ];
-    let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) } * 8.0;
-    let i = (t.floor() as usize).min(7);
-    let f = t - i as f32;
-    std::array::from_fn(|k| (STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f).round() as u8)
+    super::heatmap::sampled_scale(&STOPS, t as f64)
 }
 
 /// Writes `map` as a magma PNG, atomically.
