@@ -101,6 +101,12 @@ pub fn sun_visible_fraction_sliced(s: &Shadowing, n: DVec3, l: DVec3, angular_di
     Some(rows_fraction(visible, total))
 }
 
+/// What the sun's rays from `origin` (on a surface of normal `n`) within `sigma` \[rad\] of `l` can meet: the
+/// half-spaces above the surface and towards the sun, and that cone.
+pub fn sun_reach(origin: DVec3, n: DVec3, l: DVec3, sigma: f64) -> SliceReach {
+    SliceReach { origin, above: [n, l], cone: Some((l, sigma.cos(), sigma.sin())), beyond: None, row: None }
+}
+
 /// The rows `first .. first + count` of [`sun_visible_fraction_sliced`]'s `rows`: their cosine-weighted visible and
 /// unoccluded weights ([`sliced_rows_weights`]), the GPU's unit of work where one fragment cannot take every row
 /// (`gpu::slice_passes`).
@@ -118,8 +124,7 @@ pub fn sun_rows_weights(
     let q = c.cross(l);
     // One walk over the sun's cone, each triangle filed under the rows its arc about the axis holds
     // (`slice_buckets`); the rows, ψ = −σ cos u ascending, made only where the walk keeps a triangle.
-    let cone = Some((l, sigma.cos(), sigma.sin()));
-    let reach = SliceReach { origin: s.origin, above: [n, l], cone, beyond: None, row: None };
+    let reach = sun_reach(s.origin, n, l, sigma);
     let rows = || cosine_rows(l, q, (0.0, sigma), rows.max(1));
     sliced_rows_weights(
         s,

@@ -14,7 +14,7 @@ use crate::shading::lobe::{
 };
 use crate::shading::options::{ShadingOptions, SunModel};
 use crate::shading::radiometry::cone_solid_angle;
-use crate::shading::visibility::{grid_fraction, GridLight, Shadowing, SliceReach};
+use crate::shading::visibility::{grid_fraction, GridLight, Shadowing};
 use crate::shading::{orthonormal_to, SurfacePoint};
 
 /// The sun's solid angle `Ω_sun` \[sr\] from its angular diameter `δ` \[rad\]: `2π(1 − cos(δ/2))`.
@@ -132,14 +132,8 @@ pub fn sun_visible_fraction(s: &Shadowing, n: DVec3, l: DVec3, angular_diameter:
     // The grid's rays leave within the sun's cone and above the surface: the occluders within that reach, where
     // the occluders can list them, answer each as the whole would. The cone a little wider than the disk
     // (2^-20 of its half-angle) for the rounding of the rays' directions.
-    let sigma = 0.5 * angular_diameter * (1.0 + 1.0 / 1_048_576.0);
-    let reach = SliceReach {
-        origin: s.origin,
-        above: [n, l],
-        cone: Some((l, sigma.cos(), sigma.sin())),
-        beyond: None,
-        row: None,
-    };
+    let reach =
+        crate::shading::sun_slices::sun_reach(s.origin, n, l, 0.5 * angular_diameter * (1.0 + 1.0 / 1_048_576.0));
     match s.occluders.narrowed(&reach) {
         Some(near) => grid_fraction(&Shadowing { occluders: near.as_ref(), ..*s }, &light),
         None => grid_fraction(s, &light),
