@@ -4,9 +4,9 @@
 //! per point, they answer each such ray exactly as the whole tree would: the same watertight test on every
 //! triangle the ray could meet, the others out of its reach. A ray outside the reach (a bisection that dips below
 //! the horizon, any other caller's ray) goes to the whole tree. Where more than [`LISTED_AT_MOST`] triangles lie in
-//! reach, testing them all a ray would cost more than walking the tree, and the point keeps it: measured on the
-//! reference's renders of teapot, cube, sunset and brdfs, 64 was as fast as 256 or faster, and 1024 slower. A
-//! disk light's reach (its bounding ball's cone, wide near the light) holds more, and its grids keep the tree.
+//! reach, testing them all a ray would cost more than walking the tree, and the point keeps it (CHANGELOG.md has
+//! the limit's measurement). A disk light's reach (its bounding ball's cone, wide near the light) holds more, and
+//! its grids keep the tree.
 
 use glam::DVec3;
 
