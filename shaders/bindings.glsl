@@ -71,14 +71,17 @@ layout(constant_id = 7) const uint VARIANT_VISIBILITY = 0u; // VISIBILITY_GRID o
 layout(constant_id = 8) const uint VARIANT_OCCLUDERS_MASKED = 0u; // with shadow rays: 1 where a material of the scene
                                                              // is alpha-masked (occluders.glsl's blocks tests it)
 layout(constant_id = 9) const uint VARIANT_SUN_CELLS = 0u; // with shadow rays and a sun: SUN_CELLS_*
-layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays: PENUMBRAE_HERE or PENUMBRAE_LATER
+layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays: PENUMBRAE_HERE, _LATER, TREE_LATER
 
 // Where a pixel whose lights are neither proven wholly visible nor wholly hidden is shaded (VARIANT_PENUMBRAE;
 // gpu::layout's PENUMBRAE_*): by this draw (the whole shader), or by a second draw of the scene after this one
 // (gpu::second_draw): this draw then marks it before any ray but the sun cells' (visibility.glsl's
-// LEAVE_TO_SECOND_DRAW), and holds no grid and no walk of its own.
+// LEAVE_TO_SECOND_DRAW), and holds no grid and no walk of its own. TREE_LATER: by this draw, which holds no walk
+// of the occluders' tree: a pixel whose ray needs it is marked as the first draw marks (LEAVE_THE_TREE), and the
+// frame drawn again with the tree (gpu::layout's ShaderVariant::tree_later).
 #define PENUMBRAE_HERE 0u
 #define PENUMBRAE_LATER 1u
+#define TREE_LATER 2u
 
 // What the sun's cells answer this frame (VARIANT_SUN_CELLS; gpu::layout's SUN_CELLS_*): nothing (the sun's rays
 // take occluded), every point's rays (no cell holds more than MAX_SUN_CELL_TRIANGLES: occluded is never needed for

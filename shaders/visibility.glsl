@@ -35,6 +35,13 @@ const bool SHADOWS_MAP_ON = VARIANT_SHADOWS == SHADOWS_MAP;
         left_to_second_draw = true; \
         return value; \
     }
+// A ray through the tree in either draw that holds no tree (the first of two, and TREE_LATER's): the pixel is
+// marked for the draw or frame that has it.
+#define LEAVE_THE_TREE(value) \
+    if (VARIANT_PENUMBRAE != PENUMBRAE_HERE) { \
+        left_to_second_draw = true; \
+        return value; \
+    }
 
 #ifdef SUNSHADE_RAY_QUERY
 layout(set = 0, binding = 4) uniform accelerationStructureEXT scene_tlas;
@@ -44,7 +51,7 @@ layout(set = 0, binding = 4) uniform accelerationStructureEXT scene_tlas;
 // candidate hit is confirmed where the triangle blocks (occluders.glsl's blocks, at the hit's barycentrics;
 // src/cpu/occluders.rs in the reference), so light passes where the mask cuts the surface away.
 bool occluded(vec3 origin, vec3 direction, float t_max) {
-    LEAVE_TO_SECOND_DRAW(false);
+    LEAVE_THE_TREE(false);
     rayQueryEXT q;
     rayQueryInitializeEXT(q, scene_tlas, gl_RayFlagsTerminateOnFirstHitEXT, 0xFFu, origin, 0.0, direction, t_max);
     while (rayQueryProceedEXT(q)) {
@@ -59,7 +66,7 @@ bool occluded(vec3 origin, vec3 direction, float t_max) {
 // The same on a device without ray queries: the occluders' tree walked in the shader (occluders.glsl). A zero
 // or non-finite direction meets nothing (as WatertightRay::new refuses it).
 bool occluded(vec3 origin, vec3 direction, float t_max) {
-    LEAVE_TO_SECOND_DRAW(false);
+    LEAVE_THE_TREE(false);
     if (direction == vec3(0.0) || any(isinf(direction)) || any(isnan(direction))) {
         return false;
     }

@@ -1379,3 +1379,44 @@ fn gpu_two_draws_render_the_one_draws_image() {
         &[&small[..], &["--disk-light", "0.3,2.5,0.2:0,-1,0:0.5:2000"]].concat(),
     );
 }
+
+#[test]
+fn gpu_points_under_more_triangles_than_the_sun_cells_answer_for_draw_the_frame_again_with_the_tree() {
+    // 300 triangles stacked along the sun (5° wide, 49° up), their edges in line as seen from the floor below: a
+    // floor point at the shadow's edge (the side the stack leans away from, in view) has all 300 partly in its
+    // sun cone, past what its cone's list keeps
+    // (MAX_SUN_LISTED, shaders/sun_cells.glsl) and above what its cell answers for (MAX_SUN_CELL_TRIANGLES), so
+    // its rays need the occluders' tree. The frame is drawn first without the tree (`ShaderVariant::tree_later`),
+    // which marks those pixels, then again with it; the image is the reference's, as for any default render. The
+    // grid is 2² so that the rays' walks through the stack stay within llvmpipe's loop budget.
+    let l = DVec3::new(0.8, 1.0, 0.3).normalize();
+    let mut parts = vec![floor(3.0)];
+    for i in 0..300 {
+        let h = 0.2 + 0.004 * i as f64;
+        let at = (l * (h / l.y)).as_vec3();
+        parts.push(MeshData {
+            positions: vec![at.to_array(), (at + Vec3::X).to_array(), (at + Vec3::Z).to_array()],
+            normals: vec![[0.0, 1.0, 0.0]; 3],
+            indices: vec![0, 2, 1],
+        });
+    }
+    let sc = scene(&parts);
+    let camera = camera_down(DVec3::new(0.0, 0.0, 0.5), 0.1, 3.0);
+    let s = settings(96, 96, camera, sun_lights(l, 5.0), Shadows::Auto, 2);
+    let mut gpu = common::shadow_ray_renderer();
+    let (g, timings) = gpu.render_timed(&sc, &s);
+    let created: Vec<String> = gpu.renderer().take_created_pipelines().into_iter().map(|p| p.what).collect();
+    assert!(created.iter().any(|p| p.contains("tree later")), "{created:?}");
+    assert!(created.iter().any(|p| p.contains("partly") && !p.contains("later")), "{created:?}");
+    let redrawn = timings.tree_redrawn.expect("the stack's penumbra needs the tree");
+    let (c, apart) = cpu::checked::checked_reference(&sc, &s, &gpu.reference_options());
+    let apart = apart.as_ref().map(|a| (a.mask.as_slice(), a.name, a.allowed_fraction));
+    let (report, _) = compare::diff_apart(&g, &c, &DiffOptions::default(), apart).unwrap();
+    assert!(report.pass && report.coverage_mismatches.total == 0, "{}", report.text("gpu", "cpu"));
+    // The stack's shadow and its penumbra are in view (the test would pass vacuously otherwise).
+    let none =
+        cpu::render(&sc, &settings(96, 96, camera, sun_lights(l, 5.0), Shadows::None, 1), &gpu.reference_options());
+    let shadowed = c.pixels().iter().zip(none.pixels()).filter(|(a, b)| a[0] < b[0]).count();
+    eprintln!("{redrawn} pixel(s) drawn again with the tree; {shadowed} shadowed");
+    assert!(redrawn > 0 && shadowed > redrawn, "{redrawn} redrawn, {shadowed} shadowed");
+}

@@ -75,7 +75,7 @@ float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_di
     kind = cone == SUN_CONE_UNKNOWN ? GRID_LIGHT_SUN : GRID_LIGHT_SUN_CELLS;
     // A penumbra's rays (the grid's here, the lobe's in radiance_out) test only the triangles its cone can meet,
     // where they are few: also past the cell's bound on its rays, where they would otherwise walk the tree.
-    if (VARIANT_PENUMBRAE == PENUMBRAE_HERE && (cone == SUN_CONE_PARTIAL || sun_cells_classify(origin))) {
+    if (VARIANT_PENUMBRAE != PENUMBRAE_LATER && (cone == SUN_CONE_PARTIAL || sun_cells_classify(origin))) {
         sun_cone_list(origin, n, l, sin_sigma);
         kind = sun_listed_valid ? GRID_LIGHT_SUN_CELLS : kind;
     }
@@ -155,7 +155,7 @@ vec3 sun_specular_visible(MaterialGpu material, Frame p) {
     float radius = tan(0.5 * delta);
     // The lobe's samples cast rays only in the sun's penumbra (see the Rust), which a first draw leaves to the
     // second (its pixels' fractions are exactly 0 or 1).
-    bool penumbra = VARIANT_PENUMBRAE == PENUMBRAE_HERE && sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
+    bool penumbra = VARIANT_PENUMBRAE != PENUMBRAE_LATER && sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
     SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
         SHADOWS_ON && penumbra ? RAYS_ALONG : RAYS_NONE);
     vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));

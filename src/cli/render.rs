@@ -267,6 +267,12 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         if let Some(probe) = job.render.frame.probe {
             eprintln!("sunshade: {}", probe.describe());
         }
+        if let Some(pixels) = job.render.frame.tree_redrawn {
+            eprintln!(
+                "sunshade: {pixels} pixel(s) cast sun rays through the occluders' tree (more triangles above them \
+                 than the sun's cells answer for): drawn once more, with it"
+            );
+        }
         eprintln!("sunshade: {}", job.render.prediction.line());
         print_exposure(ev);
         for p in created {

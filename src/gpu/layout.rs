@@ -34,9 +34,11 @@ pub const SUN_CELLS_COMPLETE: u32 = 1;
 pub const SUN_CELLS_PARTIAL: u32 = 2;
 /// Where a draw with shadow rays shades the pixels whose lights are neither proven wholly visible nor wholly hidden
 /// (`VARIANT_PENUMBRAE`): itself, or a second draw of the scene after it (the first then discards them before any
-/// ray but the sun cells').
+/// ray but the sun cells'). `TREE_LATER`: itself, but a pixel whose ray would walk the occluders' tree is marked
+/// instead, and the frame drawn again with the tree ([`ShaderVariant::tree_later`]).
 pub const PENUMBRAE_HERE: u32 = 0;
 pub const PENUMBRAE_LATER: u32 = 1;
+pub const TREE_LATER: u32 = 2;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
@@ -92,7 +94,8 @@ pub struct ShaderVariant {
     pub occluders_masked: u32,
     /// With shadow rays and a sun, what the frame's sun cells answer (`SUN_CELLS_*`); `SUN_CELLS_NONE` otherwise.
     pub sun_cells: u32,
-    /// `PENUMBRAE_HERE`, or `PENUMBRAE_LATER` in the first of a frame's two draws ([`ShaderVariant::first_draw`]).
+    /// `PENUMBRAE_HERE`, `PENUMBRAE_LATER` in the first of a frame's two draws ([`ShaderVariant::first_draw`]), or
+    /// `TREE_LATER` ([`ShaderVariant::tree_later`]).
     pub penumbrae: u32,
 }
 
@@ -157,6 +160,24 @@ impl ShaderVariant {
         first.then_some(Self { penumbrae: PENUMBRAE_LATER, ..*self })
     }
 
+    /// This variant without the occluders' tree: where the only shadow rays it casts are the sun's (no disk light,
+    /// no sky, the located grid) and the frame's sun cells are partial, the tree serves only the points under more
+    /// of their cell's triangles than the cells answer for whose sun cone lists more than they keep
+    /// (shaders/sun_cells.glsl), which few scenes have (none of models/). Such a pixel is marked
+    /// (`LEFT_TO_SECOND_DRAW`) rather than shaded, and the frame is drawn again with this variant
+    /// (`Renderer::render`): every frame without one skips the tree's compilation, which on lavapipe costs as
+    /// much as the rest of the shader (docs/platform.md, "What the driver compiles"). `None` elsewhere.
+    pub fn tree_later(&self) -> Option<Self> {
+        let only_the_suns_rays = self.shadows == SHADOWS_RAY
+            && self.sun_cells == SUN_CELLS_PARTIAL
+            && self.disks == LIGHT_ABSENT
+            && self.sky == LIGHT_ABSENT
+            && self.visibility == VISIBILITY_GRID
+            && self.quantity != QUANTITY_LIGHT_ROWS
+            && self.penumbrae == PENUMBRAE_HERE;
+        only_the_suns_rays.then_some(Self { penumbrae: TREE_LATER, ..*self })
+    }
+
     /// The variant in words, for `-v` and the start-up bench: "Ward · disk sun · exact disks · sky · shadow maps ·
     /// surface 0b00101 · radiance".
     pub fn describe(&self) -> String {
@@ -183,8 +204,10 @@ impl ShaderVariant {
             SUN_CELLS_PARTIAL => parts.push("sun cells, partly".into()),
             _ => {}
         }
-        if self.penumbrae == PENUMBRAE_LATER {
-            parts.push("penumbrae later".into());
+        match self.penumbrae {
+            PENUMBRAE_LATER => parts.push("penumbrae later".into()),
+            TREE_LATER => parts.push("tree later".into()),
+            _ => {}
         }
         parts.push(pick(self.quantity, &["radiance", "irradiance", "a light's rows"]));
         parts.join(" · ")
@@ -545,6 +568,7 @@ mod tests {
             ("SUN_CELLS_COMPLETE", SUN_CELLS_COMPLETE),
             ("PENUMBRAE_HERE", PENUMBRAE_HERE),
             ("PENUMBRAE_LATER", PENUMBRAE_LATER),
+            ("TREE_LATER", TREE_LATER),
             ("SUN_CELLS_PARTIAL", SUN_CELLS_PARTIAL),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),

@@ -65,6 +65,9 @@ pub struct FrameTimings {
     pub lights_in_passes: u32,
     /// The frame's probe (`frame_probe`), where one was drawn first.
     pub probe: Option<frame_probe::Probe>,
+    /// The pixels whose sun rays needed the occluders' tree in a frame drawn without it
+    /// (`ShaderVariant::tree_later`), drawn once more with it (their time is in `pipelines` and `render`).
+    pub tree_redrawn: Option<usize>,
 }
 
 /// What a frame draws besides the lights' passes: the shadow maps' transforms (world → map) where the technique
@@ -78,6 +81,9 @@ struct FrameDraws<'a> {
     draw_pipelines: &'a [vk::Pipeline],
     /// Each draw's pipeline for the second draw of the scene, null where its first draw shaded every pixel.
     second_pipelines: &'a [vk::Pipeline],
+    /// Whether the scene pass stores its depth and stencil for a draw of the marked pixels after it
+    /// (`Renderer::record_marked_pass`).
+    keep_depth: bool,
 }
 
 /// A scene's geometry and materials on the device.
@@ -758,12 +764,17 @@ impl Renderer {
         if leave && variants.iter().zip(&firsts).any(|(v, f)| v.shadows == SHADOWS_RAY && f.is_none()) {
             return Ok(None);
         }
+        // The whole variants without the occluders' tree where they can do without it (`ShaderVariant::tree_later`):
+        // the pixels whose rays need it are marked, and drawn once more after the frame by `variants`.
+        let wholes: Vec<ShaderVariant> =
+            variants.iter().map(|v| if leave { *v } else { v.tree_later().unwrap_or(*v) }).collect();
+        let tree_later = wholes != variants;
         let (draw_pipelines, second_pipelines) = if leave {
             // The first draws alone, and the whole variant of a draw without one (nothing of it is left).
             let alone: Vec<ShaderVariant> = variants.iter().zip(&firsts).map(|(v, f)| f.unwrap_or(*v)).collect();
             (self.pipeline.pipelines_of(&alone)?, vec![vk::Pipeline::null(); variants.len()])
         } else {
-            self.first_and_second_pipelines(&variants, &firsts)?
+            self.first_and_second_pipelines(&wholes, &firsts)?
         };
         let shadow_pipeline = if any_map { Some(self.pipeline.shadow_pipeline()?) } else { None };
         // Alpha-masked draws test their alpha in the maps too (shadow_mask.frag).
@@ -805,6 +816,7 @@ impl Renderer {
             map_pipelines: &map_pipelines,
             draw_pipelines: &draw_pipelines,
             second_pipelines: &second_pipelines,
+            keep_depth: tree_later,
         };
         let mut passed = slice_passes::PassedFractions::new((width * height) as usize);
         // A first frame at these rows that slices the sun or disk lights itself is probed first (`frame_probe`), on
@@ -816,6 +828,7 @@ impl Renderer {
             _ => None,
         };
         let mut probe = None;
+        let (mut tree_pipelines, mut tree_spent, mut tree_redrawn) = (Duration::ZERO, Duration::ZERO, None);
         let (image, lights, light_fractions, readback) = loop {
             passes_pipelines += self.light_fractions(scene, settings, &light_bytes, &variants, &slots, &mut passed)?;
             let light_fractions = match passed.layered() {
@@ -840,14 +853,31 @@ impl Renderer {
                 let lights = Buffer::storage(&self.dev, &frame_bytes, "lights")?;
                 self.draw_frame(scene, settings, (&lights, light_fractions.as_ref()), &draws, &[])?;
                 let t_readback = Instant::now();
-                let image = self.read_back(width, height)?;
+                let mut image = self.read_back(width, height)?;
+                if let Some((pixels, _)) =
+                    image.alpha_count_and_first(second_draw::LEFT_TO_SECOND_DRAW).filter(|_| tree_later)
+                {
+                    // Pixels whose rays need the tree: drawn once more, alone, by the variants that have it.
+                    let t_tree = Instant::now();
+                    let with_tree = self.pipeline.pipelines_of(&variants)?;
+                    tree_pipelines = t_tree.elapsed();
+                    // SAFETY: as in `draw_frame`: the GPU is idle; the frame kept its depth and stencil.
+                    unsafe {
+                        let cb = self.commands.begin(&self.dev)?;
+                        self.record_marked_pass(cb, scene, settings, &with_tree);
+                        self.commands.submit_and_wait(&self.dev, cb)?;
+                    }
+                    image = self.read_back(width, height)?;
+                    tree_redrawn = Some(pixels);
+                    tree_spent = t_tree.elapsed();
+                }
                 if !leave {
                     second_draw::check(&image).map_err(GpuError::Unsupported)?;
                 }
                 match super::loop_budget::check(&image, &self.dev.info.name) {
                     Err(_) if !passable.is_empty() && !slots.contains(&passable[0]) => {}
                     Err(e) => return Err(GpuError::LoopBudget(e)),
-                    Ok(()) => break (image, lights, light_fractions, t_readback.elapsed()),
+                    Ok(()) => break (image, lights, light_fractions, t_readback.elapsed() - tree_spent),
                 }
             }
             // The probe or the frame ran out with the sun and disk lights in the frame: their rows go to passes, in
@@ -855,14 +885,15 @@ impl Renderer {
             scene.passes_from_rows.set(rows.min(scene.passes_from_rows.get()));
             slots.extend(&passable);
         };
-        let render = t_render.elapsed() - passes_pipelines - readback;
-        let pipelines = pipelines + passes_pipelines;
+        let render = t_render.elapsed() - passes_pipelines - tree_pipelines - readback;
+        let pipelines = pipelines + passes_pipelines + tree_pipelines;
         super::slice_gather::check(&image).map_err(GpuError::Unsupported)?;
         self.lights = Some(lights);
         self.light_fractions = light_fractions;
         self.check_validation()?;
         let lights_in_passes = slice_passes::read_bits(&slots);
-        Ok(Some((image, FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe })))
+        let timings = FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe, tree_redrawn };
+        Ok(Some((image, timings)))
     }
 
     /// Each draw's pipeline and the pipeline of its second draw (null where it has no first draw, `firsts`), made
@@ -916,7 +947,8 @@ impl Renderer {
             for (map, to_map) in self.disk_maps.iter().zip(&draws.disk_maps).filter_map(|(m, f)| Some((m, (*f)?))) {
                 self.record_depth_pass(cb, scene, settings, map, to_map, draws.map_pipelines);
             }
-            self.record_scene_pass(cb, scene, settings, (draws.draw_pipelines, draws.second_pipelines), blocks);
+            let pipelines = (draws.draw_pipelines, draws.second_pipelines);
+            self.record_scene_pass(cb, scene, settings, pipelines, (blocks, draws.keep_depth));
             self.commands.submit_and_wait(&self.dev, cb)?;
         }
         Ok(())
@@ -968,7 +1000,7 @@ impl Renderer {
                 unsafe {
                     self.write_descriptors(scene, &pass_lights, &self.no_light_fractions);
                     let cb = self.commands.begin(&self.dev)?;
-                    self.record_scene_pass(cb, scene, settings, (&pass_pipelines, &[]), &[]);
+                    self.record_scene_pass(cb, scene, settings, (&pass_pipelines, &[]), (&[], false));
                     self.commands.submit_and_wait(&self.dev, cb)?;
                 }
                 let image = self.read_back(settings.width, settings.height)?;
@@ -1164,14 +1196,15 @@ impl Renderer {
     }
 
     /// Records the scene pass: targets cleared, every draw with its pipeline variant; where the frame has a second
-    /// draw (`second_pipelines` not all null: `second_draw`), the mark and the second draw after it.
+    /// draw (`second_pipelines` not all null: `second_draw`), the mark and the second draw after it; with
+    /// `keep_depth`, the depth and stencil stored for [`Self::record_marked_pass`].
     unsafe fn record_scene_pass(
         &self,
         cb: vk::CommandBuffer,
         scene: &GpuScene,
         settings: &RenderSettings,
         (draw_pipelines, second_pipelines): (&[vk::Pipeline], &[vk::Pipeline]),
-        blocks: &[(u32, u32, u32)],
+        (blocks, keep_depth): (&[(u32, u32, u32)], bool),
     ) {
         let d = &self.dev.device;
         let target = self.target.as_ref().expect("made by ensure_target");
@@ -1215,13 +1248,54 @@ impl Renderer {
         };
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer; the GPU is idle.
         unsafe {
-            self.begin_scene_rendering(cb, settings, (true, second));
+            self.begin_scene_rendering(cb, settings, (true, second || keep_depth));
             draw_scene(draw_pipelines, false);
             if second {
                 self.mark.record(cb, &target.color, &target.depth, area);
-                self.begin_scene_rendering(cb, settings, (false, false));
+                self.begin_scene_rendering(cb, settings, (false, keep_depth));
                 draw_scene(second_pipelines, true);
             }
+        }
+    }
+
+    /// Records one more draw of the pixels a frame left marked (`ShaderVariant::tree_later`), after its readback:
+    /// the colour made an attachment again, the mark, and every draw with `pipelines` under the second draw's
+    /// tests, so that only the marked pixels run them (`second_draw`).
+    ///
+    /// # Safety
+    /// `cb` is being recorded outside a rendering; the GPU is idle; the target holds the frame, its colour as the
+    /// readback left it and its depth and stencil stored (`record_scene_pass` with `keep_depth`).
+    unsafe fn record_marked_pass(
+        &self,
+        cb: vk::CommandBuffer,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        pipelines: &[vk::Pipeline],
+    ) {
+        let d = &self.dev.device;
+        let target = self.target.as_ref().expect("made by ensure_target");
+        let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) else { return };
+        let (width, height) = (settings.width, settings.height);
+        let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width, height } };
+        let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
+        let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
+        // SAFETY: as the caller guarantees; every handle belongs to this renderer.
+        unsafe {
+            let to_attachment = [image_barrier(
+                target.color.image,
+                vk::ImageAspectFlags::COLOR,
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            )];
+            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
+            self.mark.record(cb, &target.color, &target.depth, area);
+            self.begin_scene_rendering(cb, settings, (false, false));
+            second_draw::set_tests(d, cb, true);
+            d.cmd_set_scissor(cb, 0, &[area]);
+            self.record_draws(cb, scene, (vb, ib), pipelines, Some(&cull), push);
+            d.cmd_end_rendering(cb);
         }
     }
 

@@ -17,6 +17,14 @@
 //!
 //! The images are bitwise those of one draw (tests/shadows.rs, `gpu_two_draws_render_the_one_draws_image`); the
 //! diagnostic `SUNSHADE_ONE_DRAW=1` draws once.
+//!
+//! **The tree, once more where needed.** Where the only shadow rays are the sun's and its cells are partial (some
+//! points have more triangles above them than the cells answer for: sunset.glb, brdfs.glb), the tree's walk serves
+//! only the points whose sun cone also lists more than the shader keeps, and most frames have none. The whole
+//! variant is then drawn without the tree (`ShaderVariant::tree_later`, `TREE_LATER`), marking such a pixel as the
+//! first draw marks; after the readback, where a pixel holds the mark, the mark is set again and every draw made
+//! once more with the variant that has the tree, under the second draw's tests (`Renderer::record_marked_pass`),
+//! and the image read back again. The pipelines with the tree are made only then.
 
 use std::sync::Arc;
 

@@ -113,6 +113,7 @@ pub fn on_gpu(
         spent.readback += t.readback;
         spent.lights_in_passes |= t.lights_in_passes;
         spent.probe = t.probe.or(spent.probe);
+        spent.tree_redrawn = t.tree_redrawn.or(spent.tree_redrawn);
         Ok::<_, GpuError>((image, t))
     };
     let beyond = |e: GpuError, settings: &RenderSettings| match (e, tolerance) {
