@@ -182,7 +182,7 @@ impl ShaderVariant {
     /// surface 0b00101 · radiance".
     pub fn describe(&self) -> String {
         let pick = |v: u32, names: &[&str]| names.get(v as usize).copied().unwrap_or("?").to_string();
-        let mut parts = vec![pick(self.brdf, &["Lambert", "Phong", "Blinn-Phong", "Ward", "measured"])];
+        let mut parts = vec![pick(self.brdf, &["Lambert", "Phong", "Blinn-Phong", "Ward", "measured", "glTF"])];
         let lights = [
             pick(self.sun, &["", "disk sun", "delta sun"]),
             pick(self.disks, &["", "exact disks", "small-source disks"]),
@@ -648,6 +648,17 @@ mod tests {
                 "{name} is not constant {id}"
             );
         }
+    }
+
+    /// Every BRDF a variant can hold has its name in `describe` (what `-v` and the start-up bench print).
+    #[test]
+    fn every_variant_names_its_brdf() {
+        let base = ShaderVariant::new(0, 0, &Default::default(), &Default::default(), (0, false, 0));
+        for brdf in [BRDF_LAMBERT, BRDF_PHONG, BRDF_BLINN_PHONG, BRDF_WARD, BRDF_MEASURED, BRDF_GLTF] {
+            let name = ShaderVariant { brdf, ..base }.describe();
+            assert!(!name.contains('?'), "BRDF {brdf}: {name}");
+        }
+        assert!(ShaderVariant { brdf: BRDF_GLTF, ..base }.describe().starts_with("glTF · "));
     }
 
     #[test]
