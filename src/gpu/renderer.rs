@@ -722,22 +722,18 @@ impl Renderer {
             }
         }
         // The walk's buffers, laid out when a render first walks: its rays without ray queries (unless every ray
-        // goes to the sun through complete cells), the disk lights' proof that their rays are clear
+        // goes to the sun through its cells, complete, or partial with the tree later: `ShaderVariant::tree_later`,
+        // whose marked pixels lay it out then), the disk lights' proof that their rays are clear
         // (`visibility::disk_cone`), its slices.
         let lights = &settings.lights;
-        let only_sun_cells = sun_cells == SUN_CELLS_COMPLETE && lights.disks.is_empty() && lights.sky.is_none();
+        let only_sun_rays =
+            lights.disks.is_empty() && lights.sky.is_none() && settings.shading.visibility_rule == VisibilityRule::Grid;
+        let only_sun_cells = only_sun_rays && sun_cells != SUN_CELLS_NONE;
         let walks = (self.pipeline.rays_walk_bvh() && !only_sun_cells)
             || !lights.disks.is_empty()
             || settings.shading.visibility_rule == VisibilityRule::Slices;
-        if let (Shadows::Ray, true, Some(source), None) = (technique, walks, &scene.walk_source, scene.walk.get()) {
-            let (nodes, records) = source.layout();
-            let threaded = super::shadow_bvh::threaded(&nodes);
-            let threaded =
-                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&threaded), "occluder BVH, depth first")?;
-            let nodes = TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
-            let records =
-                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
-            let _ = scene.walk.set((nodes, records, threaded));
+        if technique == Shadows::Ray && walks {
+            self.lay_out_walk(scene)?;
         }
         let shadow_setup = t_shadow_setup.elapsed();
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
@@ -861,8 +857,16 @@ impl Renderer {
                     let t_tree = Instant::now();
                     let with_tree = self.pipeline.pipelines_of(&variants)?;
                     tree_pipelines = t_tree.elapsed();
+                    if self.pipeline.rays_walk_bvh() {
+                        self.lay_out_walk(scene)?;
+                    }
                     // SAFETY: as in `draw_frame`: the GPU is idle; the frame kept its depth and stencil.
                     unsafe {
+                        self.write_descriptors(
+                            scene,
+                            &lights,
+                            light_fractions.as_ref().unwrap_or(&self.no_light_fractions),
+                        );
                         let cb = self.commands.begin(&self.dev)?;
                         self.record_marked_pass(cb, scene, settings, &with_tree);
                         self.commands.submit_and_wait(&self.dev, cb)?;
@@ -894,6 +898,22 @@ impl Renderer {
         let lights_in_passes = slice_passes::read_bits(&slots);
         let timings = FrameTimings { shadow_setup, pipelines, render, readback, lights_in_passes, probe, tree_redrawn };
         Ok(Some((image, timings)))
+    }
+
+    /// The walk's buffers (`gpu::shadow_bvh`: the tree, its records in leaf order, the tree in depth-first order),
+    /// laid out and uploaded once a scene, when a frame first walks.
+    fn lay_out_walk(&self, scene: &GpuScene) -> Result<(), GpuError> {
+        if let (Some(source), None) = (&scene.walk_source, scene.walk.get()) {
+            let (nodes, records) = source.layout();
+            let threaded = super::shadow_bvh::threaded(&nodes);
+            let threaded =
+                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&threaded), "occluder BVH, depth first")?;
+            let nodes = TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&nodes), "occluder BVH nodes")?;
+            let records =
+                TexelBuffer::rgba32ui(&self.dev, bytemuck::cast_slice(&records), "occluder records, leaf order")?;
+            let _ = scene.walk.set((nodes, records, threaded));
+        }
+        Ok(())
     }
 
     /// Each draw's pipeline and the pipeline of its second draw (null where it has no first draw, `firsts`), made
