@@ -315,12 +315,10 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
 // crossings along v), alternating in one array so that no loop copies them.
 float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     LEAVE_TO_SECOND_DRAW(1.0);
-    if (k <= 1u) {
-        vec3 ray;
-        float w = light_sample(L, vec2(0.5), ray);
-        return fraction(w > 0.0 && sample_visible(origin, L, ray) ? w : 0.0, w);
-    }
-    float kf = float(k);
+    // With k <= 1 the loop's first ray is the light's centre, and its answer the fraction: one call of
+    // sample_visible in the shader, which the driver inlines with every ray test it holds (docs/platform.md, "What
+    // the driver compiles").
+    float kf = float(max(k, 1u));
     uint steps = edge_bisections(k);
     uint left = max_located_crossings(k);
     float visible = 0.0;
@@ -350,9 +348,12 @@ float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
                 : stage == GRID_ALONG_V ? vec2(float(i), float(j) - 1.0 + mid)
                                         : vec2(float(i) - 1.0 + mid, float(j));
         vec3 ray;
-        float weight = light_sample(L, vec2(uv.x / kf, uv.y / kf), ray);
+        float weight = light_sample(L, k <= 1u ? vec2(0.5) : vec2(uv.x / kf, uv.y / kf), ray);
         // The iteration's one ray (a corner of no weight casts none).
         bool ray_seen = (stage != GRID_CORNER || weight > 0.0) && sample_visible(origin, L, ray);
+        if (k <= 1u) {
+            return fraction(ray_seen ? weight : 0.0, weight);
+        }
         // What comes next at this corner: GRID_NEXT_V / GRID_NEXT_U, whether its side along v (to the corner below)
         // / along u (to the one before) needs a crossing; GRID_NEXT_RAY, a bisection goes on; GRID_NEXT_SQUARE, its
         // square. A crossing past the grid's allowance is the side's midpoint, without rays.
