@@ -178,6 +178,22 @@ impl ShaderVariant {
         only_the_suns_rays.then_some(Self { penumbrae: TREE_LATER, ..*self })
     }
 
+    /// Whether a draw of this variant reads the occluders' tree (`gpu::shadow_bvh`): its rays' walk where the
+    /// device casts no ray queries (`rays_walk_bvh`), unless its only rays are the sun's through its cells and the
+    /// tree is not theirs to walk (complete cells; partial ones in the first of two draws or with the tree later);
+    /// the disk lights' walk that proves their rays clear (`visibility::disk_cone`); the slices' gathering.
+    pub fn reads_the_tree(&self, rays_walk_bvh: bool) -> bool {
+        if self.shadows != SHADOWS_RAY {
+            return false;
+        }
+        let cells_alone = self.disks == LIGHT_ABSENT
+            && self.sky == LIGHT_ABSENT
+            && self.visibility == VISIBILITY_GRID
+            && (self.sun_cells == SUN_CELLS_COMPLETE
+                || (self.sun_cells == SUN_CELLS_PARTIAL && self.penumbrae != PENUMBRAE_HERE));
+        self.disks != LIGHT_ABSENT || self.visibility == VISIBILITY_SLICES || (rays_walk_bvh && !cells_alone)
+    }
+
     /// The variant in words, for `-v` and the start-up bench: "Ward · disk sun · exact disks · sky · shadow maps ·
     /// surface 0b00101 · radiance".
     pub fn describe(&self) -> String {
@@ -648,6 +664,31 @@ mod tests {
                 "{name} is not constant {id}"
             );
         }
+    }
+
+    /// Which draws read the occluders' tree: the walk is laid out for them alone, so a variant that walks while
+    /// this says no would read the placeholders.
+    #[test]
+    fn the_tree_is_read_by_the_draws_that_walk_it() {
+        let base = ShaderVariant {
+            sun: SUN_DISK,
+            shadows: SHADOWS_RAY,
+            ..ShaderVariant::new(0, 0, &Default::default(), &Default::default(), (0, false, 0))
+        };
+        let partial = ShaderVariant { sun_cells: SUN_CELLS_PARTIAL, ..base };
+        let complete = ShaderVariant { sun_cells: SUN_CELLS_COMPLETE, ..base };
+        // The sun's rays alone: through complete cells never; through partial ones in the whole variant only.
+        assert!(!complete.reads_the_tree(true) && partial.reads_the_tree(true) && base.reads_the_tree(true));
+        assert!(!partial.tree_later().unwrap().reads_the_tree(true));
+        assert!(!partial.first_draw().unwrap().reads_the_tree(true));
+        // With ray queries the rays take the acceleration structure; the disk lights' walk and the slices still read it.
+        assert!(!partial.reads_the_tree(false));
+        let disks = ShaderVariant { disks: DISKS_EXACT, ..complete };
+        assert!(disks.reads_the_tree(false) && disks.first_draw().unwrap().reads_the_tree(false));
+        assert!(ShaderVariant { visibility: VISIBILITY_SLICES, ..complete }.reads_the_tree(false));
+        let sky = ShaderVariant { sky: SKY_PRESENT, ..complete };
+        assert!(sky.reads_the_tree(true) && !sky.reads_the_tree(false));
+        assert!(!ShaderVariant { shadows: SHADOWS_MAP, ..disks }.reads_the_tree(true));
     }
 
     /// Every BRDF a variant can hold has its name in `describe` (what `-v` and the start-up bench print).

@@ -721,21 +721,7 @@ impl Renderer {
                     if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
             }
         }
-        // The walk's buffers, laid out when a render first walks: its rays without ray queries (unless every ray
-        // goes to the sun through its cells, complete, or partial with the tree later: `ShaderVariant::tree_later`,
-        // whose marked pixels lay it out then), the disk lights' proof that their rays are clear
-        // (`visibility::disk_cone`), its slices.
-        let lights = &settings.lights;
-        let only_sun_rays =
-            lights.disks.is_empty() && lights.sky.is_none() && settings.shading.visibility_rule == VisibilityRule::Grid;
-        let only_sun_cells = only_sun_rays && sun_cells != SUN_CELLS_NONE;
-        let walks = (self.pipeline.rays_walk_bvh() && !only_sun_cells)
-            || !lights.disks.is_empty()
-            || settings.shading.visibility_rule == VisibilityRule::Slices;
-        if technique == Shadows::Ray && walks {
-            self.lay_out_walk(scene)?;
-        }
-        let shadow_setup = t_shadow_setup.elapsed();
+        let mut shadow_setup = t_shadow_setup.elapsed();
         // The pipeline variant of each draw (its material's sun model: `RenderSettings::shading_for`), created now
         // if this is its first frame.
         let t_pipelines = Instant::now();
@@ -765,10 +751,15 @@ impl Renderer {
         let wholes: Vec<ShaderVariant> =
             variants.iter().map(|v| if leave { *v } else { v.tree_later().unwrap_or(*v) }).collect();
         let tree_later = wholes != variants;
+        // What the frame draws: the first draws alone, and the whole variant of a draw without one (nothing of it
+        // is left); or every first draw and every whole variant.
+        let drawn: Vec<ShaderVariant> = if leave {
+            variants.iter().zip(&firsts).map(|(v, f)| f.unwrap_or(*v)).collect()
+        } else {
+            wholes.iter().copied().chain(firsts.iter().flatten().copied()).collect()
+        };
         let (draw_pipelines, second_pipelines) = if leave {
-            // The first draws alone, and the whole variant of a draw without one (nothing of it is left).
-            let alone: Vec<ShaderVariant> = variants.iter().zip(&firsts).map(|(v, f)| f.unwrap_or(*v)).collect();
-            (self.pipeline.pipelines_of(&alone)?, vec![vk::Pipeline::null(); variants.len()])
+            (self.pipeline.pipelines_of(&drawn)?, vec![vk::Pipeline::null(); variants.len()])
         } else {
             self.first_and_second_pipelines(&wholes, &firsts)?
         };
@@ -785,6 +776,10 @@ impl Renderer {
             }
         }
         let pipelines = t_pipelines.elapsed();
+        // The walk's buffers, laid out when a drawn variant first reads them (`ShaderVariant::reads_the_tree`).
+        let t_walk = Instant::now();
+        self.lay_out_walk_for(scene, &drawn)?;
+        shadow_setup += t_walk.elapsed();
         let t_render = Instant::now();
         // The lights whose visible fractions the frame reads from their passes of slices (`slice_passes`): the
         // sky's always (a pixel's sky reaches more occluders than a fragment gathers); the sun's and disk lights'
@@ -857,9 +852,7 @@ impl Renderer {
                     let t_tree = Instant::now();
                     let with_tree = self.pipeline.pipelines_of(&variants)?;
                     tree_pipelines = t_tree.elapsed();
-                    if self.pipeline.rays_walk_bvh() {
-                        self.lay_out_walk(scene)?;
-                    }
+                    self.lay_out_walk_for(scene, &variants)?;
                     // SAFETY: as in `draw_frame`: the GPU is idle; the frame kept its depth and stencil.
                     unsafe {
                         self.write_descriptors(
@@ -901,8 +894,13 @@ impl Renderer {
     }
 
     /// The walk's buffers (`gpu::shadow_bvh`: the tree, its records in leaf order, the tree in depth-first order),
-    /// laid out and uploaded once a scene, when a frame first walks.
-    fn lay_out_walk(&self, scene: &GpuScene) -> Result<(), GpuError> {
+    /// laid out and uploaded once a scene, when a draw of one of `variants` first reads them
+    /// (`ShaderVariant::reads_the_tree`).
+    fn lay_out_walk_for(&self, scene: &GpuScene, variants: &[ShaderVariant]) -> Result<(), GpuError> {
+        let rays_walk = self.pipeline.rays_walk_bvh();
+        if !variants.iter().any(|v| v.reads_the_tree(rays_walk)) {
+            return Ok(());
+        }
         if let (Some(source), None) = (&scene.walk_source, scene.walk.get()) {
             let (nodes, records) = source.layout();
             let threaded = super::shadow_bvh::threaded(&nodes);
