@@ -78,7 +78,7 @@ layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays:
 // (gpu::second_draw): this draw then marks it before any ray but the sun cells' (visibility.glsl's
 // LEAVE_TO_SECOND_DRAW), and holds no grid and no walk of its own. TREE_LATER: by this draw, which holds no walk
 // of the occluders' tree: a pixel whose ray needs it is marked as the first draw marks (LEAVE_THE_TREE), and the
-// frame drawn again with the tree (gpu::layout's ShaderVariant::tree_later).
+// marked pixels drawn once more with the tree after the frame (gpu::layout's ShaderVariant::tree_later).
 #define PENUMBRAE_HERE 0u
 #define PENUMBRAE_LATER 1u
 #define TREE_LATER 2u

@@ -1381,13 +1381,13 @@ fn gpu_two_draws_render_the_one_draws_image() {
 }
 
 #[test]
-fn gpu_points_under_more_triangles_than_the_sun_cells_answer_for_draw_the_frame_again_with_the_tree() {
+fn gpu_points_under_more_triangles_than_the_sun_cells_answer_for_are_drawn_once_more_with_the_tree() {
     // 300 triangles stacked along the sun (5° wide, 49° up), their edges in line as seen from the floor below: a
     // floor point at the shadow's edge (the side the stack leans away from, in view) has all 300 partly in its
     // sun cone, past what its cone's list keeps
     // (MAX_SUN_LISTED, shaders/sun_cells.glsl) and above what its cell answers for (MAX_SUN_CELL_TRIANGLES), so
     // its rays need the occluders' tree. The frame is drawn first without the tree (`ShaderVariant::tree_later`),
-    // which marks those pixels, then again with it; the image is the reference's, as for any default render. The
+    // which marks those pixels, then they alone once more with it; the image is the reference's, as for any default render. The
     // grid is 2² so that the rays' walks through the stack stay within llvmpipe's loop budget.
     let l = DVec3::new(0.8, 1.0, 0.3).normalize();
     let mut parts = vec![floor(3.0)];

@@ -35,7 +35,7 @@ pub const SUN_CELLS_PARTIAL: u32 = 2;
 /// Where a draw with shadow rays shades the pixels whose lights are neither proven wholly visible nor wholly hidden
 /// (`VARIANT_PENUMBRAE`): itself, or a second draw of the scene after it (the first then discards them before any
 /// ray but the sun cells'). `TREE_LATER`: itself, but a pixel whose ray would walk the occluders' tree is marked
-/// instead, and the frame drawn again with the tree ([`ShaderVariant::tree_later`]).
+/// instead, and the marked pixels drawn once more with the tree ([`ShaderVariant::tree_later`]).
 pub const PENUMBRAE_HERE: u32 = 0;
 pub const PENUMBRAE_LATER: u32 = 1;
 pub const TREE_LATER: u32 = 2;
@@ -164,8 +164,8 @@ impl ShaderVariant {
     /// no sky, the located grid) and the frame's sun cells are partial, the tree serves only the points under more
     /// of their cell's triangles than the cells answer for whose sun cone lists more than they keep
     /// (shaders/sun_cells.glsl), which few scenes have (none of models/). Such a pixel is marked
-    /// (`LEFT_TO_SECOND_DRAW`) rather than shaded, and the frame is drawn again with this variant
-    /// (`Renderer::render`): every frame without one skips the tree's compilation, which on lavapipe costs as
+    /// (`LEFT_TO_SECOND_DRAW`) rather than shaded, and the marked pixels alone are drawn once more with this
+    /// variant after the frame (`gpu::second_draw`, "The tree, once more where needed"): every frame without one skips the tree's compilation, which on lavapipe costs as
     /// much as the rest of the shader (docs/platform.md, "What the driver compiles"). `None` elsewhere.
     pub fn tree_later(&self) -> Option<Self> {
         let only_the_suns_rays = self.shadows == SHADOWS_RAY

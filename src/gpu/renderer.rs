@@ -1249,30 +1249,42 @@ impl Renderer {
                 })
                 .collect(),
         };
-        let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
-        let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
-        // Every draw with `pipelines` under the tests of the one or first draw, or of the second, in every scissor,
-        // and the rendering ended.
-        let draw_scene = |pipelines: &[vk::Pipeline], as_second: bool| {
-            // SAFETY: inside the rendering begun below, in `cb`; every handle belongs to this renderer.
-            unsafe {
-                second_draw::set_tests(d, cb, as_second);
-                for &scissor in &scissors {
-                    d.cmd_set_scissor(cb, 0, &[scissor]);
-                    self.record_draws(cb, scene, (vb, ib), pipelines, Some(&cull), push);
-                }
-                d.cmd_end_rendering(cb);
-            }
-        };
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer; the GPU is idle.
         unsafe {
             self.begin_scene_rendering(cb, settings, (true, second || keep_depth));
-            draw_scene(draw_pipelines, false);
+            self.record_scene_draws(cb, (scene, settings, (vb, ib)), draw_pipelines, false, &scissors);
             if second {
                 self.mark.record(cb, &target.color, &target.depth, area);
                 self.begin_scene_rendering(cb, settings, (false, keep_depth));
-                draw_scene(second_pipelines, true);
+                self.record_scene_draws(cb, (scene, settings, (vb, ib)), second_pipelines, true, &scissors);
             }
+        }
+    }
+
+    /// Every draw of the scene with `pipelines` under the tests of the one or first draw, or of the second
+    /// (`as_second`, `second_draw::set_tests`), in every scissor, and the rendering ended.
+    ///
+    /// # Safety
+    /// `cb` is being recorded inside a rendering of the scene's target.
+    unsafe fn record_scene_draws(
+        &self,
+        cb: vk::CommandBuffer,
+        (scene, settings, buffers): (&GpuScene, &RenderSettings, (&Buffer, &Buffer)),
+        pipelines: &[vk::Pipeline],
+        as_second: bool,
+        scissors: &[vk::Rect2D],
+    ) {
+        let d = &self.dev.device;
+        let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
+        let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
+        // SAFETY: as the caller guarantees; every handle belongs to this renderer.
+        unsafe {
+            second_draw::set_tests(d, cb, as_second);
+            for &scissor in scissors {
+                d.cmd_set_scissor(cb, 0, &[scissor]);
+                self.record_draws(cb, scene, buffers, pipelines, Some(&cull), push);
+            }
+            d.cmd_end_rendering(cb);
         }
     }
 
@@ -1295,8 +1307,6 @@ impl Renderer {
         let (Some(vb), Some(ib)) = (&scene.vertices, &scene.indices) else { return };
         let (width, height) = (settings.width, settings.height);
         let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width, height } };
-        let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
-        let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
         // SAFETY: as the caller guarantees; every handle belongs to this renderer.
         unsafe {
             let to_attachment = [image_barrier(
@@ -1310,10 +1320,7 @@ impl Renderer {
             d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
             self.mark.record(cb, &target.color, &target.depth, area);
             self.begin_scene_rendering(cb, settings, (false, false));
-            second_draw::set_tests(d, cb, true);
-            d.cmd_set_scissor(cb, 0, &[area]);
-            self.record_draws(cb, scene, (vb, ib), pipelines, Some(&cull), push);
-            d.cmd_end_rendering(cb);
+            self.record_scene_draws(cb, (scene, settings, (vb, ib)), pipelines, true, &[area]);
         }
     }
 

@@ -25,7 +25,7 @@
 //! first draw marks; after the readback, where a pixel holds the mark, the mark is set again and every draw made
 //! once more with the variant that has the tree, under the second draw's tests (`Renderer::record_marked_pass`),
 //! and the image read back again. The pipelines with the tree are made, and the tree's buffers laid out
-//! (`Renderer::lay_out_walk`), only then.
+//! (`Renderer::lay_out_walk_for`), only then.
 
 use std::sync::Arc;
 
