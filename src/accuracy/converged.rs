@@ -31,11 +31,13 @@
 //! rule defines the image rather than approximating an integral that a finer grid would resolve. Interpolation is
 //! in f64 throughout the reference.
 
+use crate::accuracy::refinement::next_grid;
 use crate::compare::{default_floor, pixel_difference};
 use crate::cpu::{self, ReferenceOptions};
 use crate::film::Image;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::shading::visibility::slice_rows;
 use crate::shading::{DiskModel, ShadingOptions, SunModel};
 
 /// The accuracy claimed by default: 1e-4 relative (with the diff's floor).
@@ -169,9 +171,29 @@ fn final_check(
     moved
 }
 
+/// The coarsest shadow grid `k` (at least 2) from which a refinement by slices that stops after two doublings
+/// (`Criterion::TOLERANCE`) has taken the lights' visible fractions with `R = 4k₂²` rows at its second doubling
+/// `k₂`, `R ≥ 2/tolerance`: the start of `--tolerance`'s refined pixels where it is coarser than the render's.
+///
+/// Why `2/R`: the rows cut the light along one angle ψ and are exact along the other, so an occluder is missed by
+/// every row only where it lies wholly between two neighbours. The sun's and disk lights' rows run at
+/// `ψ = −σ cos u` for midpoints `u` spaced `π/R` (`sun_slices`), so two neighbours lie at most `σπ/R` apart, and
+/// the band between them, at most `2σ` long, holds at most `2πσ²/R` of the disk's `πσ²`: `2/R` of its area
+/// (the sky's rows, `2π/R` apart about their axis, bound a lune of `4π/R` sr, `2/R` of a hemisphere). Two doublings
+/// that agree are the refinement's estimate (`refine`); this keeps what no row of the last grid can see below the
+/// tolerance too, as a share of the light's area (a share of its weight where that varies little across it).
+pub fn slices_start(tolerance: f64) -> u32 {
+    let rows_wanted = 2.0 / tolerance;
+    let mut k = 2;
+    while (slice_rows(next_grid(next_grid(k))) as f64) < rows_wanted && k < 1024 {
+        k += 1;
+    }
+    k
+}
+
 /// The sample counts of one refinement: every count at least doubled, `n → ⌈n·√2⌉` per axis.
 pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
-    let up = super::refinement::next_grid;
+    let up = next_grid;
     ShadingOptions {
         sun_samples_per_axis: up(shading.sun_samples_per_axis),
         samples_per_axis: up(shading.samples_per_axis),
@@ -292,4 +314,21 @@ pub fn refine(
     result.image = image;
     result.shading = s.shading;
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slices_start_is_the_coarsest_grid_whose_second_doubling_has_two_rows_per_tolerance() {
+        for t in [0.5, 1e-1, 3e-2, 1e-2, 1e-3, 1e-4] {
+            let k = slices_start(t);
+            let rows_at = |k| slice_rows(next_grid(next_grid(k))) as f64;
+            assert!(rows_at(k) * t >= 2.0, "{t}: k = {k}, {} rows", rows_at(k));
+            assert!(k == 2 || rows_at(k - 1) * t < 2.0, "{t}: k = {k} is not the coarsest");
+        }
+        // 1e-2 starts at 3² (36, 100 and 256 rows); 1e-3 at 11² (the render's 6² is then the coarser).
+        assert_eq!((slices_start(1e-2), slices_start(1e-3)), (3, 11));
+    }
 }

@@ -22,7 +22,9 @@
 //! factor of safety for two grids in place of the truth's tenth and without its final check; an estimate, not a
 //! bound, measured against the converged reference by `tests/tolerance_refined.rs` and on every model in
 //! docs/accuracy.md). The grids start from
-//! the render's (6² shadow samples, `4·6²` rows of slices: the truth's start too). The cost follows the pixels that
+//! the render's (6² shadow samples, `4·6²` rows of slices: the truth's start too), the shadows' from a coarser one
+//! where the tolerance allows it (`converged::slices_start`: 3² at 1e-2, whose second doubling takes 256 rows, so
+//! that an occluder passing between two of them hides less than T of the light). The cost follows the pixels that
 //! need it: a penumbra's band, a specular sphere.
 //!
 //! **The prediction.** The GPU's pixels have the bounds of their models (`accuracy::predicted`, the sun's chosen
@@ -32,7 +34,7 @@
 use std::time::{Duration, Instant};
 
 use super::RenderError;
-use crate::accuracy::converged::{refine, with_exact_models, ConvergenceOptions, Criterion};
+use crate::accuracy::converged::{refine, slices_start, with_exact_models, ConvergenceOptions, Criterion};
 use crate::accuracy::interpolation::f32_interpolation_bound;
 use crate::accuracy::predicted::{
     choose_sun_for_bounded_pixels, material_unbounded, predict_refining, Barycentrics, Prediction,
@@ -168,6 +170,8 @@ pub fn render(
         s.sun_per_material.clear();
         if !scene.has_alpha_masks() {
             s.shading.visibility_rule = VisibilityRule::Slices;
+            let start = slices_start(t).min(s.shading.shadow_samples_per_axis);
+            s.shading.shadow_samples_per_axis = start;
         }
         let first = cpu::render_selected(scene, &s, reference, &selected);
         for ((pixel, from), flag) in image.pixels_mut().iter_mut().zip(first.pixels()).zip(selected.iter_mut()) {
