@@ -387,48 +387,49 @@ fn render_inner(
         }
     }
 
+    // Visibility, band by band: the nearest triangle of each pixel (u32::MAX where none).
+    let band_pixels = (BAND_ROWS * width) as usize;
+    let mut nearest = vec![u32::MAX; (width * height) as usize];
+    nearest.par_chunks_mut(band_pixels).zip(bins.par_iter()).enumerate().for_each(|(band, (visible, bin))| {
+        let y0 = band as u32 * BAND_ROWS;
+        let rows = visible.len() as u32 / width;
+        let mut depth = vec![1.0f64; visible.len()];
+        for &ti in bin {
+            let t = &triangles[ti as usize];
+            let masked = t.surface & SURFACE_ALPHA_MASK != 0;
+            t.raster.for_each_covered(y0, y0 + rows, |x, y| {
+                let l = t.depth.barycentrics(x, y);
+                let z = t.depth.depth(&l);
+                let k = ((y - y0) * width + x) as usize;
+                // An alpha-masked fragment below its cutoff is discarded before the depth write, as on the
+                // device.
+                if z < depth[k] && (!masked || covers(scene, settings, t, x, y)) {
+                    depth[k] = z;
+                    visible[k] = ti;
+                }
+            });
+        }
+    });
+    // Shading, pixel by pixel: each shaded once, the pixels shared out among the threads as they go rather than
+    // by bands, since the costly ones (a penumbra's, `--tolerance`'s refined pixels) gather in a few bands.
+    let shaded: Vec<usize> =
+        (0..nearest.len()).filter(|&k| nearest[k] != u32::MAX && selected.is_none_or(|m| m[k])).collect();
+    let values: Vec<([f64; 3], bool)> = shaded
+        .par_iter()
+        .with_max_len(64)
+        .map(|&k| {
+            let (x, y) = (k as u32 % width, k as u32 / width);
+            let t = &triangles[nearest[k] as usize];
+            let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
+            shade_pixel(t, (x, y), w.to_array())
+        })
+        .collect();
     let mut image = Image::new(width, height);
     let mut mask = vec![false; (width * height) as usize];
-    let band_pixels = (BAND_ROWS * width) as usize;
-    image
-        .pixels_mut()
-        .par_chunks_mut(band_pixels)
-        .zip(mask.par_chunks_mut(band_pixels))
-        .zip(bins.par_iter())
-        .enumerate()
-        .for_each(|(band, ((pixels, flagged), bin))| {
-            let y0 = band as u32 * BAND_ROWS;
-            let rows = pixels.len() as u32 / width;
-            // Visibility: the nearest triangle per pixel, then shade each pixel once.
-            let mut depth = vec![1.0f64; pixels.len()];
-            let mut visible = vec![u32::MAX; pixels.len()];
-            for &ti in bin {
-                let t = &triangles[ti as usize];
-                let masked = t.surface & SURFACE_ALPHA_MASK != 0;
-                t.raster.for_each_covered(y0, y0 + rows, |x, y| {
-                    let l = t.depth.barycentrics(x, y);
-                    let z = t.depth.depth(&l);
-                    let k = ((y - y0) * width + x) as usize;
-                    // An alpha-masked fragment below its cutoff is discarded before the depth write, as on the
-                    // device.
-                    if z < depth[k] && (!masked || covers(scene, settings, t, x, y)) {
-                        depth[k] = z;
-                        visible[k] = ti;
-                    }
-                });
-            }
-            for (k, &ti) in visible.iter().enumerate() {
-                if ti == u32::MAX || selected.is_some_and(|m| !m[band * band_pixels + k]) {
-                    continue;
-                }
-                let (x, y) = (k as u32 % width, y0 + k as u32 / width);
-                let t = &triangles[ti as usize];
-                let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
-                let (radiance, flag) = shade_pixel(t, (x, y), w.to_array());
-                flagged[k] = flag;
-                pixels[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
-            }
-        });
+    for (&k, (radiance, flag)) in shaded.iter().zip(values) {
+        mask[k] = flag;
+        image.pixels_mut()[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
+    }
     (image, mask)
 }
 
