@@ -1,7 +1,7 @@
 // Visibility of the lights. Mirrors src/shading/visibility.rs name for name: the same sample grids (the corners of
-// k x k squares, mapped to the sun's and disk lights' disks by Shirley & Chiu's concentric map, to the sky's lune
-// by its angles), the same weights, ray origins (Hanika's terminator offset, then
-// the push along the face normal) and ray extents, so that the GPU's ray queries and the reference's f64 rays
+// k x k squares, mapped to the sun's and disk lights' disks by Shirley & Chiu's concentric map and turned, to the
+// sky's lune by its angles), the same weights, ray origins (Hanika's terminator offset, then the push along the
+// face normal) and ray extents, so that the GPU's ray queries and the reference's f64 rays
 // differ only at rays that graze an occluder's edge. See the Rust for the derivations.
 #ifndef SUNSHADE_VISIBILITY_GLSL
 #define SUNSHADE_VISIBILITY_GLSL
@@ -118,6 +118,16 @@ vec2 concentric_disk(float u, float v) {
     return vec2(r * cos(phi), r * sin(phi));
 }
 
+// cos and sin of the turn of the sun's and disk lights' grids in their disks: 2^-6 rad.
+#define GRID_TURN_COS 0.9998779321710066
+#define GRID_TURN_SIN 0.015624364224883372
+
+// A point of the unit disk turned by that angle: where the sun's and disk lights' grid samples lie (see the Rust:
+// unturned, a grid's samples meet the edges of a scene built on a grid exactly, along whole lines of pixels).
+vec2 turned(vec2 xy) {
+    return vec2(GRID_TURN_COS * xy.x - GRID_TURN_SIN * xy.y, GRID_TURN_SIN * xy.x + GRID_TURN_COS * xy.y);
+}
+
 // The grid point (i, j) of k x k on the unit disk: the concentric map of the cell's midpoint.
 vec2 disk_grid_point(uint i, uint j, uint k) {
     float kf = float(k);
@@ -220,7 +230,7 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
     if (VARIANT_SKY != LIGHT_ABSENT && L.kind == GRID_LIGHT_SKY) {
         return sky_sample(L.a, L.b, L.tilt, L.radius, uv, ray);
     }
-    vec2 xy = concentric_disk(uv.x, uv.y);
+    vec2 xy = turned(concentric_disk(uv.x, uv.y));
     if (VARIANT_DISKS == LIGHT_ABSENT || L.kind == GRID_LIGHT_SUN || L.kind == GRID_LIGHT_SUN_CELLS) {
         return sun_sample(L.n, L.c, L.a, L.b, L.radius, xy, ray);
     }

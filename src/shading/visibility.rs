@@ -15,7 +15,8 @@
 //!   its angles `(β, ψ)`; `w = (n·ω) sin β` (projected solid angle per `dβ dψ`).
 //!
 //! The grids live on the unit square, mapped to the light: the sun's and disk lights' to the unit disk by Shirley &
-//! Chiu's concentric map (equal-area, low distortion; "A Low Distortion Map Between Disk and Square", 1997), the
+//! Chiu's concentric map (equal-area, low distortion; "A Low Distortion Map Between Disk and Square", 1997), turned
+//! by a small angle in the light's frame ([`turned`]), the
 //! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
 //! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
 //! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
@@ -322,6 +323,28 @@ pub fn concentric_disk(u: f64, v: f64) -> (f64, f64) {
     (r * phi.cos(), r * phi.sin())
 }
 
+/// `cos θ` and `sin θ` of the turn of the sun's and disk lights' grids in their disks ([`turned`]): `θ = 2⁻⁶` rad.
+pub const GRID_TURN_COS: f64 = 0.9998779321710066;
+pub const GRID_TURN_SIN: f64 = 0.015624364224883372;
+
+/// A point of the unit disk turned by `θ` ([`GRID_TURN_COS`]): where the sun's and disk lights' grid samples lie.
+///
+/// Why turned: unturned, the concentric map puts a grid's middle row and column on the axes of the light's frame,
+/// which for a light along a coordinate axis are coordinate axes too, and its other samples at rational
+/// coordinates in that frame. In a scene built on a grid (boxes at whole or dyadic coordinates, an orthographic
+/// camera whose pixel centres are dyadic) such rays meet occluders' edges exactly, along whole lines of pixels,
+/// where f32 and f64 then decide the edge differently (the touching blocks of tests/shadows.rs under a low disk
+/// light). Turned by an angle whose sine and cosine are no small fractions, a sample meets such an edge only by
+/// chance: it moves by `θρ` off its aligned place (`ρ` its distance from the centre), some 2⁻⁹ of the light's
+/// radius for the innermost ring of 6², far above f32's reach of an edge. The angle is small so that the rows stay
+/// nearly parallel to the edges of such a scene, along which the located grid is most accurate (an edge along a
+/// row is located exactly; a large turn makes every such edge oblique to the rows:
+/// `tolerance_estimates_a_penumbra_against_its_circular_segment`). The light's centre, the turn's fixed point, is
+/// a corner of the grid for an even k and keeps its alignment.
+pub fn turned((x, y): (f64, f64)) -> (f64, f64) {
+    (GRID_TURN_COS * x - GRID_TURN_SIN * y, GRID_TURN_SIN * x + GRID_TURN_COS * y)
+}
+
 /// The grid point `(i, j)` of `k × k` on the unit disk: the concentric map of the cell's midpoint.
 pub fn disk_grid_point(i: u32, j: u32, k: u32) -> (f64, f64) {
     let kf = k as f64;
@@ -366,15 +389,15 @@ pub(crate) enum GridLight {
 
 impl GridLight {
     /// The weight and shadow ray of the point `(u, v)` of the unit square: the sun's and disk lights' through
-    /// [`concentric_disk`], the sky's through its lune's map.
+    /// [`concentric_disk`], [`turned`], the sky's through its lune's map.
     fn light_sample(&self, (u, v): (f64, f64)) -> (f64, SampleRay) {
         match *self {
             GridLight::Sun { n, l, t, b, radius } => {
-                let (omega, w) = sun_sample(n, l, t, b, radius, concentric_disk(u, v));
+                let (omega, w) = sun_sample(n, l, t, b, radius, turned(concentric_disk(u, v)));
                 (w, SampleRay::Along(omega))
             }
             GridLight::Disk { x: at, n, center, d, a, b, radius } => {
-                let (target, w) = disk_sample(at, n, center, d, a, b, radius, concentric_disk(u, v));
+                let (target, w) = disk_sample(at, n, center, d, a, b, radius, turned(concentric_disk(u, v)));
                 (w, SampleRay::To(target))
             }
             GridLight::Sky(lune) => {
