@@ -974,6 +974,29 @@ fn shadow_rays_pass_through_alpha_masked_cutouts() {
 }
 
 #[test]
+fn a_shadow_ray_meeting_a_mask_near_its_contour_is_fragile() {
+    // masked_cutout_scene's mask (NEAREST: its alpha jumps from 1 to 0 at u = 0.5, x = −1.25): a ray towards the
+    // sun meeting it within eps of that contour is fragile, since the GPU's f32 hit may land on the other side,
+    // whatever the alpha's distance from its cutoff (0.5 on both sides here); one meeting it a texel away from any
+    // contour is not, nor one meeting the opaque floor. The mask's two triangles share its affine UV map, so
+    // either decides a point of its plane alike.
+    let (scene, _) = masked_cutout_scene();
+    let occluders = cpu::Occluders::new(&scene);
+    let eps = 1e-5;
+    let direction = DVec3::new(-1.0, 0.0, 1.0);
+    // From (x, y, 0) the ray meets the mask's plane z = 1 at (x − 1, y, 1), t = 1.
+    let at = |hit_x: f64, i: usize| occluders.blocks_near(i, DVec3::new(hit_x + 1.0, -0.3, 0.0), direction, 1.0, eps);
+    for i in [2, 3] {
+        for (hit_x, fragile) in [(-1.25 + 0.3 * eps, true), (-1.25 - 0.3 * eps, true), (-1.6, false), (-0.9, false)] {
+            assert_eq!(at(hit_x, i).1, fragile, "triangle {i}, hit at x = {hit_x}");
+        }
+        // Both sides of the contour decide differently (the test is not vacuous).
+        assert_ne!(at(-1.25 + 2.0 * eps, i).0, at(-1.25 - 2.0 * eps, i).0);
+    }
+    assert_eq!(at(-1.25, 0), (true, false), "the opaque floor");
+}
+
+#[test]
 fn gpu_shadow_maps_pass_light_through_alpha_masked_cutouts() {
     // Any device: the masked draw's depth pass discards below the cutoff, so the map lets the light through the
     // same quarters (away from the edges by two map texels' worth).

@@ -262,8 +262,8 @@ pub const FRAGILE_RAY_RELATIVE: f64 = 1.0 / 262144.0;
 
 /// The fragile pixels' class, as a comparison names it ([`render_with_fragile_pixels`]).
 pub const FRAGILE_CLASS: &str = "fragile pixels (a shadow ray within 2^-18 of the scene's size from an occluder's \
-    edge, or a texture lookup or alpha cutoff within 2^-16 of a discontinuity: f32 geometry or texture coordinates \
-    may decide the other way)";
+    edge or an alpha-masked occluder's contour, or a texture lookup or alpha cutoff within 2^-16 of a \
+    discontinuity: f32 geometry or texture coordinates may decide the other way)";
 
 /// The most fragile pixels over tolerance a check passes: 0.05% of the compared pixels (a few rays that graze an
 /// edge, not a region).
@@ -275,8 +275,9 @@ pub const FRAGILE_ALLOWED_FRACTION: f64 = 5e-4;
 pub const FRAGILE_TEXTURE_RELATIVE: f64 = 1.0 / 65536.0;
 
 /// [`render`], and for each pixel whether it is *fragile*: one of its shadow rays passes within
-/// [`FRAGILE_RAY_RELATIVE`] of the scene's size from an occluder's boundary, so that the GPU's f32 geometry could
-/// answer it the other way ([`crate::visibility::Bvh::occluded_with_margin`]), or one of its texture lookups
+/// [`FRAGILE_RAY_RELATIVE`] of the scene's size from an occluder's boundary (an edge, or the contour where an
+/// alpha-masked occluder's alpha crosses its cutoff: [`Occluders::blocks_near`]), so that the GPU's f32 geometry
+/// could answer it the other way ([`crate::visibility::Bvh::occluded_with_margin`]), or one of its texture lookups
 /// (or its alpha mask) lies within [`FRAGILE_TEXTURE_RELATIVE`] of a discontinuity (a `NEAREST` texel
 /// boundary, a nearest mip level's boundary, the switch between magnification and minification filters, an alpha
 /// cutoff). Image-diff tests count GPU/reference differences at those pixels apart, as coverage mismatches at
@@ -340,7 +341,7 @@ pub fn render_with_map_edges(
 }
 
 /// Occluders that remember whether any ray they answered was fragile (one per pixel): it grazed an edge, or met
-/// a masked triangle where its alpha is within [`FRAGILE_TEXTURE_RELATIVE`] of the cutoff.
+/// a masked triangle within `eps` of where its alpha crosses the cutoff ([`Occluders::blocks_near`]).
 struct Recording<'a> {
     occluders: &'a Occluders<'a>,
     eps: f64,
@@ -351,8 +352,7 @@ impl Occlusion for Recording<'_> {
     fn occluded(&self, origin: DVec3, direction: DVec3, t_max: f64) -> bool {
         let Some(ray) = crate::visibility::WatertightRay::new(origin, direction) else { return false };
         let (occluded, fragile) = self.occluders.bvh.occluded_with_margin_where(&ray, 0.0, t_max, self.eps, |i, t| {
-            let (blocks, margin) = self.occluders.blocks(i, origin, direction, t);
-            (blocks, margin < FRAGILE_TEXTURE_RELATIVE)
+            self.occluders.blocks_near(i, origin, direction, t, self.eps)
         });
         if fragile {
             self.fragile.store(true, std::sync::atomic::Ordering::Relaxed);

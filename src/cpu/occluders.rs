@@ -65,10 +65,37 @@ impl<'a> Occluders<'a> {
     /// Whether triangle `i`, met by the ray at `t`, blocks it, and how near its alpha is to the cutoff (infinity
     /// for an unmasked triangle).
     pub fn blocks(&self, i: usize, origin: DVec3, direction: DVec3, t: f64) -> (bool, f64) {
+        self.blocks_at(i, origin + t * direction)
+    }
+
+    /// [`Occluders::blocks`], and whether the decision is fragile: an alpha-masked triangle whose decision differs
+    /// at a point within `eps` \[m\] of the hit in its plane (four points, along two orthogonal directions), or
+    /// whose alpha lies within [`super::FRAGILE_TEXTURE_RELATIVE`] of the cutoff. The GPU finds its hit with f32
+    /// rays and barycentrics: where the mask's alpha is steep in the triangle's plane (a sharp mask over many
+    /// texels), a hit moved by the rounding of its point changes the alpha by far more than its own rounding, and
+    /// the grid's bisections place rays on the mask's contour, where that decides.
+    pub fn blocks_near(&self, i: usize, origin: DVec3, direction: DVec3, t: f64, eps: f64) -> (bool, bool) {
+        let p = origin + t * direction;
+        let (blocks, margin) = self.blocks_at(i, p);
+        let Some(Some(m)) = self.masked.get(i) else { return (blocks, false) };
+        if margin < super::FRAGILE_TEXTURE_RELATIVE {
+            return (blocks, true);
+        }
+        let [a, b, c] = m.corners;
+        let (Some(e1), Some(n)) = ((b - a).try_normalize(), (b - a).cross(c - a).try_normalize()) else {
+            return (blocks, false);
+        };
+        let e2 = n.cross(e1);
+        let near = [e1, -e1, e2, -e2].iter().any(|&e| self.blocks_at(i, p + eps * e).0 != blocks);
+        (blocks, near)
+    }
+
+    /// Whether triangle `i` blocks a ray that meets its plane at `p` \[m\] (an unmasked one always), and how near
+    /// its alpha is to the cutoff there.
+    fn blocks_at(&self, i: usize, p: DVec3) -> (bool, f64) {
         let Some(Some(m)) = self.masked.get(i) else { return (true, f64::INFINITY) };
         let material = &self.scene.materials[m.material];
         let [a, b, c] = m.corners;
-        let p = origin + t * direction;
         // Barycentrics of the hit by signed areas (f64), normalised by the triangle's.
         let n = (b - a).cross(c - a);
         let n2 = n.length_squared();
