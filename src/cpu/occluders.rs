@@ -69,7 +69,8 @@ impl<'a> Occluders<'a> {
     }
 
     /// [`Occluders::blocks`], and whether the decision is fragile: an alpha-masked triangle whose decision differs
-    /// at a point within `eps` \[m\] of the hit in its plane (four points, along two orthogonal directions), or
+    /// at one of four points `eps` \[m\] off the hit along two orthogonal directions of its plane (so that a straight
+    /// contour within `eps/√2` of the hit is always found), or
     /// whose alpha lies within [`super::FRAGILE_TEXTURE_RELATIVE`] of the cutoff. The GPU finds its hit with f32
     /// rays and barycentrics: where the mask's alpha is steep in the triangle's plane (a sharp mask over many
     /// texels), a hit moved by the rounding of its point changes the alpha by far more than its own rounding, and
