@@ -121,10 +121,16 @@ vec2 concentric_disk(float u, float v) {
 // cos and sin of the turn of the sun's and disk lights' grids in their disks: 2^-6 rad.
 #define GRID_TURN_COS 0.9998779321710066
 #define GRID_TURN_SIN 0.015624364224883372
+// How far off the light's centre turned puts the grid's sample there, in the disk's radii: 2^-10.
+#define GRID_CENTRE_SHIFT (1.0 / 1024.0)
 
-// A point of the unit disk turned by that angle: where the sun's and disk lights' grid samples lie (see the Rust:
-// unturned, a grid's samples meet the edges of a scene built on a grid exactly, along whole lines of pixels).
+// A point of the unit disk turned by that angle, the centre moved off itself: where the sun's and disk lights' grid
+// samples lie (see the Rust: otherwise a grid's samples meet the edges of a scene built on a grid exactly, along
+// whole lines of pixels).
 vec2 turned(vec2 xy) {
+    if (xy == vec2(0.0)) {
+        return GRID_CENTRE_SHIFT * vec2(GRID_TURN_COS, GRID_TURN_SIN);
+    }
     return vec2(GRID_TURN_COS * xy.x - GRID_TURN_SIN * xy.y, GRID_TURN_SIN * xy.x + GRID_TURN_COS * xy.y);
 }
 

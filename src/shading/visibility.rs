@@ -339,11 +339,20 @@ pub const GRID_TURN_SIN: f64 = 0.015624364224883372;
 /// radius for the innermost ring of 6², far above f32's reach of an edge. The angle is small so that the rows stay
 /// nearly parallel to the edges of such a scene, along which the located grid is most accurate (an edge along a
 /// row is located exactly; a large turn makes every such edge oblique to the rows:
-/// `tolerance_estimates_a_penumbra_against_its_circular_segment`). The light's centre, the turn's fixed point, is
-/// a corner of the grid for an even k and keeps its alignment.
+/// `tolerance_estimates_a_penumbra_against_its_circular_segment`). The light's centre, the turn's fixed point and
+/// a corner of every even grid (its single ray where k = 1), is moved off it by [`GRID_CENTRE_SHIFT`] of the
+/// radius along the turned axis: the user's light centre and a gridded scene line up as readily as the axes do.
+/// Moving one sample by that much changes the located grid's estimate only where an edge passes between the two
+/// places, by a sliver of some `2⁻¹⁰/k` of the disk, far below the grid's own error.
 pub fn turned((x, y): (f64, f64)) -> (f64, f64) {
+    if x == 0.0 && y == 0.0 {
+        return (GRID_CENTRE_SHIFT * GRID_TURN_COS, GRID_CENTRE_SHIFT * GRID_TURN_SIN);
+    }
     (GRID_TURN_COS * x - GRID_TURN_SIN * y, GRID_TURN_SIN * x + GRID_TURN_COS * y)
 }
+
+/// How far off the light's centre [`turned`] puts the grid's sample there, in the disk's radii: `2⁻¹⁰`.
+pub const GRID_CENTRE_SHIFT: f64 = 1.0 / 1024.0;
 
 /// The grid point `(i, j)` of `k × k` on the unit disk: the concentric map of the cell's midpoint.
 pub fn disk_grid_point(i: u32, j: u32, k: u32) -> (f64, f64) {
