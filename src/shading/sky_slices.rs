@@ -167,7 +167,8 @@ pub fn weight_integral(n_c: f64, n_p: f64, b0: f64, b1: f64) -> f64 {
 /// The weight over `[lo, hi]` (β) less the union of `blocked` (pseudo-angles, sorted here), by the gaps between
 /// them; a gap's end at the span's own end keeps its exact β.
 pub fn visible_weight(n_c: f64, n_p: f64, span: (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
-    gaps_weight(blocked, span, beta_key, angle_of, |b0, b1| weight_integral(n_c, n_p, b0, b1))
+    let keys = (beta_key(span.0), beta_key(span.1));
+    gaps_weight(blocked, (span, keys), angle_of, |b0, b1| weight_integral(n_c, n_p, b0, b1))
 }
 
 /// The pseudo-angle of β ([`pseudo_angle`] of its direction), by which [`visible_weight`] compares a span's ends
@@ -177,19 +178,17 @@ fn beta_key(b: f64) -> f64 {
 }
 
 /// The sum of `weight` over the gaps that the union of `blocked` (pseudo-angles, sorted here by their starts)
-/// leaves in `[lo, hi]` (angles whose pseudo-angles `key` gives; `angle` turns a pseudo-angle back): one walk in
-/// order of the starts, a gap wherever the next start lies beyond the furthest end reached; a gap's end at the
-/// span's own end keeps its exact angle. The union's walk of [`visible_weight`] (β) and of
+/// leaves in `[lo, hi]` (angles whose pseudo-angles are `key_lo` and `key_hi`; `angle` turns a pseudo-angle
+/// back): one walk in order of the starts, a gap wherever the next start lies beyond the furthest end reached; a
+/// gap's end at the span's own end keeps its exact angle. The union's walk of [`visible_weight`] (β) and of
 /// `slices_about_centre::visible_weight_about_centre` (γ).
 pub fn gaps_weight(
     blocked: &mut [(f64, f64)],
-    (lo, hi): (f64, f64),
-    key: impl Fn(f64) -> f64,
+    ((lo, hi), (key_lo, key_hi)): ((f64, f64), (f64, f64)),
     angle: impl Fn(f64) -> f64,
     weight: impl Fn(f64, f64) -> f64,
 ) -> f64 {
     blocked.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    let (key_lo, key_hi) = (key(lo), key(hi));
     let mut visible = 0.0;
     let mut reached = key_lo;
     let at = |k: f64| {
@@ -242,7 +241,7 @@ pub fn row_visible_weight(
         }
     }
     if any {
-        visible_weight(n_c, n_p, span, blocked)
+        gaps_weight(blocked, (span, (key_lo, key_hi)), angle_of, |b0, b1| weight_integral(n_c, n_p, b0, b1))
     } else {
         whole
     }

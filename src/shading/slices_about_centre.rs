@@ -62,7 +62,8 @@ pub fn pseudo_angle_of_gamma(g: f64) -> f64 {
 /// The weight over `[lo, hi]` (γ) less the union of `blocked` (pseudo-angles, sorted here by their starts), by
 /// the gaps between them; a gap's end at the span's own end keeps its exact γ (`sky_slices::visible_weight` in γ).
 pub fn visible_weight_about_centre(n_c: f64, n_p: f64, span: (f64, f64), blocked: &mut [(f64, f64)]) -> f64 {
-    gaps_weight(blocked, span, pseudo_angle_of_gamma, gamma_of, |g0, g1| weight_integral_about_centre(n_c, n_p, g0, g1))
+    let keys = (pseudo_angle_of_gamma(span.0), pseudo_angle_of_gamma(span.1));
+    gaps_weight(blocked, (span, keys), gamma_of, |g0, g1| weight_integral_about_centre(n_c, n_p, g0, g1))
 }
 
 #[cfg(test)]
