@@ -314,7 +314,7 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
     return 0.5 * twice;
 }
 
-// sum(w V) / sum(w) over the unit square mapped to the light (light_sample): k = 1, the light's centre
+// sum(w V) / sum(w) over the unit square mapped to the light (light_sample): k = 1, the light's centre (turned)
 // alone; otherwise the (k + 1)^2 corners of a k x k grid of squares, each square its corners' mean weight times
 // its visible share, the edges between disagreeing corners located by bisection (grid_fraction in the Rust, the
 // same rays and the same sums in the same order).
@@ -331,7 +331,7 @@ float cell_visible_area(bvec4 seen, float bottom, float right, float top, float 
 // crossings along v), alternating in one array so that no loop copies them.
 float grid_fraction(vec3 origin, uint k, VisibilityLight L) {
     LEAVE_TO_SECOND_DRAW(1.0);
-    // With k <= 1 the loop's first ray is the light's centre, and its answer the fraction: one call of
+    // With k <= 1 the loop's first ray is the light's centre (turned), and its answer the fraction: one call of
     // sample_visible in the shader, which the driver inlines with every ray test it holds (docs/platform.md, "What
     // the driver compiles").
     float kf = float(max(k, 1u));

@@ -16,13 +16,13 @@
 //!
 //! The grids live on the unit square, mapped to the light: the sun's and disk lights' to the unit disk by Shirley &
 //! Chiu's concentric map (equal-area, low distortion; "A Low Distortion Map Between Disk and Square", 1997), turned
-//! by a small angle in the light's frame ([`turned`]), the
-//! sky's linearly to its lune's angles. They cast rays at the `(k + 1)²` corners of `k²` squares and *locate* the
-//! edges of the shadows between disagreeing corners by bisection, each square adding its visible share (marching
-//! squares): second order in `1/k` through a penumbra (`grid_fraction`). With k = 1 one ray, through the
-//! light's centre: a hard shadow. The reference can take the fractions by slices instead (`sky_slices`,
-//! `sun_slices`, `disk_slices`, `reference --visibility`), exact along one angle, for a truth that the grid
-//! converges on too slowly in penumbrae.
+//! by a small angle in the light's frame ([`turned`]), the sky's linearly to its lune's angles. They cast rays at
+//! the `(k + 1)²` corners of `k²` squares and *locate* the edges of the shadows between disagreeing corners by
+//! bisection, each square adding its visible share (marching squares): second order in `1/k` through a penumbra
+//! (`grid_fraction`). With k = 1 one ray, through the light's centre (2⁻¹⁰ of its radius off it, [`turned`]): a
+//! hard shadow. The reference can take the fractions by slices instead (`sky_slices`, `sun_slices`,
+//! `disk_slices`, `reference --visibility`), exact along one angle, for a truth that the grid converges on too
+//! slowly in penumbrae.
 //!
 //! **Specular part.** The lobe integrals already sample each light (`shade.rs`); each of their samples casts its
 //! own shadow ray, so the lobe sees exactly the part of the light that is visible. A delta sun and a small-source
@@ -335,8 +335,9 @@ pub const GRID_TURN_SIN: f64 = 0.015624364224883372;
 /// camera whose pixel centres are dyadic) such rays meet occluders' edges exactly, along whole lines of pixels,
 /// where f32 and f64 then decide the edge differently (the touching blocks of tests/shadows.rs under a low disk
 /// light). Turned by an angle whose sine and cosine are no small fractions, a sample meets such an edge only by
-/// chance: it moves by `θρ` off its aligned place (`ρ` its distance from the centre), some 2⁻⁹ of the light's
-/// radius for the innermost ring of 6², far above f32's reach of an edge. The angle is small so that the rows stay
+/// chance: it moves by `θρ` off its aligned place (`ρ` its distance from the centre), some 2⁻⁸ of the light's
+/// radius for the corners of 6² nearest the centre (`ρ = 1/3`), 2⁻¹¹ for the nearest bisections, far above f32's
+/// reach of an edge. The angle is small so that the rows stay
 /// nearly parallel to the edges of such a scene, along which the located grid is most accurate (an edge along a
 /// row is located exactly; a large turn makes every such edge oblique to the rows:
 /// `tolerance_estimates_a_penumbra_against_its_circular_segment`). The light's centre, the turn's fixed point and
@@ -507,8 +508,8 @@ pub fn cell_visible_area(seen: [bool; 4], bottom: f64, right: f64, top: f64, lef
 }
 
 /// `∫ w V / ∫ w` over the unit square mapped to the light ([`GridLight::light_sample`]) ([`fraction`]):
-/// `w` a direction's weight, `V` its ray's visibility. `k = 1`: the ray through the light's centre alone, a hard
-/// shadow. Otherwise the `(k + 1)²` corners of a `k × k` grid of squares cast their rays (none where the weight is
+/// `w` a direction's weight, `V` its ray's visibility. `k = 1`: the ray through the light's centre alone (2⁻¹⁰ of its
+/// radius off it, [`turned`]), a hard shadow. Otherwise the `(k + 1)²` corners of a `k × k` grid of squares cast their rays (none where the weight is
 /// not positive), and each square adds the mean of its corners' weights times its visible share.
 ///
 /// **Edges located, areas by marching squares.** Counting each square as wholly visible or blocked by a sample
