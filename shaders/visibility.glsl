@@ -246,10 +246,11 @@ float light_sample(VisibilityLight L, vec2 uv, out vec3 ray) {
 // Whether a grid sample's shadow ray reaches its light: visible_to for a disk light's point, visible_along for a
 // direction, written as one call of occluded so that the driver, which inlines every call, compiles one copy of
 // the ray's traversal here instead of two (docs/platform.md, "What the driver compiles"). The arithmetic is
-// theirs: target - origin for a point, the direction itself otherwise.
+// theirs: target - origin for a point, the direction itself otherwise. Only a frame with the sun's cells has
+// lights of kind GRID_LIGHT_SUN_CELLS, so that the cells' test is compiled only for its pipelines.
 bool sample_visible(vec3 origin, VisibilityLight L, vec3 ray) {
 #ifdef SUNSHADE_SHADOW_RAYS
-    if (ONLY_SUN_CELL_RAYS || L.kind == GRID_LIGHT_SUN_CELLS) {
+    if (ONLY_SUN_CELL_RAYS || (VARIANT_SUN_CELLS != SUN_CELLS_NONE && L.kind == GRID_LIGHT_SUN_CELLS)) {
         return !sun_cells_occluded(origin, L.n, ray);
     }
 #endif

@@ -8,7 +8,9 @@
 //! booleans:
 //!
 //! 1. The spec constants take the given values (their defaults are rewritten, so the module stands alone), and every
-//!    `OpSpecConstantOp` and every integer or boolean instruction whose operands are known is evaluated.
+//!    `OpSpecConstantOp` and every integer or boolean instruction whose operands are known is evaluated, as are
+//!    `false && x`, `true || x` and a select of a known operand, and a load of a local that every store sets to
+//!    one known value (glslang at -O0 keeps locals in memory: `bool cells = ONLY_SUN_CELL_RAYS || ...`).
 //! 2. In each function, only the edges a known condition takes are followed from the entry block; a block that is
 //!    reached no more keeps its label and becomes `OpUnreachable` (or, as a live loop's continue target, branches
 //!    back to the header), so the structured control flow stays valid. A conditional branch with a known condition
@@ -37,6 +39,9 @@ const OP_SPEC_CONSTANT_OP: u16 = 52;
 const OP_FUNCTION: u16 = 54;
 const OP_FUNCTION_END: u16 = 56;
 const OP_FUNCTION_CALL: u16 = 57;
+const OP_VARIABLE: u16 = 59;
+const OP_LOAD: u16 = 61;
+const OP_STORE: u16 = 62;
 const OP_ENTRY_POINT: u16 = 15;
 const OP_PHI: u16 = 245;
 const OP_LOOP_MERGE: u16 = 246;
@@ -175,6 +180,27 @@ fn evaluate(op: u16, a: &[u32]) -> Option<u32> {
     }
 }
 
+/// [`evaluate`] where every operand is known; else the value that the known operands alone decide: `false && x`,
+/// `true || x`, and a select whose condition and chosen operand are known (the instruction stays in the module for
+/// the driver to compute; only the branches on it are decided here).
+fn evaluate_partly(op: u16, a: &[Option<u32>]) -> Option<u32> {
+    if let Some(all) = a.iter().copied().collect::<Option<Vec<u32>>>() {
+        return evaluate(op, &all);
+    }
+    match (op, a) {
+        (166, [x, y]) if *x == Some(1) || *y == Some(1) => Some(1),
+        (167, [x, y]) if *x == Some(0) || *y == Some(0) => Some(0),
+        (169, [Some(c), x, y]) => {
+            if *c != 0 {
+                *x
+            } else {
+                *y
+            }
+        }
+        _ => None,
+    }
+}
+
 /// What is known of a module under given constants: values, and each function's followed edges.
 struct Analysis {
     known: HashMap<u32, u32>,
@@ -206,12 +232,35 @@ fn successors(term: Inst<'_>, known: &HashMap<u32, u32>) -> Vec<u32> {
     }
 }
 
+/// Function-scope variables that only whole loads and stores touch (never handed to a call, an access chain or any
+/// other instruction): what a load of one reads is what one of its stores wrote (or nothing, before the first).
+/// glslang at -O0 keeps every local in such a variable, so a local set from a constant (`bool cells = ONLY_... ||
+/// ...`) is known only through them.
+fn plain_variables(insts: &[Inst<'_>], functions: &[Function]) -> HashSet<u32> {
+    let bodies = || functions.iter().flat_map(|f| &insts[f.start..f.end]);
+    let mut plain: HashSet<u32> = bodies().filter(|i| i.op == OP_VARIABLE).map(|i| i.words[2]).collect();
+    for i in bodies() {
+        // An OpLoad's operands past its pointer are memory-access literals; an OpStore's pointer and value are
+        // what the variable holds and a value (never a pointer to a local in logical addressing).
+        let operands = match i.op {
+            OP_VARIABLE | OP_STORE => &[][..],
+            OP_LOAD => &i.words[1..3],
+            _ => &i.words[1..],
+        };
+        for w in operands {
+            plain.remove(w);
+        }
+    }
+    plain
+}
+
 fn analyse(
     insts: &[Inst<'_>],
     functions: &[Function],
     mut known: HashMap<u32, u32>,
     tracked: &HashSet<u32>,
 ) -> Analysis {
+    let plain = plain_variables(insts, functions);
     let by_id: HashMap<u32, &Function> = functions.iter().map(|f| (f.id, f)).collect();
     let entry_points: Vec<u32> = insts.iter().filter(|i| i.op == OP_ENTRY_POINT).map(|i| i.words[2]).collect();
     // Each round first follows the edges the values known so far allow, then evaluates the reached blocks in the
@@ -239,10 +288,28 @@ fn analyse(
                     }
                 }
             }
+            // Each plain variable's one value, where every store in a reached block writes the same known one.
+            let mut stored: HashMap<u32, Option<u32>> = HashMap::new();
+            for block in f.blocks.iter().filter(|b| reachable.contains(&b.label)) {
+                for inst in insts[block.start..block.end].iter().filter(|i| i.op == OP_STORE) {
+                    let (pointer, value) = (inst.words[1], known.get(&inst.words[2]).copied());
+                    if plain.contains(&pointer) {
+                        let one = stored.entry(pointer).or_insert(value);
+                        if *one != value {
+                            *one = None;
+                        }
+                    }
+                }
+            }
             for block in f.blocks.iter().filter(|b| reachable.contains(&b.label)) {
                 for inst in &insts[block.start..block.end] {
                     let w = inst.words;
                     match inst.op {
+                        OP_LOAD if tracked.contains(&w[1]) && !known.contains_key(&w[2]) => {
+                            if let Some(Some(v)) = stored.get(&w[3]) {
+                                known.insert(w[2], *v);
+                            }
+                        }
                         OP_FUNCTION_CALL if live.insert(w[3]) => queue.push(w[3]),
                         OP_PHI if tracked.contains(&w[1]) && !known.contains_key(&w[2]) => {
                             let values: Vec<Option<u32>> = w[3..]
@@ -258,8 +325,8 @@ fn analyse(
                         }
                         OP_FUNCTION_CALL | OP_PHI => {}
                         op if w.len() >= 3 && tracked.contains(&w[1]) && !known.contains_key(&w[2]) => {
-                            let args: Option<Vec<u32>> = w[3..].iter().map(|a| known.get(a).copied()).collect();
-                            if let Some(v) = args.and_then(|a| evaluate(op, &a)) {
+                            let args: Vec<Option<u32>> = w[3..].iter().map(|a| known.get(a).copied()).collect();
+                            if let Some(v) = evaluate_partly(op, &args) {
                                 known.insert(w[2], v);
                             }
                         }
@@ -577,6 +644,65 @@ void main() {
             // Specializing again changes nothing: every branch left depends on run-time values.
             assert_eq!(specialize(&out, constants).unwrap(), out, "{constants:?}");
         }
+    }
+
+    /// Locals set from constants, a constant and-ed with a run-time value, and a local a call may change.
+    const LOCALS: &str = r#"#version 450
+layout(constant_id = 0) const uint MODE = 0u;
+const bool ON = MODE == 1u;
+layout(location = 0) in vec4 v;
+layout(location = 0) out vec4 o;
+float local_set(float x) {
+    return sin(x) * cos(x);
+}
+float anded(float x) {
+    return x * 3.0;
+}
+float escaped(float x) {
+    return x + 2.0;
+}
+void maybe_set(inout bool b) {
+    if (v.x > 0.0) {
+        b = true;
+    }
+}
+void main() {
+    float r = v.x;
+    bool local = MODE == 1u;
+    if (local) {
+        r = local_set(r);
+    }
+    bool both = ON && v.z > 0.0;
+    if (both) {
+        r = anded(r);
+    }
+    bool handed = MODE == 1u;
+    maybe_set(handed);
+    if (handed) {
+        r = escaped(r);
+    }
+    o = vec4(r);
+}
+"#;
+
+    #[test]
+    fn locals_and_logical_operations_that_constants_decide_are_known() {
+        let words = crate::compile("l.frag", &[("l.frag", LOCALS)], &[]).unwrap();
+        for (mode, expected) in
+            [(0, &["escaped", "main", "maybe_set"][..]), (1, &["anded", "escaped", "local_set", "main", "maybe_set"])]
+        {
+            let out = specialize(&words, &[(0, mode)]).unwrap();
+            spirv_val(&out);
+            let mut kept = functions(&out);
+            kept.sort();
+            assert_eq!(kept, expected, "MODE = {mode}");
+        }
+        assert_eq!(evaluate_partly(167, &[None, Some(0)]), Some(0));
+        assert_eq!(evaluate_partly(167, &[None, Some(1)]), None);
+        assert_eq!(evaluate_partly(166, &[Some(1), None]), Some(1));
+        assert_eq!(evaluate_partly(169, &[Some(0), None, Some(4)]), Some(4));
+        assert_eq!(evaluate_partly(169, &[Some(1), None, Some(4)]), None);
+        assert_eq!(evaluate_partly(170, &[None, Some(4)]), None);
     }
 
     #[test]
