@@ -137,11 +137,12 @@ vec3 perturbed_normal(vec3 tn, vec3 t, vec3 b, vec3 n) {
 
 // Whether a shadow ray's hit on an alpha-masked triangle blocks it: the base colour's alpha (factor x texture x
 // vertex colour, s.color white without colours) at the hit reaches the cutoff. The texture is read at the hit's
-// coordinates with no footprint (s.uv_x = s.uv_y = s.uv: level 0, magnification filter).
+// coordinates with no footprint (texture_magnified: level 0, magnification filter).
 bool masked_hit_blocks(MaterialGpu m, SurfaceSample s) {
     precise float alpha = m.base.a;
-    if (m.tex[TEX_BASE].texture.x != NO_TEXTURE) {
-        alpha = alpha * material_texture(m.tex[TEX_BASE], s).a;
+    TextureRefGpu r = m.tex[TEX_BASE];
+    if (r.texture.x != NO_TEXTURE) {
+        alpha = alpha * texture_magnified(r.texture.x, transform_uv(r, s.uv[r.texture.y])).a;
     }
     alpha = alpha * s.color.a;
     return alpha_covers(m, alpha);

@@ -154,18 +154,37 @@ LevelChoice choose_level(uvec4 header, uvec4 level0, REAL2 uv, REAL2 uv_x, REAL2
     return c;
 }
 
+// texture_lookup with no footprint (uv_x = uv_y = uv, a shadow ray's hit): level 0, the magnification filter.
+vec4 texture_magnified(uint t, REAL2 uv) {
+    uvec4 header = texture_table[t];
+    uint wrap_s = header.z & 3u;
+    uint wrap_t = (header.z >> 2u) & 3u;
+    return filter_level(texture_table[header.x], (header.z >> 4u) & 1u, wrap_s, wrap_t, uv);
+}
+
 // Texture t looked up at uv with the footprint given by the UVs at the right and lower neighbouring pixel
-// centres: choose_level, then filter_level on one level or two, blended r0 (1 - d) + r1 d in f32.
+// centres: choose_level, then filter_level on one level or two, blended r0 (1 - d) + r1 d in f32. The levels are
+// filtered by one call in a loop, so that the driver, which inlines every call, compiles filter_level once a lookup.
 vec4 texture_lookup(uint t, REAL2 uv, REAL2 uv_x, REAL2 uv_y) {
     uvec4 header = texture_table[t];
     LevelChoice c = choose_level(header, texture_table[header.x], uv, uv_x, uv_y);
     uint wrap_s = header.z & 3u;
     uint wrap_t = (header.z >> 2u) & 3u;
-    vec4 r0 = filter_level(texture_table[header.x + c.level], c.filter_kind, wrap_s, wrap_t, uv);
-    if (c.blend == 0.0) {
+    // No local array: llvmpipe reads and writes one lane by lane.
+    vec4 r0 = vec4(0.0);
+    vec4 r1 = vec4(0.0);
+    uint levels = c.blend == 0.0 ? 1u : 2u;
+    for (uint l = 0u; l < levels; ++l) {
+        vec4 r = filter_level(texture_table[header.x + c.level + l], c.filter_kind, wrap_s, wrap_t, uv);
+        if (l == 0u) {
+            r0 = r;
+        } else {
+            r1 = r;
+        }
+    }
+    if (levels == 1u) {
         return r0;
     }
-    vec4 r1 = filter_level(texture_table[header.x + c.level + 1u], c.filter_kind, wrap_s, wrap_t, uv);
     precise float rd = 1.0 - c.blend;
     precise vec4 result = r0 * rd + r1 * c.blend;
     return result;

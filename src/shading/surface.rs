@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 
-use super::texture_filter::texture_lookup;
+use super::texture_filter::{texture_lookup, texture_magnified};
 use crate::scene::material::brdf_from_metallic_roughness;
 use crate::scene::{AlphaMode, Brdf, BrdfKind, Material, Texture, TextureRef};
 
@@ -107,10 +107,16 @@ pub fn alpha_covers(material: &Material, alpha: f32) -> bool {
 }
 
 /// Whether a shadow ray's hit on an alpha-masked triangle blocks it, and how near its alpha is to the cutoff:
-/// the base colour's alpha at the hit (`s.uv_x = s.uv_y = s.uv`: no footprint, level 0 with the magnification
-/// filter) against the cutoff ([`alpha_covers`]).
+/// the base colour's alpha at the hit ([`base_color`]'s, `(factor × texture) × vertex colour`; the texture read at
+/// the hit's coordinates with no footprint, [`texture_magnified`]) against the cutoff ([`alpha_covers`]).
 pub fn masked_hit_blocks(material: &Material, textures: &[Texture], s: &SurfaceSample) -> (bool, f64) {
-    let alpha = base_color(material, textures, s)[3];
+    let mut alpha = material.base_alpha;
+    if let Some(r) = &material.base_color_texture {
+        alpha *= texture_magnified(&textures[r.texture], transform_uv(&r.transform, s.uv[r.tex_coord as usize]))[3];
+    }
+    if let Some(v) = s.color {
+        alpha *= v[3];
+    }
     let margin = match material.alpha {
         AlphaMode::Mask(cutoff) => (alpha as f64 - cutoff as f64).abs(),
         AlphaMode::Opaque | AlphaMode::Blend => f64::INFINITY,

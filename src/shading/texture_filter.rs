@@ -159,6 +159,15 @@ pub fn texture_lookup(texture: &Texture, uv: [f64; 2], uv_x: [f64; 2], uv_y: [f6
     [0, 1, 2, 3].map(|c| r0[c] * rd + r1[c] * d)
 }
 
+/// [`texture_lookup`] with no footprint (`uv_x = uv_y = uv`, as at a shadow ray's hit on a masked occluder): ρ = 0
+/// (or NaN) takes level 0 with the magnification filter and no blend, so this is that level filtered, bitwise the
+/// same. The shader calls it where the footprint is known to be empty, compiling neither the level choice nor a
+/// second level there.
+pub fn texture_magnified(texture: &Texture, uv: [f64; 2]) -> [f32; 4] {
+    let wrap = [texture.sampler.wrap_s, texture.sampler.wrap_t];
+    filter_level(&texture.levels[0], texture.sampler.mag, wrap, uv)
+}
+
 /// How near the result of a lookup is to one of its jumps, as a fraction of the decision's own scale: the
 /// distance of a `NEAREST` texel coordinate from a texel boundary over `|x| + 1`, of `2m²` from 1 for a nearest
 /// mip level, of `ρ²` from 1 where magnification and minification filter differently (over `max(ρ², 1)`); infinity
@@ -249,6 +258,27 @@ mod tests {
         // A checker minified to one texel a pixel's footprint of 8: the mean, 0.5.
         let v = texture_lookup(&t, [0.5, 0.5], [0.5 + 8.0 / 64.0, 0.5], [0.5, 0.5 + 8.0 / 64.0]);
         assert!((v[0] - 0.5).abs() < 1e-6, "{v:?}");
+    }
+
+    #[test]
+    fn a_lookup_without_footprint_is_the_magnified_level_0() {
+        let mut rng = crate::test_rng::uniform(7);
+        let texels = (0..12 * 5).map(|_| [0, 1, 2, 3].map(|_| rng().abs() as f32)).collect();
+        let level0 = Level::linear(12, 5, texels);
+        for (mag, min, wrap) in [
+            (Filter::Linear, Filter::Nearest, Wrap::Repeat),
+            (Filter::Nearest, Filter::Linear, Wrap::MirroredRepeat),
+            (Filter::Linear, Filter::Linear, Wrap::ClampToEdge),
+        ] {
+            let sampler = Sampler { wrap_s: wrap, wrap_t: Wrap::Repeat, mag, min, mip: MipFilter::Linear };
+            let t = Texture::new("t".into(), level0.clone(), sampler);
+            let mut uvs: Vec<[f64; 2]> = (0..500).map(|_| [rng() * 3.0, rng() * 2.0]).collect();
+            uvs.extend([[f64::NAN, 0.3], [f64::INFINITY, 0.5], [0.25, -f64::INFINITY], [1e300, 2.0]]);
+            for uv in uvs {
+                let lookup = texture_lookup(&t, uv, uv, uv).map(f32::to_bits);
+                assert_eq!(texture_magnified(&t, uv).map(f32::to_bits), lookup, "{uv:?} {mag:?} {wrap:?}");
+            }
+        }
     }
 
     #[test]
