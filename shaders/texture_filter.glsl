@@ -56,28 +56,46 @@ vec4 texel(uvec4 level, uint i, uint j) {
 }
 
 // One level filtered at uv: nearest, or bilinear between the four texel centres around (u w - 1/2, v h - 1/2).
+// The texels (one, or four corners k: x0 + (k & 1), y0 + (k >> 1)) are read by one call of texel in a loop, so
+// that the driver, which inlines every call, compiles one texel read and two wraps a filter.
 vec4 filter_level(uvec4 level, uint filter_kind, uint wrap_s, uint wrap_t, REAL2 uv) {
     uint w = level.y;
     uint h = level.z;
-    if (filter_kind == FILTER_NEAREST) {
-        precise REAL x = floor(texel_coordinate(uv.x * REAL(w)));
-        precise REAL y = floor(texel_coordinate(uv.y * REAL(h)));
-        return texel(level, wrap_texel(x, w, wrap_s), wrap_texel(y, h, wrap_t));
+    bool nearest = filter_kind == FILTER_NEAREST;
+    precise REAL x;
+    precise REAL y;
+    if (nearest) {
+        x = floor(texel_coordinate(uv.x * REAL(w)));
+        y = floor(texel_coordinate(uv.y * REAL(h)));
+    } else {
+        x = texel_coordinate(uv.x * REAL(w) - REAL(0.5));
+        y = texel_coordinate(uv.y * REAL(h) - REAL(0.5));
     }
-    precise REAL x = texel_coordinate(uv.x * REAL(w) - REAL(0.5));
-    precise REAL y = texel_coordinate(uv.y * REAL(h) - REAL(0.5));
     REAL x0 = floor(x);
     REAL y0 = floor(y);
+    vec4 t00 = vec4(0.0);
+    vec4 t10 = vec4(0.0);
+    vec4 t01 = vec4(0.0);
+    vec4 t11 = vec4(0.0);
+    uint corners = nearest ? 1u : 4u;
+    for (uint k = 0u; k < corners; ++k) {
+        // x0 + 0 is x0 (or +0 for -0, which wraps alike).
+        vec4 t = texel(level, wrap_texel(x0 + REAL(k & 1u), w, wrap_s), wrap_texel(y0 + REAL(k >> 1u), h, wrap_t));
+        if (k == 0u) {
+            t00 = t;
+        } else if (k == 1u) {
+            t10 = t;
+        } else if (k == 2u) {
+            t01 = t;
+        } else {
+            t11 = t;
+        }
+    }
+    if (nearest) {
+        return t00;
+    }
     precise float a = float(x - x0);
     precise float b = float(y - y0);
-    uint i0 = wrap_texel(x0, w, wrap_s);
-    uint i1 = wrap_texel(x0 + REAL(1.0), w, wrap_s);
-    uint j0 = wrap_texel(y0, h, wrap_t);
-    uint j1 = wrap_texel(y0 + REAL(1.0), h, wrap_t);
-    vec4 t00 = texel(level, i0, j0);
-    vec4 t10 = texel(level, i1, j0);
-    vec4 t01 = texel(level, i0, j1);
-    vec4 t11 = texel(level, i1, j1);
     precise float ra = 1.0 - a;
     precise float rb = 1.0 - b;
     precise vec4 top = t00 * ra + t10 * a;
