@@ -25,8 +25,8 @@ struct Case {
 struct Run {
     wall: Duration,
     phases: BTreeMap<String, f64>,
-    /// (what, SPIR-V instructions, creation time [ms]).
-    pipelines: Vec<(String, usize, f64)>,
+    /// (what, (SPIR-V instructions, inlined), creation time [ms]).
+    pipelines: Vec<(String, (usize, usize), f64)>,
     device: String,
     /// Peak resident memory [MB] (`-v`'s "peak memory"; 0 where not printed).
     peak_mb: f64,
@@ -58,10 +58,12 @@ fn run_once(case: &Case, whole: bool) -> Result<Run, CliError> {
     let mut run = Run { wall, ..Default::default() };
     for line in stderr.lines() {
         if let Some(rest) = line.strip_prefix("sunshade: pipeline ") {
-            // "WHAT: N SPIR-V instructions, created in X ms"
+            // "WHAT: N SPIR-V instructions (M inlined), created in X ms"
             let parsed = rest.rsplit_once(": ").and_then(|(what, tail)| {
-                let (n, t) = tail.split_once(" SPIR-V instructions, created in ")?;
-                Some((what.to_string(), n.parse().ok()?, t.strip_suffix(" ms")?.parse().ok()?))
+                let (n, tail) = tail.split_once(" SPIR-V instructions (")?;
+                let (inlined, t) = tail.split_once(" inlined), created in ")?;
+                let sizes = (n.parse().ok()?, inlined.parse().ok()?);
+                Some((what.to_string(), sizes, t.strip_suffix(" ms")?.parse().ok()?))
             });
             run.pipelines.extend(parsed);
         } else if let Some(rest) = line.strip_prefix("sunshade: device ") {
@@ -84,7 +86,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let cases = cases(a)?;
     let mut rows = String::new();
     // Variant -> (instructions, creation times, whole-shader creation times).
-    let mut variants: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let mut variants: BTreeMap<String, ((usize, usize), Vec<f64>, Vec<f64>)> = BTreeMap::new();
     let mut device = String::new();
     for case in &cases {
         let mut runs = Vec::new();
@@ -104,7 +106,7 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
         }
         for r in &whole_runs {
             for (what, _, t) in &r.pipelines {
-                variants.entry(what.clone()).or_insert((0, Vec::new(), Vec::new())).2.push(*t);
+                variants.entry(what.clone()).or_insert(((0, 0), Vec::new(), Vec::new())).2.push(*t);
             }
         }
         let process = ms(median(runs.iter().map(|r| r.wall).collect()));
@@ -151,13 +153,13 @@ pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     );
     out += &rows;
     out += &format!(
-        "\n| pipeline | SPIR-V instructions | created in [ms] |{}\n|---|---:|---:|{}\n",
+        "\n| pipeline | SPIR-V instructions | inlined | created in [ms] |{}\n|---|---:|---:|---:|{}\n",
         if a.whole_shaders { " whole shader [ms] |" } else { "" },
         if a.whole_shaders { "---:|" } else { "" }
     );
-    for (what, (n, times, whole)) in variants {
+    for (what, ((n, inlined), times, whole)) in variants {
         let w = if a.whole_shaders { format!(" {:.1} |", median_f64(whole)) } else { String::new() };
-        out += &format!("| {what} | {n} | {:.1} |{w}\n", median_f64(times));
+        out += &format!("| {what} | {n} | {inlined} | {:.1} |{w}\n", median_f64(times));
     }
     publish(&out, a.json, &a.update, "startup")
 }

@@ -277,9 +277,10 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
         print_exposure(ev);
         for p in created {
             eprintln!(
-                "sunshade: pipeline {}: {} SPIR-V instructions, created in {:.1} ms",
+                "sunshade: pipeline {}: {} SPIR-V instructions ({} inlined), created in {:.1} ms",
                 p.what,
                 p.instructions,
+                p.inlined,
                 p.time.as_secs_f64() * 1e3
             );
         }

@@ -25,11 +25,13 @@ pub const COLOR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// A pipeline made for a frame: what it is, the SPIR-V instructions of its fragment stage as the driver got it
-/// (0 for none), and how long the driver took to create it.
+/// and as many after every call is inlined (what lavapipe compiles; 0 for none), and how long the driver took to
+/// create it.
 #[derive(Clone, Debug)]
 pub struct CreatedPipeline {
     pub what: String,
     pub instructions: usize,
+    pub inlined: usize,
     pub time: std::time::Duration,
 }
 
@@ -403,7 +405,7 @@ unsafe fn create_pipeline(
 ) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
     let started = std::time::Instant::now();
     let constants = variant.map_or([0; 11], |v| v.constants());
-    let mut instructions = 0;
+    let (mut instructions, mut inlined) = (0, 0);
     let module = match fs {
         Some(words) => {
             let specialized;
@@ -415,6 +417,7 @@ unsafe fn create_pipeline(
                 &specialized[..]
             };
             instructions = sunshade_glsl::instruction_count(code).map_err(GpuError::ShaderCompile)?;
+            inlined = sunshade_glsl::inlined_instruction_count(code).map_err(GpuError::ShaderCompile)?;
             // SAFETY: valid device; SPIR-V built by build.rs, specialized (spirv-val checks both in tests).
             unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None) }
                 .vk("vkCreateShaderModule")?
@@ -426,7 +429,7 @@ unsafe fn create_pipeline(
     unsafe {
         let pipeline = create_pipeline_from(d, cache, layout, (vs, module), with_normals, &constants, depth_only);
         d.destroy_shader_module(module, None);
-        let made = CreatedPipeline { what: String::new(), instructions, time: started.elapsed() };
+        let made = CreatedPipeline { what: String::new(), instructions, inlined, time: started.elapsed() };
         pipeline.map(|p| (p, made))
     }
 }

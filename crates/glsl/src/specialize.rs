@@ -118,6 +118,58 @@ pub fn instruction_count(words: &[u32]) -> Result<usize, String> {
     instructions(words).map(|v| v.len())
 }
 
+/// The instructions of a module's entry points' functions with every call replaced by the callee's body, as a driver
+/// that inlines all calls (lavapipe) first sees them: each function's own body counts once per call of it. Names,
+/// `OpLine`s and the module's declarations do not count. What a pipeline's creation on lavapipe grows with
+/// (docs/platform.md, "What the driver compiles").
+pub fn inlined_instruction_count(words: &[u32]) -> Result<usize, String> {
+    let insts = instructions(words)?;
+    let mut own: HashMap<u32, (usize, Vec<u32>)> = HashMap::new();
+    let mut current = None;
+    for i in &insts {
+        match i.op {
+            OP_FUNCTION => current = Some(i.words[2]),
+            OP_FUNCTION_END => current = None,
+            OP_NAME | 8 | 317 => {}
+            op => {
+                if let Some(f) = current {
+                    let entry = own.entry(f).or_default();
+                    entry.0 += 1;
+                    if op == OP_FUNCTION_CALL {
+                        entry.1.push(i.words[3]);
+                    }
+                }
+            }
+        }
+    }
+    // Depth first from the entry points; SPIR-V forbids recursion, and a call cycle is refused rather than followed.
+    fn total(
+        f: u32,
+        own: &HashMap<u32, (usize, Vec<u32>)>,
+        memo: &mut HashMap<u32, Option<usize>>,
+    ) -> Result<usize, String> {
+        match memo.get(&f) {
+            Some(Some(n)) => return Ok(*n),
+            Some(None) => return Err(format!("malformed SPIR-V: function %{f} calls itself")),
+            None => {}
+        }
+        memo.insert(f, None);
+        let (count, calls) = own.get(&f).ok_or_else(|| format!("malformed SPIR-V: no function %{f}"))?;
+        let mut n = *count;
+        for c in calls {
+            n += total(*c, own, memo)?;
+        }
+        memo.insert(f, Some(n));
+        Ok(n)
+    }
+    let mut memo = HashMap::new();
+    let mut sum = 0;
+    for i in insts.iter().filter(|i| i.op == OP_ENTRY_POINT) {
+        sum += total(i.words[2], &own, &mut memo)?;
+    }
+    Ok(sum)
+}
+
 /// A function's block: where its instructions start (the `OpLabel`) and end (one past the terminator).
 struct Block {
     label: u32,
@@ -703,6 +755,18 @@ void main() {
         assert_eq!(evaluate_partly(169, &[Some(0), None, Some(4)]), Some(4));
         assert_eq!(evaluate_partly(169, &[Some(1), None, Some(4)]), None);
         assert_eq!(evaluate_partly(170, &[None, Some(4)]), None);
+    }
+
+    #[test]
+    fn the_inlined_count_takes_a_function_once_a_call() {
+        let words = module();
+        let count = |w: &[u32]| inlined_instruction_count(w).unwrap();
+        // MODE 0: light; 1: heavy; 2: light, and heavy in a loop. heavy's body (a loop of sines) is larger than
+        // light's one multiplication.
+        let [light, heavy, both] = [0, 1, 2].map(|mode| specialize(&words, &[(0, mode), (1, 0)]).unwrap());
+        assert!(count(&both) > count(&heavy) && count(&heavy) > count(&light));
+        assert!(count(&light) < instruction_count(&light).unwrap());
+        assert!(inlined_instruction_count(&[1, 2, 3]).is_err());
     }
 
     #[test]
