@@ -94,24 +94,32 @@ void main() {
     vec3 emission = vec3(0.0);
     if (VARIANT_SURFACE != 0u) {
         SurfaceSample s = surface_sample();
+        // The textures the variant reads, by one lookup (surface_texels): the base colour for the mask and the
+        // BRDF, metallic-roughness for a BRDF but Lambert's (surface_brdf), the normal map, the emission.
+        const bool reads_base = (VARIANT_SURFACE & (SURFACE_ALPHA_MASK | SURFACE_EVAL)) != 0u;
+        const bool reads_mr = (VARIANT_SURFACE & SURFACE_EVAL) != 0u && VARIANT_BRDF != BRDF_LAMBERT;
+        const uint reads = (reads_base ? 1u << TEX_BASE : 0u) | (reads_mr ? 1u << TEX_METALLIC_ROUGHNESS : 0u)
+            | ((VARIANT_SURFACE & SURFACE_NORMAL_MAP) != 0u ? 1u << TEX_NORMAL : 0u)
+            | ((VARIANT_SURFACE & SURFACE_EMISSION) != 0u ? 1u << TEX_EMISSIVE : 0u);
+        SurfaceTexels t = surface_texels(material, s, reads);
         // The base colour once, for the mask and the BRDF (only the variants that use it look it up).
-        vec4 base = (VARIANT_SURFACE & (SURFACE_ALPHA_MASK | SURFACE_EVAL)) != 0u ? base_color(material, s) : vec4(1.0);
+        vec4 base = reads_base ? base_color(material, s, t) : vec4(1.0);
         if ((VARIANT_SURFACE & SURFACE_ALPHA_MASK) != 0u && !alpha_covers(material, base.a)) {
             discard;
         }
         if ((VARIANT_SURFACE & SURFACE_EVAL) != 0u) {
-            material = surface_brdf(material, s, base);
+            material = surface_brdf(material, t, base);
         }
         if ((VARIANT_SURFACE & SURFACE_NORMAL_MAP) != 0u) {
             // Back faces of double-sided materials turn the whole frame (the normal and bitangent already are).
-            vec3 tn = tangent_space_normal(material, s);
+            vec3 tn = tangent_space_normal(material, t);
             vec3 t_side = gl_FrontFacing ? frame.tangent : -frame.tangent;
             frame.normal = perturbed_normal(tn, t_side, frame.bitangent, frame.normal);
             frame.tangent = orthonormal_tangent(tangent.xyz, frame.normal);
             frame.bitangent = (tangent.w < 0.0 ? -1.0 : 1.0) * cross(frame.normal, frame.tangent);
         }
         if ((VARIANT_SURFACE & SURFACE_EMISSION) != 0u) {
-            emission = emitted_radiance(material, s);
+            emission = emitted_radiance(material, t);
         }
     }
 #ifdef SUNSHADE_SLICES

@@ -12,7 +12,7 @@
 void main() {
     MaterialGpu material = material_at(pc.material);
     SurfaceSample s = surface_sample();
-    if (!alpha_covers(material, base_color(material, s).a)) {
+    if (!alpha_covers(material, base_color(material, s, surface_texels(material, s, 1u << TEX_BASE)).a)) {
         discard;
     }
 }

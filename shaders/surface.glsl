@@ -31,11 +31,45 @@ vec4 material_texture(TextureRefGpu r, SurfaceSample s) {
                           transform_uv(r, s.uv_y[set]));
 }
 
-// Linear base colour and alpha: (factor x texture) x vertex colour.
-vec4 base_color(MaterialGpu m, SurfaceSample s) {
+// The material's textures at the pixel that a draw reads (`reads`: bit 1 << TEX_* for each), looked up by one call
+// of material_texture in a loop over the four, so that the driver, which inlines every call, compiles one lookup
+// however many a variant reads (the Rust looks each up where it is used). One not read or absent stays white.
+struct SurfaceTexels {
+    vec4 base;
+    vec4 metallic_roughness;
+    vec4 normal;
+    vec4 emissive;
+};
+
+SurfaceTexels surface_texels(MaterialGpu m, SurfaceSample s, uint reads) {
+    SurfaceTexels t = SurfaceTexels(vec4(1.0), vec4(1.0), vec4(1.0), vec4(1.0));
+    for (uint k = 0u; k < 4u; ++k) {
+        // The slot by constant indices (a local array indexed by k is read lane by lane on llvmpipe).
+        TextureRefGpu r = k == TEX_BASE ? m.tex[TEX_BASE]
+            : (k == TEX_METALLIC_ROUGHNESS ? m.tex[TEX_METALLIC_ROUGHNESS]
+            : (k == TEX_NORMAL ? m.tex[TEX_NORMAL] : m.tex[TEX_EMISSIVE]));
+        if ((reads & (1u << k)) == 0u || r.texture.x == NO_TEXTURE) {
+            continue;
+        }
+        vec4 v = material_texture(r, s);
+        if (k == TEX_BASE) {
+            t.base = v;
+        } else if (k == TEX_METALLIC_ROUGHNESS) {
+            t.metallic_roughness = v;
+        } else if (k == TEX_NORMAL) {
+            t.normal = v;
+        } else {
+            t.emissive = v;
+        }
+    }
+    return t;
+}
+
+// Linear base colour and alpha: (factor x texture) x vertex colour (t.base: surface_texels's).
+vec4 base_color(MaterialGpu m, SurfaceSample s, SurfaceTexels t) {
     precise vec4 c = m.base;
     if (m.tex[TEX_BASE].texture.x != NO_TEXTURE) {
-        c = c * material_texture(m.tex[TEX_BASE], s);
+        c = c * t.base;
     }
     if ((VARIANT_SURFACE & SURFACE_COLORS) != 0u) {
         c = c * s.color;
@@ -83,8 +117,8 @@ MaterialGpu brdf_from_metallic_roughness(MaterialGpu m, vec3 base, float metalli
 }
 
 // The BRDF at the pixel: the mapping of the base colour and the metallic-roughness texture (B metallic, G
-// roughness) times the factors.
-MaterialGpu surface_brdf(MaterialGpu m, SurfaceSample s, vec4 base) {
+// roughness; t.metallic_roughness, read for every BRDF but Lambert's) times the factors.
+MaterialGpu surface_brdf(MaterialGpu m, SurfaceTexels t, vec4 base) {
     precise float metallic = m.pbr.x;
     precise float roughness = m.pbr.y;
     switch (VARIANT_BRDF) {
@@ -97,9 +131,8 @@ MaterialGpu surface_brdf(MaterialGpu m, SurfaceSample s, vec4 base) {
     case BRDF_MEASURED:
     case BRDF_GLTF:
         if (m.tex[TEX_METALLIC_ROUGHNESS].texture.x != NO_TEXTURE) {
-            vec4 t = material_texture(m.tex[TEX_METALLIC_ROUGHNESS], s);
-            metallic = metallic * t.b;
-            roughness = roughness * t.g;
+            metallic = metallic * t.metallic_roughness.b;
+            roughness = roughness * t.metallic_roughness.g;
         }
         break;
     }
@@ -111,18 +144,19 @@ bool alpha_covers(MaterialGpu m, float alpha) {
     return alpha >= m.pbr.w;
 }
 
-// Emitted radiance [W/(m^2 sr)]: the material's emission times its emissive texture.
-vec3 emitted_radiance(MaterialGpu m, SurfaceSample s) {
+// Emitted radiance [W/(m^2 sr)]: the material's emission times its emissive texture (t.emissive).
+vec3 emitted_radiance(MaterialGpu m, SurfaceTexels t) {
     precise vec3 e = m.emission.rgb;
     if (m.tex[TEX_EMISSIVE].texture.x != NO_TEXTURE) {
-        e = e * material_texture(m.tex[TEX_EMISSIVE], s).rgb;
+        e = e * t.emissive.rgb;
     }
     return e;
 }
 
-// The normal map's tangent-space normal, unnormalised: (2 t - 1) (scale, scale, 1).
-vec3 tangent_space_normal(MaterialGpu m, SurfaceSample s) {
-    vec4 t = material_texture(m.tex[TEX_NORMAL], s);
+// The normal map's tangent-space normal, unnormalised: (2 t - 1) (scale, scale, 1), t the normal texture's
+// texel (t.normal).
+vec3 tangent_space_normal(MaterialGpu m, SurfaceTexels texels) {
+    vec4 t = texels.normal;
     precise vec3 n = (t.rgb * 2.0 - 1.0) * vec3(m.pbr.z, m.pbr.z, 1.0);
     return n;
 }

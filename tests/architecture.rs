@@ -274,6 +274,12 @@ const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
     ),
     ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
     (
+        "surface.glsl",
+        "surface_texels",
+        "a draw's textures looked up by one call in a loop, as the driver inlines each call; the Rust looks each up \
+         where it is used (material_texture)",
+    ),
+    (
         "lights/disk.glsl",
         "disk_rays_gather",
         "the GPU's shortcut before the grid (src/visibility/disk_cone.rs's walk); the reference casts its rays",
