@@ -8,7 +8,8 @@
 
 #ifdef SUNSHADE_WALK
 // What the walks of the slices (shaders/slices.glsl) and of the disk lights' cones (disk_cone.glsl), on every
-// device with shadow rays, share: the tree, the walk.
+// device with shadow rays, share: the tree, its stack (the slices take BVH_WALK; the cones' walk, disk_cone_gather,
+// starts above the root).
 // The most triangles a leaf holds (visibility::bvh's LEAF_SIZE): one, which the walks' leaf tests assume.
 #define BVH_LEAF_SIZE 1u
 // The walk's stack entries (visibility::bvh's STACK_SIZE: more than the deepest tree's levels).

@@ -162,11 +162,12 @@ uint disk_cone_listed_count = 0u;
             disk_cone_listed_count += 1u; \
         } \
     }
-// Child `i` of an inner node: skipped where its box is apart; an inner node stacked, a leaf's triangle tested.
-#define DISK_CONE_CHILD(i) \
+// Child `i` of an inner node: skipped where its box is apart; an inner node stacked, a leaf's triangle tested. The
+// root (`root`) is tested as a child, but a root leaf by its triangle alone.
+#define DISK_CONE_CHILD(i, root) \
     { \
         BvhNode child = bvh_node(i); \
-        if (!disk_cone_apart_from_box(c, child.lo, child.hi)) { \
+        if (((root) && child.count > 0u) || !disk_cone_apart_from_box(c, child.lo, child.hi)) { \
             if (child.count == 0u) { \
                 stack[top] = (i); \
                 top += 1u; \
@@ -177,18 +178,26 @@ uint disk_cone_listed_count = 0u;
 // The occluders the shadow rays from origin (moved off x) to the disk light may meet: the tree walked with the cone,
 // the triangles it cannot show apart listed (disk_cone_listed): DISK_CONE_CLEAR where there are none (every ray
 // gets through), DISK_CONE_LIST, or DISK_CONE_UNKNOWN where there is no cone or more than DISK_CONE_LIST_LIMIT.
-// One iteration of llvmpipe's loop budget an inner node entered, as the rays' walk.
+// One iteration of llvmpipe's loop budget an inner node entered, as the rays' walk, and one for the root: the walk
+// starts above it (DISK_CONE_ABOVE_ROOT, whose one child is the root), so that its two visits of a node's children
+// are the only copies of the box and triangle tests the driver compiles (it inlines every call).
+#define DISK_CONE_ABOVE_ROOT 0xffffffffu
 uint disk_cone_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float radius) {
     disk_cone_listed_count = 0u;
     DiskCone c;
     if (!disk_cone(origin, x, n, center, d, radius, c)) {
         return DISK_CONE_UNKNOWN;
     }
-    BvhNode root = bvh_node(0u);
-    if (root.count > 0u) {
-        DISK_CONE_LEAF(root)
-    } else if (!disk_cone_apart_from_box(c, root.lo, root.hi)) {
-        BVH_WALK(DISK_CONE_CHILD)
+    uint stack[BVH_STACK_SIZE];
+    uint top = 1u;
+    stack[0] = DISK_CONE_ABOVE_ROOT;
+    while (top > 0u) {
+        top -= 1u;
+        uint entry = stack[top];
+        bool above_root = entry == DISK_CONE_ABOVE_ROOT;
+        uint first = above_root ? 0u : bvh_node(entry).first;
+        DISK_CONE_CHILD(first, above_root)
+        if (!above_root) DISK_CONE_CHILD(first + 1u, false)
     }
     return disk_cone_listed_count == 0u ? DISK_CONE_CLEAR : DISK_CONE_LIST;
 }
