@@ -42,16 +42,22 @@ vec3 orthonormal_tangent(vec3 t, vec3 n) {
 
 void main() {
     MaterialGpu material = material_at(pc.material);
-#ifdef SUNSHADE_DEVICE_INTERPOLATION
-    vec3 position = v_position;
-    vec3 normal = safe_normalize(v_normal);
-    vec4 tangent = v_tangent;
-#else
+    // The triangle's corners and the fragment's own barycentrics, for the position and normal (unless the device
+    // interpolates them) and for the shadow rays' origin.
     uint first = pc.first_index + 3u * uint(gl_PrimitiveID);
     uint i0 = uint(int(indices[first]) + pc.vertex_offset);
     uint i1 = uint(int(indices[first + 1u]) + pc.vertex_offset);
     uint i2 = uint(int(indices[first + 2u]) + pc.vertex_offset);
     vec3 p0 = vertex_vec3(i0, 0u), p1 = vertex_vec3(i1, 0u), p2 = vertex_vec3(i2, 0u);
+#ifdef SUNSHADE_DEVICE_INTERPOLATION
+    vec3 position = v_position;
+    vec3 normal = safe_normalize(v_normal);
+    vec4 tangent = v_tangent;
+    vec3 l = vec3(0.0);
+    if (SHADOWS_ON || SHADOWS_MAP_ON) {
+        l = triangle_barycentrics(clip_position(p0), clip_position(p1), clip_position(p2), pixel_ndc(gl_FragCoord.xy));
+    }
+#else
     vec3 l = triangle_barycentrics(clip_position(p0), clip_position(p1), clip_position(p2), pixel_ndc(gl_FragCoord.xy));
     vec3 position = l.x * p0 + l.y * p1 + l.z * p2;
     vec3 normal = safe_normalize(l.x * vertex_vec3(i0, 3u) + l.y * vertex_vec3(i1, 3u) + l.z * vertex_vec3(i2, 3u));
@@ -73,19 +79,13 @@ void main() {
     frame.face_normal = normal;
     if (SHADOWS_ON || SHADOWS_MAP_ON) {
         // The shadow rays' origin from the triangle's corners and vertex normals on the side being shaded, at the
-        // fragment's own barycentrics (visibility.glsl; with device interpolation they are computed here too).
-        uint first_s = pc.first_index + 3u * uint(gl_PrimitiveID);
-        uint j0 = uint(int(indices[first_s]) + pc.vertex_offset);
-        uint j1 = uint(int(indices[first_s + 1u]) + pc.vertex_offset);
-        uint j2 = uint(int(indices[first_s + 2u]) + pc.vertex_offset);
-        vec3 q0 = vertex_vec3(j0, 0u), q1 = vertex_vec3(j1, 0u), q2 = vertex_vec3(j2, 0u);
-        vec3 b = triangle_barycentrics(clip_position(q0), clip_position(q1), clip_position(q2), pixel_ndc(gl_FragCoord.xy));
+        // fragment's own barycentrics (visibility.glsl).
         float side = gl_FrontFacing ? 1.0 : -1.0;
-        vec3 n0 = side * safe_normalize(vertex_vec3(j0, 3u));
-        vec3 n1 = side * safe_normalize(vertex_vec3(j1, 3u));
-        vec3 n2 = side * safe_normalize(vertex_vec3(j2, 3u));
-        frame.shadow_origin = shadow_ray_origin(q0, q1, q2, n0, n1, n2, b, position, normal);
-        vec3 face = cross(q1 - q0, q2 - q0);
+        vec3 n0 = side * safe_normalize(vertex_vec3(i0, 3u));
+        vec3 n1 = side * safe_normalize(vertex_vec3(i1, 3u));
+        vec3 n2 = side * safe_normalize(vertex_vec3(i2, 3u));
+        frame.shadow_origin = shadow_ray_origin(p0, p1, p2, n0, n1, n2, l, position, normal);
+        vec3 face = cross(p1 - p0, p2 - p0);
         face = dot(face, normal) < 0.0 ? -face : face;
         frame.face_normal = safe_normalize(face);
     }
