@@ -154,6 +154,8 @@ fn command() -> clap::Command {
 
 /// Runs the command line and returns the process exit code.
 pub fn main() -> ExitCode {
+    // Before any thread and any Vulkan instance: the loader then skips Mesa's GPU drivers where no GPU node exists.
+    crate::gpu::drivers::skip_mesa_drivers_without_render_node();
     let parsed = command().try_get_matches().and_then(|m| <Cli as clap::FromArgMatches>::from_arg_matches(&m));
     let cli = match parsed {
         Ok(cli) => cli,

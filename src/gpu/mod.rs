@@ -1,6 +1,7 @@
 //! The Vulkan renderer (ash). It knows nothing of glTF: it takes a [`Scene`](crate::scene::Scene) and
 //! [`RenderSettings`](crate::settings::RenderSettings) and returns an [`Image`](crate::film::Image).
 //!
+//! - `drivers`: which installed drivers the Vulkan loader opens (Mesa's GPU drivers skipped without a GPU node);
 //! - `context`: instance (no surface), validation messages, device choice, queue, allocator;
 //! - `device_info`: the properties and limits that matter, and the `--device` choice;
 //! - `memory`: buffers and images with their memory;
@@ -19,6 +20,7 @@ mod accel;
 mod commands;
 mod context;
 mod device_info;
+pub mod drivers;
 mod error;
 pub mod frame_probe;
 pub mod layout;
