@@ -312,11 +312,8 @@ pub fn sharpest_brdf(material: &Material, scene: &Scene) -> Brdf {
     let Some(kind) = material.mapping else { return material.brdf.clone() };
     let mut roughness = material.pbr.roughness;
     if let Some(t) = &material.metallic_roughness_texture {
-        let min_texel = scene
-            .textures
-            .get(t.texture)
-            .and_then(|t| t.levels.first())
-            .map_or(0.0, |l| (0..l.len()).map(|i| l.texel(i)[1]).fold(1.0f32, f32::min));
+        let min_texel =
+            scene.textures.get(t.texture).and_then(|t| t.levels.first()).map_or(0.0, |l| l.channel_min(1).min(1.0));
         roughness *= min_texel.clamp(0.0, 1.0);
     }
     let alpha = (roughness * roughness).max(MIN_MAPPED_ALPHA);

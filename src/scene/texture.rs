@@ -136,6 +136,18 @@ impl Level {
         }
     }
 
+    /// The least value of channel `c` (0–3) over the level's texels, `f32::min`'s (NaN ignored), infinity for no
+    /// texels. 8-bit texels by their codes: each channel's table is increasing, so the least code's value.
+    pub fn channel_min(&self, c: usize) -> f32 {
+        match &self.texels {
+            Texels::Linear(t) => t.iter().map(|p| p[c]).fold(f32::INFINITY, f32::min),
+            Texels::Codes { codes, space } => {
+                let table = if c == 3 { code_table(ColorSpace::Linear) } else { code_table(*space) };
+                codes.iter().map(|p| p[c]).min().map_or(f32::INFINITY, |code| table[code as usize])
+            }
+        }
+    }
+
     /// How many texels the level holds.
     pub fn len(&self) -> usize {
         match &self.texels {
@@ -369,6 +381,11 @@ mod tests {
                 }
             }
             assert!(matches!(kept[1].texels, Texels::Linear(_)));
+            // A channel's least value by codes is the least of the decoded texels.
+            for (level, c) in [(&kept[0], 0), (&kept[0], 1), (&kept[0], 3), (&kept[1], 2)].into_iter() {
+                let each = (0..level.len()).map(|i| level.texel(i)[c]).fold(f32::INFINITY, f32::min);
+                assert_eq!(level.channel_min(c).to_bits(), each.to_bits(), "{space:?} channel {c}");
+            }
         }
         assert_eq!(code_value(ColorSpace::Srgb, 128), srgb_to_linear(128));
         assert_eq!(code_value(ColorSpace::Linear, 51), 0.2);
