@@ -243,32 +243,74 @@ pub fn level_count(width: u32, height: u32) -> usize {
 /// separably in f64 (rows, then columns) from linear texels, rounded once to f32 (so the levels below an 8-bit
 /// image are linear f32, not codes).
 pub fn mip_chain(level0: Level) -> Vec<Level> {
-    use rayon::prelude::*;
     let count = level_count(level0.width, level0.height);
     let mut levels = vec![level0];
     while levels.len() < count {
         let prev = levels.last().expect("level 0 is there");
         let (w, h) = ((prev.width / 2).max(1), (prev.height / 2).max(1));
-        let mut texels = vec![[0.0f32; 4]; (w * h) as usize];
-        // Output rows in parallel, each from the two or three source rows it covers, filtered across first
-        // (a source row shared by two output rows is filtered for each, the same way): every texel is computed
-        // alone, so the result does not depend on the order or the split.
-        texels.par_chunks_mut(w as usize).enumerate().for_each(|(j, out)| {
-            let (first, end) = box_span(prev.height, h, j as u32);
-            let across: Vec<Vec<[f64; 4]>> = (first..end)
-                .map(|y| {
-                    let row: Vec<[f64; 4]> =
-                        (0..prev.width).map(|x| prev.texel((y * prev.width + x) as usize).map(f64::from)).collect();
-                    (0..w).map(|i| box_filter(prev.width, w, i, |s| row[s])).collect()
-                })
-                .collect();
-            for (i, texel) in out.iter_mut().enumerate() {
-                *texel = box_filter(prev.height, h, j as u32, |s| across[s - first as usize][i]).map(|v| v as f32);
-            }
-        });
-        levels.push(Level::linear(w, h, texels));
+        let next = if prev.width == 2 * w && prev.height == 2 * h { halved(prev) } else { box_filtered(prev, w, h) };
+        levels.push(next);
     }
     levels
+}
+
+/// The next level of `prev` (w × h texels) by [`box_filter`], separably: output rows in parallel, each from the
+/// two or three source rows it covers, filtered across first (a source row shared by two output rows is filtered
+/// for each, the same way): every texel is computed alone, so the result does not depend on the order or the split.
+fn box_filtered(prev: &Level, w: u32, h: u32) -> Level {
+    use rayon::prelude::*;
+    let mut texels = vec![[0.0f32; 4]; (w * h) as usize];
+    texels.par_chunks_mut(w as usize).enumerate().for_each(|(j, out)| {
+        let (first, end) = box_span(prev.height, h, j as u32);
+        let across: Vec<Vec<[f64; 4]>> = (first..end)
+            .map(|y| {
+                let row: Vec<[f64; 4]> =
+                    (0..prev.width).map(|x| prev.texel((y * prev.width + x) as usize).map(f64::from)).collect();
+                (0..w).map(|i| box_filter(prev.width, w, i, |s| row[s])).collect()
+            })
+            .collect();
+        for (i, texel) in out.iter_mut().enumerate() {
+            *texel = box_filter(prev.height, h, j as u32, |s| across[s - first as usize][i]).map(|v| v as f32);
+        }
+    });
+    Level::linear(w, h, texels)
+}
+
+/// [`box_filtered`] where both sides are even: each texel from its 2 × 2 source texels, written out with the
+/// same f64 operations in the same order as box_filter's even case (across, then down), without the rows it
+/// gathers; bitwise the same level.
+fn halved(prev: &Level) -> Level {
+    // The texels' values, by their codes' tables where 8-bit (what Level::texel reads, without its match each time).
+    match &prev.texels {
+        Texels::Linear(t) => halved_from(prev.width, prev.height, |k| t[k].map(f64::from)),
+        Texels::Codes { codes, space } => {
+            let colour = code_table(*space).map(f64::from);
+            let alpha = code_table(ColorSpace::Linear).map(f64::from);
+            halved_from(prev.width, prev.height, |k| {
+                let [r, g, b, a] = codes[k];
+                [colour[r as usize], colour[g as usize], colour[b as usize], alpha[a as usize]]
+            })
+        }
+    }
+}
+
+/// [`halved`] of a `width` × `height` level whose texel k (row-major) is `texel(k)`.
+fn halved_from(width: u32, height: u32, texel: impl Fn(usize) -> [f64; 4] + Sync) -> Level {
+    use rayon::prelude::*;
+    let (w, h) = (width / 2, height / 2);
+    let pair =
+        |a: [f64; 4], b: [f64; 4]| -> [f64; 4] { std::array::from_fn(|c| (0.0 + 1.0 * a[c] + 1.0 * b[c]) / 2.0) };
+    let at = |x: u32, y: u32| texel((y * width + x) as usize);
+    let mut texels = vec![[0.0f32; 4]; (w * h) as usize];
+    texels.par_chunks_mut(w as usize).enumerate().for_each(|(j, out)| {
+        let (y0, y1) = (2 * j as u32, 2 * j as u32 + 1);
+        for (i, texel) in out.iter_mut().enumerate() {
+            let (x0, x1) = (2 * i as u32, 2 * i as u32 + 1);
+            let (top, bottom) = (pair(at(x0, y0), at(x1, y0)), pair(at(x0, y1), at(x1, y1)));
+            *texel = pair(top, bottom).map(|v| v as f32);
+        }
+    });
+    Level::linear(w, h, texels)
 }
 
 /// The source texels `[first, end)` that texel `i` of `m` box-filtered from `n` reads (see [`box_filter`]).
@@ -381,6 +423,12 @@ mod tests {
                 }
             }
             assert!(matches!(kept[1].texels, Texels::Linear(_)));
+            // Even sides: the 2 × 2 shortcut is bitwise the separable filter.
+            let even = Level { width: 6, height: 4, texels: Texels::Codes { codes: codes[..24].to_vec(), space } };
+            let (fast, general) = (halved(&even), box_filtered(&even, 3, 2));
+            for i in 0..fast.len() {
+                assert_eq!(fast.texel(i).map(f32::to_bits), general.texel(i).map(f32::to_bits), "{space:?} texel {i}");
+            }
             // A channel's least value by codes is the least of the decoded texels.
             for (level, c) in [(&kept[0], 0), (&kept[0], 1), (&kept[0], 3), (&kept[1], 2)].into_iter() {
                 let each = (0..level.len()).map(|i| level.texel(i)[c]).fold(f32::INFINITY, f32::min);
