@@ -20,6 +20,9 @@ struct Case {
     size: (u32, u32),
 }
 
+/// A variant's (SPIR-V instructions, inlined), creation times and whole-shader creation times [ms].
+type VariantTimes = ((usize, usize), Vec<f64>, Vec<f64>);
+
 /// What one process printed and took.
 #[derive(Default)]
 struct Run {
@@ -85,8 +88,7 @@ fn phase(runs: &[Run], name: &str) -> f64 {
 pub fn run(a: &BenchArgs) -> Result<(), CliError> {
     let cases = cases(a)?;
     let mut rows = String::new();
-    // Variant -> (instructions, creation times, whole-shader creation times).
-    let mut variants: BTreeMap<String, ((usize, usize), Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let mut variants: BTreeMap<String, VariantTimes> = BTreeMap::new();
     let mut device = String::new();
     for case in &cases {
         let mut runs = Vec::new();
