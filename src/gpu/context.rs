@@ -246,6 +246,9 @@ unsafe extern "system" fn debug_callback(
             return vk::FALSE;
         }
         let message = (*data).message_as_c_str().map(|m| m.to_string_lossy().into_owned()).unwrap_or_default();
+        if super::drivers::is_own_skip_notice(&message) {
+            return vk::FALSE;
+        }
         let log = &*(user_data as *const ValidationLog);
         log.push(format!("[{severity:?} {kind:?}] {message}"));
     }
