@@ -97,8 +97,19 @@ void main() {
         // The textures the variant reads, by one lookup (surface_texels): the base colour for the mask and the
         // BRDF, metallic-roughness for a BRDF but Lambert's (surface_brdf), the normal map, the emission.
         const bool reads_base = (VARIANT_SURFACE & (SURFACE_ALPHA_MASK | SURFACE_EVAL)) != 0u;
-        const bool reads_mr = (VARIANT_SURFACE & SURFACE_EVAL) != 0u && VARIANT_BRDF != BRDF_LAMBERT;
-        const uint reads = (reads_base ? 1u << TEX_BASE : 0u) | (reads_mr ? 1u << TEX_METALLIC_ROUGHNESS : 0u)
+        bool reads_mr = false;
+        switch (VARIANT_BRDF) {
+        case BRDF_LAMBERT:
+            break;
+        case BRDF_PHONG:
+        case BRDF_BLINN_PHONG:
+        case BRDF_WARD:
+        case BRDF_MEASURED:
+        case BRDF_GLTF:
+            reads_mr = (VARIANT_SURFACE & SURFACE_EVAL) != 0u;
+            break;
+        }
+        uint reads = (reads_base ? 1u << TEX_BASE : 0u) | (reads_mr ? 1u << TEX_METALLIC_ROUGHNESS : 0u)
             | ((VARIANT_SURFACE & SURFACE_NORMAL_MAP) != 0u ? 1u << TEX_NORMAL : 0u)
             | ((VARIANT_SURFACE & SURFACE_EMISSION) != 0u ? 1u << TEX_EMISSIVE : 0u);
         SurfaceTexels t = surface_texels(material, s, reads);
