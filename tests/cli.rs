@@ -276,7 +276,7 @@ fn bench_times_whole_processes_and_names_their_pipelines() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(
-        out.contains("| pipeline | SPIR-V instructions | created in [ms] |") && out.contains("| Lambert · "),
+        out.contains("| pipeline | SPIR-V instructions | inlined | created in [ms] |") && out.contains("| Lambert · "),
         "{out}"
     );
 }

@@ -30,9 +30,6 @@ pub fn should_skip(var: impl Fn(&str) -> bool, dri: Option<Vec<String>>) -> bool
     !dri.unwrap_or_default().iter().any(|name| name.starts_with("renderD"))
 }
 
-/// Whether this process set `VK_LOADER_DRIVERS_DISABLE` itself ([`skip_mesa_drivers_without_render_node`]).
-static SET_HERE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
 /// Sets `VK_LOADER_DRIVERS_DISABLE` to [`MESA_DRM_DRIVERS`] where [`should_skip`] says so. Call it first thing in a
 /// process, before any thread starts and before the first Vulkan instance (the CLI's `main` does; a library user
 /// may): the environment is the process's, and its children inherit the choice.
@@ -42,14 +39,14 @@ pub fn skip_mesa_drivers_without_render_node() {
         .map(|entries| entries.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect());
     if should_skip(|v| std::env::var_os(v).is_some(), dri) {
         std::env::set_var("VK_LOADER_DRIVERS_DISABLE", MESA_DRM_DRIVERS);
-        SET_HERE.store(true, std::sync::atomic::Ordering::Relaxed);
     }
 }
 
-/// Whether a message the loader sends the validation messenger is its notice that it skipped a driver as this
-/// process asked (not a validation message: the messenger hears the loader too while the instance is made).
+/// Whether a message the loader sends the validation messenger is its notice that it skipped a driver as sunshade
+/// asked (not a validation message: the messenger hears the loader too while the instance is made): the variable
+/// holds sunshade's own value, set by this process or inherited from the sunshade process that started it.
 pub fn is_own_skip_notice(message: &str) -> bool {
-    SET_HERE.load(std::sync::atomic::Ordering::Relaxed) && is_skip_notice(message)
+    is_skip_notice(message) && std::env::var("VK_LOADER_DRIVERS_DISABLE").is_ok_and(|v| v == MESA_DRM_DRIVERS)
 }
 
 /// The loader's notice for a driver left out by `VK_LOADER_DRIVERS_DISABLE` (loader 1.3.239's wording).
