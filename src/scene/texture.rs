@@ -129,9 +129,8 @@ impl Level {
             Texels::Linear(t) => t[index],
             Texels::Codes { codes, space } => {
                 let [r, g, b, a] = codes[index];
-                let colour = code_table(*space);
-                let alpha = code_table(ColorSpace::Linear);
-                [colour[r as usize], colour[g as usize], colour[b as usize], alpha[a as usize]]
+                let t = channel_tables(*space);
+                [t[0][r as usize], t[1][g as usize], t[2][b as usize], t[3][a as usize]]
             }
         }
     }
@@ -142,7 +141,7 @@ impl Level {
         match &self.texels {
             Texels::Linear(t) => t.iter().map(|p| p[c]).fold(f32::INFINITY, f32::min),
             Texels::Codes { codes, space } => {
-                let table = if c == 3 { code_table(ColorSpace::Linear) } else { code_table(*space) };
+                let table = channel_tables(*space)[c];
                 codes.iter().map(|p| p[c]).min().map_or(f32::INFINITY, |code| table[code as usize])
             }
         }
@@ -166,6 +165,13 @@ impl Level {
 /// computed in f64 and rounded once to f32. The GPU reads the same 256 values from its texel buffer.
 pub fn code_value(space: ColorSpace, code: u8) -> f32 {
     code_table(space)[code as usize]
+}
+
+/// Each channel's code table for 8-bit texels in `space`: the colour space's for red, green and blue, linear for
+/// alpha.
+pub fn channel_tables(space: ColorSpace) -> [&'static [f32; 256]; 4] {
+    let colour = code_table(space);
+    [colour, colour, colour, code_table(ColorSpace::Linear)]
 }
 
 /// The 256 values of [`code_value`] in `space`, computed once.
@@ -284,11 +290,10 @@ fn halved(prev: &Level) -> Level {
     match &prev.texels {
         Texels::Linear(t) => halved_from(prev.width, prev.height, |k| t[k].map(f64::from)),
         Texels::Codes { codes, space } => {
-            let colour = code_table(*space).map(f64::from);
-            let alpha = code_table(ColorSpace::Linear).map(f64::from);
+            let t = channel_tables(*space).map(|table| table.map(f64::from));
             halved_from(prev.width, prev.height, |k| {
                 let [r, g, b, a] = codes[k];
-                [colour[r as usize], colour[g as usize], colour[b as usize], alpha[a as usize]]
+                [t[0][r as usize], t[1][g as usize], t[2][b as usize], t[3][a as usize]]
             })
         }
     }
