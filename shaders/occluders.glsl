@@ -31,9 +31,8 @@ bool blocks(uvec4 tri, vec2 b) {
                                     surface_data[tri.y * FLOATS_PER_SURFACE_VERTEX + offset + 1u]))
                  + w.z * REAL2(vec2(surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset],
                                     surface_data[tri.z * FLOATS_PER_SURFACE_VERTEX + offset + 1u]));
+        // masked_hit_blocks reads the texture at s.uv alone (no footprint): uv_x and uv_y are left unset.
         s.uv[set] = uv;
-        s.uv_x[set] = uv;
-        s.uv_y[set] = uv;
     }
     s.color = vec4(1.0);
     if ((tri.w & 0x80000000u) != 0u) {

@@ -80,8 +80,8 @@ pub struct BenchArgs {
     pub measured: bool,
     /// What a whole `render` process costs: each scene (default: every model in models/ at 512 × 512 unless
     /// --width/--height are given, and models/square.gltf at 64 × 64) rendered by --repeat separate processes; the
-    /// medians of the process and of its phases, and each pipeline's SPIR-V size (as handed over and with its calls inlined) and creation time. Its --update
-    /// region is "startup".
+    /// medians of the process and of its phases, and each pipeline's SPIR-V size (as handed over and with its calls
+    /// inlined) and creation time. Its --update region is "startup".
     #[arg(long, conflicts_with_all = ["interpolation", "process_runs", "brdf_chart", "shadows", "textures", "pareto", "measured"])]
     pub startup: bool,
     /// What the default render's shadows cost: teapot, cube, sunset and room (512 × 512 unless --width/--height are

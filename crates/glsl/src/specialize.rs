@@ -24,6 +24,8 @@ use std::collections::{HashMap, HashSet};
 
 const OP_UNDEF: u16 = 1;
 const OP_NAME: u16 = 5;
+const OP_LINE: u16 = 8;
+const OP_NO_LINE: u16 = 317;
 const OP_DECORATE: u16 = 71;
 const OP_DECORATE_ID: u16 = 332;
 const OP_DECORATE_STRING: u16 = 5632;
@@ -130,7 +132,7 @@ pub fn inlined_instruction_count(words: &[u32]) -> Result<usize, String> {
         match i.op {
             OP_FUNCTION => current = Some(i.words[2]),
             OP_FUNCTION_END => current = None,
-            OP_NAME | 8 | 317 => {}
+            OP_NAME | OP_LINE | OP_NO_LINE => {}
             op => {
                 if let Some(f) = current {
                     let entry = own.entry(f).or_default();
