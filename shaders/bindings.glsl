@@ -72,6 +72,7 @@ layout(constant_id = 8) const uint VARIANT_OCCLUDERS_MASKED = 0u; // with shadow
                                                              // is alpha-masked (occluders.glsl's blocks tests it)
 layout(constant_id = 9) const uint VARIANT_SUN_CELLS = 0u; // with shadow rays and a sun: SUN_CELLS_*
 layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays: PENUMBRAE_HERE, _LATER, TREE_LATER
+layout(constant_id = 11) const uint VARIANT_MARK = 0u; // with PENUMBRAE_LATER: MARK_BY_COLOUR or MARK_BY_STENCIL
 
 // Where a pixel whose lights are neither proven wholly visible nor wholly hidden is shaded (VARIANT_PENUMBRAE;
 // gpu::layout's PENUMBRAE_*): by this draw (the whole shader), or by a second draw of the scene after this one
@@ -82,6 +83,12 @@ layout(constant_id = 10) const uint VARIANT_PENUMBRAE = 0u; // with shadow rays:
 #define PENUMBRAE_HERE 0u
 #define PENUMBRAE_LATER 1u
 #define TREE_LATER 2u
+
+// How the first of two draws marks the pixels it leaves to the second (VARIANT_MARK; gpu::layout's MARK_BY_*): by
+// the colour's alpha LEFT_TO_SECOND_DRAW alone, which a pass between the draws turns into the stencil, or by the
+// stencil value every fragment of the draw writes besides (scene.frag's mark_stencil; VK_EXT_shader_stencil_export).
+#define MARK_BY_COLOUR 0u
+#define MARK_BY_STENCIL 1u
 
 // What the sun's cells answer this frame (VARIANT_SUN_CELLS; gpu::layout's SUN_CELLS_*): nothing (the sun's rays
 // take occluded), every point's rays (no cell holds more than MAX_SUN_CELL_TRIANGLES: occluded is never needed for

@@ -2,6 +2,9 @@
 #ifdef SUNSHADE_RAY_QUERY
 #extension GL_EXT_ray_query : require
 #endif
+#if defined(SUNSHADE_RAY_QUERY) || defined(SUNSHADE_RAY_BVH)
+#extension GL_ARB_shader_stencil_export : require
+#endif
 // Radiance of each covered pixel, linear, in W/(m^2 sr); alpha 1 marks coverage.
 //
 // The fragment fetches its triangle's three vertices (gl_PrimitiveID) and interpolates position and normal with
@@ -19,6 +22,20 @@ layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec4 v_tangent;
 #endif
+
+// The coverage alpha (fragment.glsl's coverage_alpha); in a first draw that marks by stencil (VARIANT_MARK), also
+// the fragment's stencil value: 1 where the alpha holds the mark, 0 elsewhere, so that the stencil the depth test
+// leaves is the mark of the surface it keeps, as the pass that reads the mark from the colour would set it
+// (gpu::second_draw). The specializer removes the write, and with it the output, from every other variant.
+float marked_coverage_alpha() {
+    float alpha = coverage_alpha();
+#ifdef SUNSHADE_SHADOW_RAYS
+    if (VARIANT_PENUMBRAE == PENUMBRAE_LATER && VARIANT_MARK == MARK_BY_STENCIL) {
+        gl_FragStencilRefARB = alpha == LEFT_TO_SECOND_DRAW ? 1 : 0;
+    }
+#endif
+    return alpha;
+}
 
 // A vertex's position (offset VERTEX_POSITION, 0), normal (3) or tangent (6, a vec4): its texel offset / 3.
 vec3 vertex_vec3(uint index, uint offset) {
@@ -158,12 +175,12 @@ void main() {
 #endif
     if (VARIANT_QUANTITY == QUANTITY_IRRADIANCE) {
         // The irradiance at the surface [W/m^2] (shading::quantity): the lights' visible parts, no material.
-        out_radiance = vec4(irradiance_visible(frame), coverage_alpha());
+        out_radiance = vec4(irradiance_visible(frame), marked_coverage_alpha());
         return;
     }
     vec3 radiance = radiance_out(material, frame);
     if ((VARIANT_SURFACE & SURFACE_EMISSION) != 0u) {
         radiance = radiance + emission;
     }
-    out_radiance = vec4(radiance, coverage_alpha());
+    out_radiance = vec4(radiance, marked_coverage_alpha());
 }

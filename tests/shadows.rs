@@ -1363,28 +1363,46 @@ fn gpu_disk_slices_agree_with_the_reference() {
 
 /// Renders `flags` on `model` (in models/) in two draws, the default (the first settling the pixels the sun's cells
 /// and the disk lights' walk prove wholly lit or wholly hidden, the second shading the rest), and in one draw of the
-/// whole shader (`ContextOptions::one_draw`): the same bits. The two-draw frame must have made a first draw's
-/// pipeline, so that the comparison is not between two single draws.
+/// whole shader (`ContextOptions::one_draw`): the same bits. The two draws are made both ways a device marks the
+/// pixels the first leaves to the second: by the stencil its fragments write where the device exports stencil
+/// values (lavapipe does), and by colour and the pass between the draws (`ContextOptions::mark_by_colour`, as a
+/// device without the extension does; its pipelines must then be valid without it). Each two-draw frame must have
+/// made a first draw's pipeline, so that the comparison is not between two single draws.
 fn two_draws_same_bits(model: &str, flags: &[&str]) {
     use sunshade::gpu::ContextOptions;
     use sunshade::testing::{job, CheckedRenderer as Checked};
     let path = format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR"));
     let j = job(&path, flags).unwrap_or_else(|e| panic!("{e}"));
-    let mut two = common::shadow_ray_renderer();
-    let a = two.render_job(&j).unwrap_or_else(|e| panic!("{e}"));
-    let created = two.renderer().take_created_pipelines();
-    assert!(
-        created.iter().any(|p| p.what.contains("penumbrae later")),
-        "{model} {flags:?}: no first draw among {:?}",
-        created.iter().map(|p| &p.what).collect::<Vec<_>>()
-    );
-    drop(two);
     let mut one = Checked::try_with(ContextOptions { one_draw: true, ..ContextOptions::from_env() })
         .unwrap_or_else(|e| panic!("{e}"));
     let b = one.render_job(&j).unwrap_or_else(|e| panic!("{e}"));
-    assert!(a.covered_count() > 0, "{model}: nothing drawn");
-    let differ = common::bits(&a).iter().zip(common::bits(&b)).filter(|(x, y)| **x != *y).count();
-    assert_eq!(differ, 0, "{model} {flags:?}: the two draws changed {differ} channel values of the one draw's image");
+    assert!(b.covered_count() > 0, "{model}: nothing drawn");
+    drop(one);
+    for by_colour in [false, true] {
+        let mut two = if by_colour {
+            Checked::try_with(ContextOptions { mark_by_colour: true, ..ContextOptions::from_env() })
+                .unwrap_or_else(|e| panic!("{e}"))
+        } else {
+            common::shadow_ray_renderer()
+        };
+        let stencil = two.renderer().device_info().stencil_export;
+        let a = two.render_job(&j).unwrap_or_else(|e| panic!("{e}"));
+        let created: Vec<String> = two.renderer().take_created_pipelines().into_iter().map(|p| p.what).collect();
+        assert!(created.iter().any(|p| p.contains("penumbrae later")), "{model} {flags:?}: no first draw: {created:?}");
+        assert_eq!(
+            created.iter().any(|p| p.contains("marked by stencil")),
+            stencil,
+            "{model} {flags:?}: first draws {created:?}, stencil export {stencil}"
+        );
+        assert!(!by_colour || !stencil, "mark_by_colour left the stencil export on");
+        let differ = common::bits(&a).iter().zip(common::bits(&b)).filter(|(x, y)| **x != *y).count();
+        assert_eq!(
+            differ,
+            0,
+            "{model} {flags:?} (marked by {}): the two draws changed {differ} channel values of the one draw's image",
+            if stencil { "stencil" } else { "colour" }
+        );
+    }
 }
 
 #[test]

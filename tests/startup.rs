@@ -17,14 +17,14 @@ const ALL_SURFACE: u32 = SURFACE_EVAL | SURFACE_NORMAL_MAP | SURFACE_EMISSION | 
 const F64: &str = "SUNSHADE_F64_BARYCENTRICS";
 
 /// A variant: a name for messages, the stage and `#define`s of its module, its constants (`ShaderVariant`'s order:
-/// brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells, penumbrae) and its budget:
+/// brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells, penumbrae, mark) and its budget:
 /// the instructions of its specialized shader with every call inlined (`sunshade_glsl::inlined_instruction_count`,
 /// what lavapipe compiles, which creation time follows more closely than the SPIR-V's size), recorded plus about 10%.
 struct Pinned {
     name: &'static str,
     stage: &'static str,
     defines: &'static [&'static str],
-    constants: [u32; 11],
+    constants: [u32; VARIANT_CONSTANTS],
     budget: usize,
 }
 
@@ -45,6 +45,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 4100, // 3692 when recorded
     },
@@ -64,6 +65,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 2100, // 1906 when recorded
     },
@@ -83,6 +85,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 8400, // 7554 when recorded
     },
@@ -102,6 +105,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 27200, // 24647 when recorded
     },
@@ -121,6 +125,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 27400, // 24858 when recorded
     },
@@ -140,6 +145,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 27000, // 24499 when recorded
     },
@@ -159,6 +165,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 40200, // 36488 when recorded
     },
@@ -178,6 +185,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 7200, // 6527 when recorded
     },
@@ -197,6 +205,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 6900, // 6222 when recorded
     },
@@ -216,6 +225,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 8900, // 8075 when recorded
     },
@@ -235,11 +245,12 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 6400, // 5779 when recorded
     },
     Pinned {
-        name: "the first of two draws (penumbrae later), BVH walk: Lambert, disk sun",
+        name: "the first of two draws (penumbrae later, marked by stencil), BVH walk: Lambert, disk sun",
         stage: "scene.frag",
         defines: &[F64, "SUNSHADE_RAY_BVH"],
         constants: [
@@ -254,6 +265,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_LATER,
+            MARK_BY_STENCIL,
         ],
         budget: 3600, // 3234 when recorded
     },
@@ -273,6 +285,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 10200, // 9185 when recorded
     },
@@ -293,6 +306,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             TREE_LATER,
+            MARK_BY_COLOUR,
         ],
         budget: 6500, // 5877 when recorded
     },
@@ -312,6 +326,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 63800, // 57996 when recorded
     },
@@ -331,6 +346,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 59900, // 54429 when recorded
     },
@@ -350,6 +366,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 37700, // 34190 when recorded
     },
@@ -369,6 +386,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 6400, // 5768 when recorded
     },
@@ -388,6 +406,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 39300, // 35680 when recorded
     },
@@ -407,6 +426,7 @@ const PINNED: &[Pinned] = &[
             1,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 7700, // 6952 when recorded
     },
@@ -426,6 +446,7 @@ const PINNED: &[Pinned] = &[
             1,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 7700, // 6963 when recorded
     },
@@ -445,6 +466,7 @@ const PINNED: &[Pinned] = &[
             0,
             SUN_CELLS_PARTIAL,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 47700, // 43299 when recorded
     },
@@ -464,6 +486,7 @@ const PINNED: &[Pinned] = &[
             1,
             SUN_CELLS_COMPLETE,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 16900, // 15331 when recorded
     },
@@ -483,6 +506,7 @@ const PINNED: &[Pinned] = &[
             0,
             0,
             PENUMBRAE_HERE,
+            MARK_BY_COLOUR,
         ],
         budget: 11400, // 10291 when recorded
     },
@@ -490,16 +514,16 @@ const PINNED: &[Pinned] = &[
         name: "the shadow maps' alpha-masked pass",
         stage: "shadow_mask.frag",
         defines: &[F64],
-        constants: [0, 0, 0, 0, 0, SURFACE_EVAL | SURFACE_ALPHA_MASK, 0, 0, 0, 0, PENUMBRAE_HERE],
+        constants: [0, 0, 0, 0, 0, SURFACE_EVAL | SURFACE_ALPHA_MASK, 0, 0, 0, 0, PENUMBRAE_HERE, MARK_BY_COLOUR],
         budget: 2500, // 2271 when recorded
     },
 ];
 
-fn constants_of(v: [u32; 11]) -> Vec<(u32, u32)> {
+fn constants_of(v: [u32; VARIANT_CONSTANTS]) -> Vec<(u32, u32)> {
     (0u32..).zip(v).collect()
 }
 
-fn specialized(stage: &str, defines: &[&str], constants: [u32; 11]) -> Vec<u32> {
+fn specialized(stage: &str, defines: &[&str], constants: [u32; VARIANT_CONSTANTS]) -> Vec<u32> {
     let words = embedded(stage, defines).unwrap_or_else(|| panic!("no module {stage} {defines:?} built"));
     sunshade_glsl::specialize(&words, &constants_of(constants)).unwrap_or_else(|e| panic!("{stage} {defines:?}: {e}"))
 }
@@ -533,7 +557,7 @@ fn variant_sizes_stay_within_their_budgets() {
 /// nothing.
 #[test]
 fn specialized_modules_are_valid_spirv() {
-    let ranges: [u32; 11] = [5, 3, 3, 2, 3, ALL_SURFACE + 1, 3, 2, 2, 3, 2];
+    let ranges: [u32; VARIANT_CONSTANTS] = [5, 3, 3, 2, 3, ALL_SURFACE + 1, 3, 2, 2, 3, 2, 2];
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = |n: u32| {
         state ^= state << 13;
@@ -546,7 +570,7 @@ fn specialized_modules_are_valid_spirv() {
         let words = embedded(m.stage, m.defines).unwrap();
         let whole = sunshade_glsl::instruction_count(&words).unwrap();
         for k in 0..4 {
-            let mut c: [u32; 11] = std::array::from_fn(|i| next(ranges[i]));
+            let mut c: [u32; VARIANT_CONSTANTS] = std::array::from_fn(|i| next(ranges[i]));
             // Each constant at its largest value once.
             if k == 0 {
                 c = std::array::from_fn(|i| ranges[i] - 1);

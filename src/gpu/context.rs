@@ -65,7 +65,9 @@ pub struct ContextOptions {
     pub pipeline_cache_dir: Option<std::path::PathBuf>,
     /// Diagnostics only: hand the driver each fragment shader whole, with its specialization constants, instead of
     /// the module specialized for the pipeline (`sunshade_glsl::specialize`): for measuring what that saves and
-    /// checking that images do not change (`SUNSHADE_WHOLE_SHADERS=1`, tests/startup.rs).
+    /// checking that images do not change (`SUNSHADE_WHOLE_SHADERS=1`, tests/startup.rs). Only on a device with
+    /// `VK_EXT_shader_stencil_export` (lavapipe), whose capability the whole modules with shadow rays declare; their
+    /// frames are drawn once (`one_draw`), as a module that declares the stencil output is taken to write it.
     pub whole_shaders: bool,
     /// Shadow rays by ray queries: `None` where the device has them and is a GPU (`device_info::casts_ray_queries`,
     /// which `SUNSHADE_RAY_QUERIES` overrides), `Some(true)` wherever the device has them, `Some(false)` never.
@@ -74,17 +76,23 @@ pub struct ContextOptions {
     /// pixels the cheap proofs can (`ShaderVariant::first_draw`): for measuring what the two draws save and checking
     /// that images do not change (`SUNSHADE_ONE_DRAW=1`, `bench --shadow-cost`, tests/gpu_render.rs).
     pub one_draw: bool,
+    /// Diagnostics only: where the device could mark a first draw's pixels by the stencil its fragments write
+    /// (`DeviceInfo::stencil_export`), mark them by colour and the pass between the draws instead, as a device
+    /// without `VK_EXT_shader_stencil_export` does (`SUNSHADE_MARK_BY_COLOUR=1`, tests/shadows.rs).
+    pub mark_by_colour: bool,
 }
 
 impl ContextOptions {
     /// Validation on when the environment variable `SUNSHADE_VALIDATION` is `1`; whole shaders and one draw
-    /// (diagnostics) when `SUNSHADE_WHOLE_SHADERS` and `SUNSHADE_ONE_DRAW` are `1`.
+    /// and marks by colour (diagnostics) when `SUNSHADE_WHOLE_SHADERS`, `SUNSHADE_ONE_DRAW` and
+    /// `SUNSHADE_MARK_BY_COLOUR` are `1`.
     pub fn from_env() -> Self {
         let on = |k: &str| std::env::var(k).is_ok_and(|v| v == "1");
         Self {
             validation: on("SUNSHADE_VALIDATION"),
             whole_shaders: on("SUNSHADE_WHOLE_SHADERS"),
             one_draw: on("SUNSHADE_ONE_DRAW"),
+            mark_by_colour: on("SUNSHADE_MARK_BY_COLOUR"),
             ..Default::default()
         }
     }
@@ -263,6 +271,7 @@ impl Device {
         let devices = instance.devices()?;
         let (physical, mut info) = device_info::choose(&devices, options.device.as_deref())?;
         info.ray_query = device_info::casts_ray_queries(&info, options.ray_queries);
+        info.stencil_export &= !options.mark_by_colour;
         let queue_family = info.graphics_queue_family.expect("chosen devices have a graphics queue");
         // SAFETY: valid physical device; the create info only enables features the device reported.
         unsafe {
@@ -281,19 +290,25 @@ impl Device {
             let mut features12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(rq);
             let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
             let mut query = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
-            let rq_extensions = [
-                ash::khr::acceleration_structure::NAME.as_ptr(),
-                ash::khr::ray_query::NAME.as_ptr(),
-                ash::khr::deferred_host_operations::NAME.as_ptr(),
-            ];
+            let mut extensions = Vec::new();
+            if rq {
+                extensions.extend([
+                    ash::khr::acceleration_structure::NAME.as_ptr(),
+                    ash::khr::ray_query::NAME.as_ptr(),
+                    ash::khr::deferred_host_operations::NAME.as_ptr(),
+                ]);
+            }
+            if info.stencil_export {
+                extensions.push(ash::ext::shader_stencil_export::NAME.as_ptr());
+            }
             let mut create_info = vk::DeviceCreateInfo::default()
                 .queue_create_infos(&queue_info)
                 .enabled_features(&features)
                 .push_next(&mut features13)
-                .push_next(&mut features12);
+                .push_next(&mut features12)
+                .enabled_extension_names(&extensions);
             if rq {
-                create_info =
-                    create_info.enabled_extension_names(&rq_extensions).push_next(&mut accel).push_next(&mut query);
+                create_info = create_info.push_next(&mut accel).push_next(&mut query);
             }
             let device = instance.instance.create_device(physical, &create_info, None).vk("vkCreateDevice")?;
             let queue = device.get_device_queue(queue_family, 0);

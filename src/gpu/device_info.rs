@@ -44,6 +44,10 @@ pub struct DeviceInfo {
     /// features, and `bufferDeviceAddress`: shadow rays by ray queries possible. In a renderer's
     /// (`Renderer::device_info`): whether it casts them so ([`casts_ray_queries`]; it enables them all then).
     pub ray_query: bool,
+    /// `VK_EXT_shader_stencil_export`: the first of a frame's two draws marks the pixels it leaves to the second
+    /// by the stencil value its fragments write (`gpu::second_draw`), with no pass between the draws. Enabled
+    /// wherever the device offers it.
+    pub stencil_export: bool,
     /// `minAccelerationStructureScratchOffsetAlignment` (0 without acceleration structures).
     pub min_acceleration_structure_scratch_offset_alignment: u32,
     /// `vendorID`, `deviceID`, `driverVersion` and `pipelineCacheUUID`: what a pipeline cache is valid for.
@@ -165,6 +169,7 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
                     && query.ray_query == vk::TRUE
                     && v12.buffer_device_address == vk::TRUE
             };
+        let stencil_export = offers(c"VK_EXT_shader_stencil_export");
         let min_acceleration_structure_scratch_offset_alignment = if ray_query {
             let mut accel = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
             let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut accel);
@@ -176,6 +181,7 @@ pub(crate) fn describe(instance: &ash::Instance, physical: vk::PhysicalDevice, i
         DeviceInfo {
             index,
             ray_query,
+            stencil_export,
             min_acceleration_structure_scratch_offset_alignment,
             vendor_id: props.vendor_id,
             device_id: props.device_id,

@@ -39,6 +39,13 @@ pub const SUN_CELLS_PARTIAL: u32 = 2;
 pub const PENUMBRAE_HERE: u32 = 0;
 pub const PENUMBRAE_LATER: u32 = 1;
 pub const TREE_LATER: u32 = 2;
+/// How the first of two draws marks the pixels it leaves to the second (`VARIANT_MARK`): by their colour alone (a
+/// pass between the draws then sets the stencil where the colour holds the mark), or by the stencil value its
+/// fragments write besides (`VK_EXT_shader_stencil_export`; no pass between the draws). `gpu::second_draw`.
+pub const MARK_BY_COLOUR: u32 = 0;
+pub const MARK_BY_STENCIL: u32 = 1;
+/// The specialization constants of a variant ([`ShaderVariant::constants`]).
+pub const VARIANT_CONSTANTS: usize = 12;
 /// What the fragment shader writes (`VARIANT_QUANTITY`): radiance, or the irradiance at the surface.
 pub const QUANTITY_RADIANCE: u32 = 0;
 pub const QUANTITY_IRRADIANCE: u32 = 1;
@@ -68,7 +75,7 @@ pub const MIP_LINEAR: u32 = 2;
 pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// What one pipeline variant's fragment shader computes: its specialization constants (`VARIANT_*` in
-/// `shaders/bindings.glsl`, constant ids 0 to 10). The shader keeps only the code these select; `shadows` also
+/// `shaders/bindings.glsl`, constant ids 0 to 11). The shader keeps only the code these select; `shadows` also
 /// selects the module (with ray queries or without).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShaderVariant {
@@ -97,6 +104,9 @@ pub struct ShaderVariant {
     /// `PENUMBRAE_HERE`, `PENUMBRAE_LATER` in the first of a frame's two draws ([`ShaderVariant::first_draw`]), or
     /// `TREE_LATER` ([`ShaderVariant::tree_later`]).
     pub penumbrae: u32,
+    /// In a first draw (`PENUMBRAE_LATER`), `MARK_BY_STENCIL` where the device exports stencil values from the
+    /// fragment shader; `MARK_BY_COLOUR` otherwise.
+    pub mark: u32,
 }
 
 impl ShaderVariant {
@@ -138,16 +148,30 @@ impl ShaderVariant {
         };
         let occluders_masked = (shadows == SHADOWS_RAY && scene_masked) as u32;
         let sun_cells = if shadows == SHADOWS_RAY && sun != LIGHT_ABSENT { sun_cells } else { SUN_CELLS_NONE };
-        let penumbrae = PENUMBRAE_HERE;
-        Self { brdf, sun, disks, sky, shadows, surface, quantity, visibility, occluders_masked, sun_cells, penumbrae }
+        let (penumbrae, mark) = (PENUMBRAE_HERE, MARK_BY_COLOUR);
+        Self {
+            brdf,
+            sun,
+            disks,
+            sky,
+            shadows,
+            surface,
+            quantity,
+            visibility,
+            occluders_masked,
+            sun_cells,
+            penumbrae,
+            mark,
+        }
     }
 
     /// The variant of this one for the first of two draws, which shades only the pixels whose lights the cheap
     /// proofs settle (the sun's cells, the disk lights' walk: wholly visible or wholly hidden) and leaves the rest
     /// to this variant drawn after it; `None` where such a draw would settle no pixel, and the frame draws once:
     /// without shadow rays or by slices, with the sky (whose grid every pixel casts), small-source disks or a sun
-    /// without cells (whose rays go through the tree), and in the slices' passes.
-    pub fn first_draw(&self) -> Option<Self> {
+    /// without cells (whose rays go through the tree), and in the slices' passes. It marks those pixels by the
+    /// stencil too where the device can (`stencil_export`).
+    pub fn first_draw(&self, stencil_export: bool) -> Option<Self> {
         let sun_settles = self.sun == LIGHT_ABSENT || self.sun_cells != SUN_CELLS_NONE;
         let something_settled = (self.sun == SUN_DISK && self.sun_cells != SUN_CELLS_NONE) || self.disks == DISKS_EXACT;
         let first = self.shadows == SHADOWS_RAY
@@ -157,7 +181,8 @@ impl ShaderVariant {
             && self.disks != DISKS_SMALL_SOURCE
             && sun_settles
             && something_settled;
-        first.then_some(Self { penumbrae: PENUMBRAE_LATER, ..*self })
+        let mark = if stencil_export { MARK_BY_STENCIL } else { MARK_BY_COLOUR };
+        first.then_some(Self { penumbrae: PENUMBRAE_LATER, mark, ..*self })
     }
 
     /// This variant without the occluders' tree: where the only shadow rays it casts are the sun's (no disk light,
@@ -221,6 +246,7 @@ impl ShaderVariant {
             _ => {}
         }
         match self.penumbrae {
+            PENUMBRAE_LATER if self.mark == MARK_BY_STENCIL => parts.push("penumbrae later, marked by stencil".into()),
             PENUMBRAE_LATER => parts.push("penumbrae later".into()),
             TREE_LATER => parts.push("tree later".into()),
             _ => {}
@@ -230,7 +256,7 @@ impl ShaderVariant {
     }
 
     /// The constants in `constant_id` order.
-    pub fn constants(&self) -> [u32; 11] {
+    pub fn constants(&self) -> [u32; VARIANT_CONSTANTS] {
         [
             self.brdf,
             self.sun,
@@ -243,6 +269,7 @@ impl ShaderVariant {
             self.occluders_masked,
             self.sun_cells,
             self.penumbrae,
+            self.mark,
         ]
     }
 }
@@ -585,6 +612,8 @@ mod tests {
             ("PENUMBRAE_HERE", PENUMBRAE_HERE),
             ("PENUMBRAE_LATER", PENUMBRAE_LATER),
             ("TREE_LATER", TREE_LATER),
+            ("MARK_BY_COLOUR", MARK_BY_COLOUR),
+            ("MARK_BY_STENCIL", MARK_BY_STENCIL),
             ("SUN_CELLS_PARTIAL", SUN_CELLS_PARTIAL),
             ("QUANTITY_RADIANCE", QUANTITY_RADIANCE),
             ("QUANTITY_IRRADIANCE", QUANTITY_IRRADIANCE),
@@ -653,6 +682,7 @@ mod tests {
             "VARIANT_OCCLUDERS_MASKED",
             "VARIANT_SUN_CELLS",
             "VARIANT_PENUMBRAE",
+            "VARIANT_MARK",
         ];
         assert_eq!(
             variant_constants.len(),
@@ -680,11 +710,11 @@ mod tests {
         // The sun's rays alone: through complete cells never; through partial ones in the whole variant only.
         assert!(!complete.reads_the_tree(true) && partial.reads_the_tree(true) && base.reads_the_tree(true));
         assert!(!partial.tree_later().unwrap().reads_the_tree(true));
-        assert!(!partial.first_draw().unwrap().reads_the_tree(true));
+        assert!(!partial.first_draw(false).unwrap().reads_the_tree(true));
         // With ray queries the rays take the acceleration structure; the disk lights' walk and the slices still read it.
         assert!(!partial.reads_the_tree(false));
         let disks = ShaderVariant { disks: DISKS_EXACT, ..complete };
-        assert!(disks.reads_the_tree(false) && disks.first_draw().unwrap().reads_the_tree(false));
+        assert!(disks.reads_the_tree(false) && disks.first_draw(false).unwrap().reads_the_tree(false));
         assert!(ShaderVariant { visibility: VISIBILITY_SLICES, ..complete }.reads_the_tree(false));
         let sky = ShaderVariant { sky: SKY_PRESENT, ..complete };
         assert!(sky.reads_the_tree(true) && !sky.reads_the_tree(false));

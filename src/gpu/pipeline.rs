@@ -17,7 +17,9 @@ use ash::vk;
 
 use super::context::Device;
 use super::error::{GpuError, VkContext};
-use super::layout::{PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY, VISIBILITY_SLICES};
+use super::layout::{
+    PushConstants, ShaderVariant, Vertex, MAX_DISK_MAPS, SHADOWS_RAY, VARIANT_CONSTANTS, VISIBILITY_SLICES,
+};
 use super::pipeline_cache::{self, DiskPipelineCache};
 use super::second_draw::SCENE_DEPTH_STENCIL_FORMAT;
 
@@ -266,6 +268,7 @@ impl ScenePipeline {
             occluders_masked: 0,
             sun_cells: 0,
             penumbrae: 0,
+            mark: 0,
         };
         // SAFETY: valid device, layout, modules and cache owned by self.
         let (p, made) = unsafe {
@@ -404,7 +407,7 @@ unsafe fn create_pipeline(
     whole: bool,
 ) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
     let started = std::time::Instant::now();
-    let constants = variant.map_or([0; 11], |v| v.constants());
+    let constants = variant.map_or([0; VARIANT_CONSTANTS], |v| v.constants());
     let (mut instructions, mut inlined) = (0, 0);
     let module = match fs {
         Some(words) => {
@@ -440,7 +443,7 @@ unsafe fn create_pipeline_from(
     layout: vk::PipelineLayout,
     (vs, fs): (vk::ShaderModule, vk::ShaderModule),
     with_normals: bool,
-    constants: &[u32; 11],
+    constants: &[u32; VARIANT_CONSTANTS],
     depth_only: bool,
 ) -> Result<vk::Pipeline, GpuError> {
     // SAFETY (whole function): valid device and modules.

@@ -20,7 +20,7 @@ use super::layout::{
 };
 use super::memory::{image_barrier, Buffer, Image2d, TexelBuffer};
 use super::pipeline::{CreatedPipeline, ScenePipeline, ShadowRays, COLOR_FORMAT};
-use super::second_draw::{self, MarkPass, SCENE_DEPTH_STENCIL_FORMAT};
+use super::second_draw::{self, MarkPass, Tests, SCENE_DEPTH_STENCIL_FORMAT};
 use super::shaders;
 use super::shadow_bvh::{BvhNodeGpu, WalkSource};
 use super::shadow_map::DepthMap;
@@ -213,6 +213,14 @@ impl Renderer {
             (dev, instance, stages, elapsed)
         });
         let dev = dev?;
+        if options.whole_shaders && !dev.info.stencil_export {
+            // The shadow rays' whole modules declare the stencil output that the specializer removes from the
+            // pipelines that do not write it.
+            return Err(GpuError::Unsupported(format!(
+                "whole shaders (a diagnostic) need VK_EXT_shader_stencil_export, which {} does not have here",
+                dev.info.name
+            )));
+        }
         let t1 = Instant::now();
         let interpolation = match options.interpolation {
             Some(Interpolation::BarycentricF64) if !dev.info.shader_float64 => {
@@ -279,7 +287,9 @@ impl Renderer {
             commands,
             setup: SetupTimings { instance, shader_compile },
             interpolation,
-            one_draw: options.one_draw,
+            // Whole modules declare the stencil output of a first draw that marks by stencil; lavapipe takes it as
+            // written by every pipeline of the module, so a second draw's stencil test would fail: they draw once.
+            one_draw: options.one_draw || options.whole_shaders,
             dev,
         };
         renderer.check_validation()?;
@@ -741,8 +751,10 @@ impl Renderer {
             .collect();
         // Each draw's first draw, where one settles pixels, made with the others (in parallel) and drawn before them:
         // the pixels it leaves (penumbrae, rays through the tree) are shaded by the whole variant after it.
-        let firsts: Vec<Option<ShaderVariant>> =
-            variants.iter().map(|v| if self.one_draw && !leave { None } else { v.first_draw() }).collect();
+        let firsts: Vec<Option<ShaderVariant>> = variants
+            .iter()
+            .map(|v| if self.one_draw && !leave { None } else { v.first_draw(self.dev.info.stencil_export) })
+            .collect();
         if leave && variants.iter().zip(&firsts).any(|(v, f)| v.shadows == SHADOWS_RAY && f.is_none()) {
             return Ok(None);
         }
@@ -1251,18 +1263,26 @@ impl Renderer {
         };
         // SAFETY: `cb` is being recorded by the caller; every handle belongs to this renderer; the GPU is idle.
         unsafe {
+            let buffers = (scene, settings, (vb, ib));
+            if second && self.dev.info.stencil_export {
+                // The first draw marks by the stencil its fragments write: the second follows in the same rendering.
+                self.begin_scene_rendering(cb, settings, (true, keep_depth));
+                self.record_scene_draws(cb, buffers, draw_pipelines, Tests::FirstMarkingStencil, &scissors, false);
+                self.record_scene_draws(cb, buffers, second_pipelines, Tests::Second, &scissors, true);
+                return;
+            }
             self.begin_scene_rendering(cb, settings, (true, second || keep_depth));
-            self.record_scene_draws(cb, (scene, settings, (vb, ib)), draw_pipelines, false, &scissors);
+            self.record_scene_draws(cb, buffers, draw_pipelines, Tests::OneOrFirst, &scissors, true);
             if second {
                 self.mark.record(cb, &target.color, &target.depth, area);
                 self.begin_scene_rendering(cb, settings, (false, keep_depth));
-                self.record_scene_draws(cb, (scene, settings, (vb, ib)), second_pipelines, true, &scissors);
+                self.record_scene_draws(cb, buffers, second_pipelines, Tests::Second, &scissors, true);
             }
         }
     }
 
-    /// Every draw of the scene with `pipelines` under the tests of the one or first draw, or of the second
-    /// (`as_second`, `second_draw::set_tests`), in every scissor, and the rendering ended.
+    /// Every draw of the scene with `pipelines` under `tests` (`second_draw::set_tests`), in every scissor; the
+    /// rendering ended after them where `end`.
     ///
     /// # Safety
     /// `cb` is being recorded inside a rendering of the scene's target.
@@ -1271,20 +1291,23 @@ impl Renderer {
         cb: vk::CommandBuffer,
         (scene, settings, buffers): (&GpuScene, &RenderSettings, (&Buffer, &Buffer)),
         pipelines: &[vk::Pipeline],
-        as_second: bool,
+        tests: Tests,
         scissors: &[vk::Rect2D],
+        end: bool,
     ) {
         let d = &self.dev.device;
         let cull = |draw: &Draw| if draw.double_sided { vk::CullModeFlags::NONE } else { vk::CullModeFlags::BACK };
         let push = |draw: &Draw| push_constants(settings, draw.material, draw.first_index, draw.vertex_offset);
         // SAFETY: as the caller guarantees; every handle belongs to this renderer.
         unsafe {
-            second_draw::set_tests(d, cb, as_second);
+            second_draw::set_tests(d, cb, tests);
             for &scissor in scissors {
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 self.record_draws(cb, scene, buffers, pipelines, Some(&cull), push);
             }
-            d.cmd_end_rendering(cb);
+            if end {
+                d.cmd_end_rendering(cb);
+            }
         }
     }
 
@@ -1320,7 +1343,7 @@ impl Renderer {
             d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&to_attachment));
             self.mark.record(cb, &target.color, &target.depth, area);
             self.begin_scene_rendering(cb, settings, (false, false));
-            self.record_scene_draws(cb, (scene, settings, (vb, ib)), pipelines, true, &[area]);
+            self.record_scene_draws(cb, (scene, settings, (vb, ib)), pipelines, Tests::Second, &[area], true);
         }
     }
 

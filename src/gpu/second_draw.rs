@@ -8,15 +8,21 @@
 //!    within an opaque one; the disk lights' walk: every ray clear) is shaded as the whole shader shades it; any
 //!    other writes the coverage alpha [`LEFT_TO_SECOND_DRAW`]. Depth is tested and written as in one draw, so that
 //!    every pixel keeps the surface one draw would keep (the first drawn of equal depths).
-//! 2. **The mark** (shaders/second_draw.frag over one triangle covering the target): the stencil is set to 1 where
-//!    the colour's alpha is the mark, 0 elsewhere.
+//! 2. **The mark**: the stencil is 1 where the colour's alpha is the mark, 0 elsewhere. Where the device exports
+//!    stencil values from the fragment shader (`VK_EXT_shader_stencil_export`; lavapipe does), the first draw's
+//!    fragments write it themselves (`MARK_BY_STENCIL`, scene.frag's `marked_coverage_alpha`), the stencil op
+//!    replacing the value wherever the depth test passes ([`Tests::FirstMarkingStencil`]), so the pixel keeps the
+//!    mark of the surface that it keeps; no pass between the draws, which share one rendering. Elsewhere a pass sets
+//!    it from the colour ([`MarkPass`]: shaders/second_draw.frag over one triangle covering the target). The first
+//!    way saves the pass, its barriers and a second rendering (docs/platform.md, "Branches no pixel takes").
 //! 3. **The second draw**: the whole variant, with the depth test `EQUAL` and the stencil test `EQUAL 1`, its pass
 //!    setting the stencil to 0. Only the surface the first draw kept reaches a marked pixel (of equal depths, the
 //!    first drawn, as in one draw: it clears the mark before the next), and the tests run before the fragment shader,
 //!    so no other pixel runs it.
 //!
-//! The images are bitwise those of one draw (tests/shadows.rs, `gpu_two_draws_render_the_one_draws_image`); the
-//! diagnostic `SUNSHADE_ONE_DRAW=1` draws once.
+//! The images are bitwise those of one draw, marked either way (tests/shadows.rs,
+//! `gpu_two_draws_render_the_one_draws_image`); the diagnostics `SUNSHADE_ONE_DRAW=1` draws once,
+//! `SUNSHADE_MARK_BY_COLOUR=1` marks by colour where the device could by stencil.
 //!
 //! **The tree, once more where needed.** Where the only shadow rays are the sun's and its cells are partial (some
 //! points have more triangles above them than the cells answer for: sunset.glb, brdfs.glb), the tree's walk serves
@@ -265,29 +271,41 @@ unsafe fn create_mark_pipeline(d: &ash::Device, layout: vk::PipelineLayout) -> R
     }
 }
 
-/// Sets the depth and stencil tests of the scene's pipelines (dynamic state) for the one draw or the first
-/// (`second == false`: depth `LESS`, no stencil test) or for the second (depth `EQUAL`, stencil `EQUAL 1`, its pass
-/// clearing the mark so that a later surface of equal depth finds it cleared).
+/// Which draw of a frame the scene's pipelines record: what their depth and stencil tests are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Tests {
+    /// The one draw, or the first of two that marks by colour: depth `LESS`, no stencil test.
+    OneOrFirst,
+    /// The first of two whose fragments write the mark as their stencil value (`MARK_BY_STENCIL`): depth `LESS`,
+    /// and where it passes the stencil replaced by the fragment's value (by 0 from a pipeline that writes none:
+    /// a draw without a first variant), so that each pixel's stencil is the mark of the surface the depth test
+    /// keeps, as the mark's pass would set it.
+    FirstMarkingStencil,
+    /// The second: depth `EQUAL`, stencil `EQUAL 1`, its pass clearing the mark so that a later surface of equal
+    /// depth finds it cleared.
+    Second,
+}
+
+/// Sets the depth and stencil tests of the scene's pipelines (dynamic state) for `tests`.
 ///
 /// # Safety
 /// `cb` is being recorded inside a rendering of the scene's target.
-pub(crate) unsafe fn set_tests(d: &ash::Device, cb: vk::CommandBuffer, second: bool) {
+pub(crate) unsafe fn set_tests(d: &ash::Device, cb: vk::CommandBuffer, tests: Tests) {
     let faces = vk::StencilFaceFlags::FRONT_AND_BACK;
+    let depth = if tests == Tests::Second { vk::CompareOp::EQUAL } else { vk::CompareOp::LESS };
+    // (pass op, compare op, reference)
+    let (pass, compare, reference) = match tests {
+        Tests::FirstMarkingStencil => (vk::StencilOp::REPLACE, vk::CompareOp::ALWAYS, 0),
+        _ => (vk::StencilOp::ZERO, vk::CompareOp::EQUAL, 1),
+    };
     // SAFETY: as the caller guarantees.
     unsafe {
-        d.cmd_set_depth_compare_op(cb, if second { vk::CompareOp::EQUAL } else { vk::CompareOp::LESS });
-        d.cmd_set_stencil_test_enable(cb, second);
-        d.cmd_set_stencil_op(
-            cb,
-            faces,
-            vk::StencilOp::KEEP,
-            vk::StencilOp::ZERO,
-            vk::StencilOp::KEEP,
-            vk::CompareOp::EQUAL,
-        );
+        d.cmd_set_depth_compare_op(cb, depth);
+        d.cmd_set_stencil_test_enable(cb, tests != Tests::OneOrFirst);
+        d.cmd_set_stencil_op(cb, faces, vk::StencilOp::KEEP, pass, vk::StencilOp::KEEP, compare);
         d.cmd_set_stencil_compare_mask(cb, faces, 1);
         d.cmd_set_stencil_write_mask(cb, faces, 1);
-        d.cmd_set_stencil_reference(cb, faces, 1);
+        d.cmd_set_stencil_reference(cb, faces, reference);
     }
 }
 

@@ -16,6 +16,9 @@
 //!    back to the header), so the structured control flow stays valid. A conditional branch with a known condition
 //!    becomes an `OpBranch` (its `OpSelectionMerge` dropped), and phis keep the edges that remain.
 //! 3. Functions that no live block calls are removed, with the names and decorations of everything removed.
+//! 4. The fragment's stencil output (`FragStencilRefEXT`) where no live code writes it is removed, with the
+//!    capability, extension and execution mode it needs: one module serves the pipelines that write it and those that do not, on
+//!    devices with `VK_EXT_shader_stencil_export` and without (sunshade's first of two draws, gpu::second_draw).
 //!
 //! Floating-point instructions are never evaluated, reordered or rewritten: the code that remains is the
 //! instructions the driver would have kept, word for word, so images are bitwise unchanged.
@@ -45,6 +48,15 @@ const OP_VARIABLE: u16 = 59;
 const OP_LOAD: u16 = 61;
 const OP_STORE: u16 = 62;
 const OP_ENTRY_POINT: u16 = 15;
+const OP_EXTENSION: u16 = 10;
+const OP_CAPABILITY: u16 = 17;
+const OP_EXECUTION_MODE: u16 = 16;
+const EXECUTION_MODE_STENCIL_REF_REPLACING: u32 = 5027;
+const OP_ACCESS_CHAIN: u16 = 65;
+const DECORATION_BUILT_IN: u32 = 11;
+const BUILT_IN_FRAG_STENCIL_REF: u32 = 5014;
+const CAPABILITY_STENCIL_EXPORT: u32 = 5013;
+const STENCIL_EXPORT_EXTENSION: &str = "SPV_EXT_shader_stencil_export";
 const OP_PHI: u16 = 245;
 const OP_LOOP_MERGE: u16 = 246;
 const OP_SELECTION_MERGE: u16 = 247;
@@ -102,8 +114,17 @@ fn instructions(words: &[u32]) -> Result<Vec<Inst<'_>>, String> {
     if words.len() < 5 || words[0] != 0x0723_0203 {
         return Err("not a SPIR-V module (magic number missing)".into());
     }
+    instructions_from(words, 5)
+}
+
+/// The instructions of a stream of them without the module's header (a function's text).
+fn instructions_of(words: &[u32]) -> Result<Vec<Inst<'_>>, String> {
+    instructions_from(words, 0)
+}
+
+fn instructions_from(words: &[u32], first: usize) -> Result<Vec<Inst<'_>>, String> {
     let mut out = Vec::new();
-    let mut at = 5;
+    let mut at = first;
     while at < words.len() {
         let count = (words[at] >> 16) as usize;
         if count == 0 || at + count > words.len() {
@@ -395,6 +416,37 @@ fn analyse(
     }
 }
 
+/// The literal string that starts at `words[0]` (nul-terminated, padded to whole words), and the words it takes.
+fn literal_string(words: &[u32]) -> (String, usize) {
+    let mut bytes = Vec::new();
+    for (n, w) in words.iter().enumerate() {
+        for b in w.to_le_bytes() {
+            if b == 0 {
+                return (String::from_utf8_lossy(&bytes).into_owned(), n + 1);
+            }
+            bytes.push(b);
+        }
+    }
+    (String::from_utf8_lossy(&bytes).into_owned(), words.len())
+}
+
+/// The variable of the fragment's stencil output (decorated `BuiltIn FragStencilRefEXT`), where the module declares
+/// one and no instruction of `body` (the live functions' text) stores to it, loads it or indexes it.
+fn unwritten_stencil_output(header: &[Inst<'_>], body: &[u32]) -> Option<u32> {
+    let var = header.iter().find_map(|i| {
+        let w = i.words;
+        (i.op == OP_DECORATE && w.len() >= 4 && w[2] == DECORATION_BUILT_IN && w[3] == BUILT_IN_FRAG_STENCIL_REF)
+            .then(|| w[1])
+    })?;
+    let body = instructions_of(body).ok()?;
+    let touched = body.iter().any(|i| match i.op {
+        OP_STORE => i.words.get(1) == Some(&var),
+        OP_LOAD | OP_ACCESS_CHAIN => i.words.get(3) == Some(&var),
+        _ => false,
+    });
+    (!touched).then_some(var)
+}
+
 /// `words` specialized for `constants` (SpecId, value; booleans 0 or 1): see the module's documentation. Constants
 /// the module does not declare are ignored; spec constants not named keep their defaults.
 pub fn specialize(words: &[u32], constants: &[(u32, u32)]) -> Result<Vec<u32>, String> {
@@ -572,10 +624,30 @@ pub fn specialize(words: &[u32], constants: &[(u32, u32)]) -> Result<Vec<u32>, S
         let at = if matches!(i.op, 7 | 11 | 19..=39 | 73 | 322 | 4472 | 5341) { 1 } else { 2 };
         defined.extend(i.words.get(at));
     }
+    // Step 4: the stencil output no live code writes, with what only it needs.
+    let unwritten = unwritten_stencil_output(&insts[..first_function], &body);
+    if let Some(var) = unwritten {
+        defined.remove(&var);
+    }
     for i in &insts[..first_function] {
         let w = i.words;
         match i.op {
             OP_NAME | OP_DECORATE | OP_DECORATE_ID | OP_DECORATE_STRING if !defined.contains(&w[1]) => continue,
+            OP_VARIABLE if unwritten == w.get(2).copied() => continue,
+            OP_CAPABILITY if unwritten.is_some() && w.get(1) == Some(&CAPABILITY_STENCIL_EXPORT) => continue,
+            OP_EXECUTION_MODE if unwritten.is_some() && w.get(2) == Some(&EXECUTION_MODE_STENCIL_REF_REPLACING) => {
+                continue
+            }
+            OP_EXTENSION if unwritten.is_some() && literal_string(&w[1..]).0 == STENCIL_EXPORT_EXTENSION => continue,
+            OP_ENTRY_POINT if unwritten.is_some() => {
+                // Execution model, function, name, then the interface's ids.
+                let interface = 3 + literal_string(&w[3..]).1;
+                let mut kept: Vec<u32> = w[..interface.min(w.len())].to_vec();
+                kept.extend(w.iter().skip(interface).filter(|id| Some(**id) != unwritten));
+                kept[0] = ((kept.len() as u32) << 16) | OP_ENTRY_POINT as u32;
+                out.extend_from_slice(&kept);
+                continue;
+            }
             OP_SPEC_CONSTANT if w.len() == 4 => {
                 let v = value_of(w[2]).unwrap_or(w[3]);
                 out.extend_from_slice(&[w[0], w[1], w[2], v]);
@@ -804,5 +876,61 @@ void main() {
         assert_eq!(evaluate(169, &[0, 5, 6]), Some(6));
         // Floating-point instructions are never evaluated.
         assert_eq!(evaluate(129, &[0x3f80_0000, 0x3f80_0000]), None);
+    }
+
+    /// A stencil output written only under a constant: kept with its capability and extension where the constant
+    /// selects the write, gone (output, capability, extension, entry point's interface) where it does not, so that
+    /// the module is valid for a device without the extension.
+    #[test]
+    fn an_unwritten_stencil_output_goes_with_its_capability() {
+        let shader = r#"#version 460
+#extension GL_ARB_shader_stencil_export : require
+layout(constant_id = 0) const uint MARK = 0u;
+layout(location = 0) in vec4 v;
+layout(location = 0) out vec4 o;
+void main() {
+    if (MARK == 1u) {
+        gl_FragStencilRefARB = v.x > 0.0 ? 1 : 0;
+    }
+    o = v;
+}
+"#;
+        let words = crate::compile("s.frag", &[("s.frag", shader)], &[]).unwrap();
+        let has = |words: &[u32], op: u16, operand: u32| {
+            instructions(words).unwrap().iter().any(|i| i.op == op && i.words.get(1) == Some(&operand))
+        };
+        let extension = |words: &[u32]| {
+            instructions(words)
+                .unwrap()
+                .iter()
+                .any(|i| i.op == OP_EXTENSION && literal_string(&i.words[1..]).0 == STENCIL_EXPORT_EXTENSION)
+        };
+        let stencil_var = |words: &[u32]| {
+            instructions(words).unwrap().iter().find_map(|i| {
+                let w = i.words;
+                (i.op == OP_DECORATE
+                    && w.len() >= 4
+                    && w[2] == DECORATION_BUILT_IN
+                    && w[3] == BUILT_IN_FRAG_STENCIL_REF)
+                    .then(|| w[1])
+            })
+        };
+        assert!(has(&words, OP_CAPABILITY, CAPABILITY_STENCIL_EXPORT) && extension(&words));
+        let written = specialize(&words, &[(0, 1)]).unwrap();
+        spirv_val(&written);
+        assert!(has(&written, OP_CAPABILITY, CAPABILITY_STENCIL_EXPORT) && extension(&written));
+        assert!(stencil_var(&written).is_some());
+        let unwritten = specialize(&words, &[(0, 0)]).unwrap();
+        spirv_val(&unwritten);
+        assert!(!has(&unwritten, OP_CAPABILITY, CAPABILITY_STENCIL_EXPORT) && !extension(&unwritten));
+        let var = stencil_var(&words).unwrap();
+        assert!(stencil_var(&unwritten).is_none());
+        let names_var = |i: &Inst<'_>| {
+            matches!(i.op, OP_NAME | OP_DECORATE | OP_VARIABLE) && i.words[1..].iter().take(2).any(|w| *w == var)
+        };
+        assert!(!instructions(&unwritten).unwrap().iter().any(names_var));
+        // The other output and the input stay in the entry point's interface.
+        let entry = instructions(&unwritten).unwrap().into_iter().find(|i| i.op == OP_ENTRY_POINT).unwrap();
+        assert_eq!(entry.words.len() - 3 - literal_string(&entry.words[3..]).1, 2);
     }
 }
