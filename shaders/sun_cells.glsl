@@ -118,14 +118,28 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
         return SUN_CONE_UNKNOWN;
     }
-    uvec2 range = sun_cell_range(origin);
+    // Partial cells need the count of the entries above the point (sun_cell_range's bisection); complete ones
+    // scan the cell's entries from its highest and stop at the first at or below the point's depth, the same
+    // entries in the same order without the bisection's loop.
+    uvec2 range = uvec2(0u);
+    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL) {
+        range = sun_cell_range(origin);
+    } else {
+        uint c = sun_cell_of(origin);
+        range = c == NO_SUN_CELL ? uvec2(0u) : uvec2(SUN_CELL_START(c), SUN_CELL_START(c + 1u));
+    }
     if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_CLASSIFIED) {
         return SUN_CONE_UNKNOWN;
     }
     bool past_rays = VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES;
     bool partial = false;
+    float depth = dot(origin, SUN_CELLS_L.xyz);
     for (uint i = range.x; i < range.y; ++i) {
-        uint cls = sun_triangle_class(origin, n, l, sin_sigma, SUN_CELL_VEC4(i, 0u).xyz, SUN_CELL_VEC4(i, 1u).xyz,
+        vec4 c0_top = SUN_CELL_VEC4(i, 0u);
+        if (c0_top.w <= depth) {
+            break;
+        }
+        uint cls = sun_triangle_class(origin, n, l, sin_sigma, c0_top.xyz, SUN_CELL_VEC4(i, 1u).xyz,
                                       SUN_CELL_VEC4(i, 2u).xyz);
         bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || material_at(SUN_CELL_RECORD(i).w & 0x7fffffffu).kind.z == 0u;
         if (cls == SUN_CONE_COVERED && opaque) {
