@@ -11,7 +11,7 @@
 use std::io::{self, BufRead, Write};
 use std::path::{Path, PathBuf};
 
-use super::{srgb_encode, write_atomically, Exposure, Image};
+use super::{srgb_code, write_atomically, Exposure, Image};
 
 /// The file formats sunshade reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,7 +93,7 @@ pub fn write_image_with(
             let mut data = Vec::with_capacity(image.pixels().len() * 4);
             for p in image.pixels() {
                 for c in &p[..3] {
-                    data.push(srgb_encode(*c as f64 * scale));
+                    data.push(srgb_code(*c as f64 * scale));
                 }
                 data.push((p[3].clamp(0.0, 1.0) * 255.0).round() as u8);
             }
@@ -348,6 +348,7 @@ mod tests {
     }
 
     use super::*;
+    use crate::film::srgb_encode;
 
     fn sample() -> Image {
         let mut img = Image::new(3, 2);

@@ -6,12 +6,14 @@
 mod atomic;
 mod exposure;
 mod io;
+mod srgb_codes;
 
 pub use atomic::write_atomically;
 pub use exposure::{auto_exposure_ev, srgb_encode, Exposure};
 pub use io::{
     read_image, read_quantity, read_recorded, write_image, write_image_with, ImageFormat, ImageIoError, Metadata,
 };
+pub use srgb_codes::srgb_code;
 
 /// An RGBA32F image of linear radiance [W/(m²·sr)] with alpha as coverage.
 #[derive(Clone, Debug, PartialEq)]
