@@ -725,8 +725,11 @@ impl Renderer {
             let texel_bytes = (self.dev.info.max_texel_buffer_elements as u64 * 16).min(u32::MAX as u64) as u32;
             let max_entries = super::sun_cells::max_entries(self.dev.info.max_storage_buffer_range.min(texel_bytes));
             if let Some(cells) = SunCells::build(triangles, sun.direction.as_dvec3(), half_angle, max_entries) {
-                let bytes = super::sun_cells::bytes(&cells, triangles, records);
-                self.sun_cells = Some(TexelBuffer::rgba32ui(&self.dev, &bytes, "sun cells")?);
+                let count = super::sun_cells::texel_count(&cells);
+                let format = vk::Format::R32G32B32A32_UINT;
+                self.sun_cells = Some(TexelBuffer::filled(&self.dev, count, format, "sun cells", |out| {
+                    super::sun_cells::write(&cells, triangles, records, out)
+                })?);
                 sun_cells =
                     if cells.fullest() <= MAX_SUN_CELL_TRIANGLES { SUN_CELLS_COMPLETE } else { SUN_CELLS_PARTIAL };
             }

@@ -35,9 +35,18 @@ pub fn max_entries(max_bytes: u32) -> usize {
     max_bytes as usize / 8 * 7 / (ENTRY_WORDS * 4)
 }
 
-/// The buffer of `cells`, whose triangle indices point into `triangles` (world corners \[m\], the vertex buffer's
-/// f32 positions) and `records` (their occluder records). The entries start at a multiple of four words.
-pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
+/// The texels (four words each) the buffer of `cells` takes: the header's four, the starts padded to whole texels,
+/// four an entry.
+pub fn texel_count(cells: &SunCells) -> usize {
+    4 + cells.starts.len().div_ceil(4) + (ENTRY_WORDS / 4) * cells.triangles.len()
+}
+
+/// Writes the buffer of `cells` into `out` ([`texel_count`] texels: the device's mapped memory), whose triangle
+/// indices point into `triangles` (world corners \[m\], the vertex buffer's f32 positions) and `records` (their
+/// occluder records). The entries start at a multiple of four words; they are written on every core (a low sun's
+/// cells hold millions of words).
+pub fn write(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]], out: &mut [[u32; 4]]) {
+    use rayon::prelude::*;
     let f = |a: glam::DVec3, w: f64| [a.x as f32, a.y as f32, a.z as f32, w as f32];
     let offset = cells.starts.len().next_multiple_of(4);
     let header = SunCellsHeader {
@@ -46,23 +55,31 @@ pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 
         l: f(cells.l, cells.per_metre),
         dims: [cells.dims[0], cells.dims[1], offset as u32, 1],
     };
-    let mut words: Vec<u32> = Vec::with_capacity(offset + ENTRY_WORDS * cells.triangles.len());
+    assert_eq!(out.len(), texel_count(cells), "the sun cells' buffer");
+    let (head, rest) = out.split_at_mut(4);
+    bytemuck::cast_slice_mut::<[u32; 4], u8>(head).copy_from_slice(bytemuck::bytes_of(&header));
     // The shader reads data in vec4s: the starts padded to four words (offset), the entries sixteen each.
-    words.extend_from_slice(&cells.starts);
-    words.resize(offset, 0);
-    for &t in &cells.triangles {
+    let (starts, entries) = rest.split_at_mut(offset / 4);
+    let starts: &mut [u32] = bytemuck::cast_slice_mut(starts);
+    starts[..cells.starts.len()].copy_from_slice(&cells.starts);
+    starts[cells.starts.len()..].fill(0);
+    entries.par_chunks_mut(ENTRY_WORDS / 4).zip(cells.triangles.par_iter()).for_each(|(entry, &t)| {
         let [c0, c1, c2] = triangles[t as usize];
         // The top rounded up to f32, so that the shader's cut-off never passes over a triangle the f64 keeps.
         let top = cells.tops[t as usize];
         let top32 = if (top as f32 as f64) < top { (top as f32).next_up() } else { top as f32 };
-        for (c, w) in [(c0, top32), (c1, 0.0), (c2, 0.0)] {
-            words.extend([c.x as f32, c.y as f32, c.z as f32, w].map(f32::to_bits));
+        for (texel, (c, w)) in entry.iter_mut().zip([(c0, top32), (c1, 0.0), (c2, 0.0)]) {
+            *texel = [c.x as f32, c.y as f32, c.z as f32, w].map(f32::to_bits);
         }
-        words.extend_from_slice(&records[t as usize]);
-    }
-    let mut bytes = bytemuck::bytes_of(&header).to_vec();
-    bytes.extend_from_slice(bytemuck::cast_slice(&words));
-    bytes
+        entry[3] = records[t as usize];
+    });
+}
+
+/// The buffer of `cells` as bytes ([`write`] into memory of its own).
+pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
+    let mut texels = vec![[0u32; 4]; texel_count(cells)];
+    write(cells, triangles, records, &mut texels);
+    bytemuck::cast_slice(&texels).to_vec()
 }
 
 #[cfg(test)]
