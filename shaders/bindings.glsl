@@ -86,7 +86,8 @@ layout(constant_id = 11) const uint VARIANT_MARK = 0u; // with PENUMBRAE_LATER: 
 
 // How the first of two draws marks the pixels it leaves to the second (VARIANT_MARK; gpu::layout's MARK_BY_*): by
 // the colour's alpha LEFT_TO_SECOND_DRAW alone, which a pass between the draws turns into the stencil, or by the
-// stencil value every fragment of the draw writes besides (scene.frag's mark_stencil; VK_EXT_shader_stencil_export).
+// stencil value every fragment of the draw writes besides (scene.frag's marked_coverage_alpha;
+// VK_EXT_shader_stencil_export).
 #define MARK_BY_COLOUR 0u
 #define MARK_BY_STENCIL 1u
 
