@@ -11,9 +11,9 @@
 //! 2. **The mark**: the stencil is 1 where the colour's alpha is the mark, 0 elsewhere. Where the device exports
 //!    stencil values from the fragment shader (`VK_EXT_shader_stencil_export`; lavapipe does), the first draw's
 //!    fragments write it themselves (`MARK_BY_STENCIL`, scene.frag's `marked_coverage_alpha`), the stencil op
-//!    replacing the value wherever the depth test passes ([`Tests::FirstMarkingStencil`]), so the pixel keeps the
+//!    replacing the value wherever the depth test passes (`Tests::FirstMarkingStencil`), so the pixel keeps the
 //!    mark of the surface that it keeps; no pass between the draws, which share one rendering. Elsewhere a pass sets
-//!    it from the colour ([`MarkPass`]: shaders/second_draw.frag over one triangle covering the target). The first
+//!    it from the colour (`MarkPass`: shaders/second_draw.frag over one triangle covering the target). The first
 //!    way saves the pass, its barriers and a second rendering (docs/platform.md, "Branches no pixel takes").
 //! 3. **The second draw**: the whole variant, with the depth test `EQUAL` and the stencil test `EQUAL 1`, its pass
 //!    setting the stencil to 0. Only the surface the first draw kept reaches a marked pixel (of equal depths, the

@@ -75,7 +75,7 @@ pub fn write(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 
     });
 }
 
-/// The buffer of `cells` as bytes ([`write`] into memory of its own).
+/// The buffer of `cells` as bytes ([`write()`] into memory of its own).
 pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
     let mut texels = vec![[0u32; 4]; texel_count(cells)];
     write(cells, triangles, records, &mut texels);
