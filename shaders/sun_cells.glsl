@@ -163,6 +163,77 @@ uint sun_listed[MAX_SUN_LISTED];
 uint sun_listed_count = 0u;
 bool sun_listed_valid = false;
 
+// The listed triangles binned over the sun cone's directions, so that each of a penumbra's rays tests only those
+// whose directions from the point can hold it (sun_list_bins, sun_bin_of). A direction w of the cone is placed by
+// its gnomonic coordinates about the cone's axis l, ((w.t, w.b) / w.l) / tan(sigma) in [-1, 1]^2, (t, b) a frame
+// about l; a ray from the point meets a triangle only in a direction inside the triangle's gnomonic image, which
+// lies within the box of its corners' images where every corner lies in front of the point along l (within 60
+// degrees of l, so that the images stay within tan 60 and keep their digits). A triangle with a corner elsewhere
+// is put in every bin. The boxes are grown by SUN_BIN_MARGIN, some thousand times what f32 loses in the images
+// and in the watertight test's own answer near an edge: a triangle the test can find a ray's hit on is always in
+// the ray's bin, so that the rays' answers are those of the whole list. Only where the cells are partial (a low
+// sun, dense occluders: lists of tens to hundreds); elsewhere the lists are short and the bins' code would cost
+// every pipeline's creation more than they save.
+#define SUN_BINS_SIDE 4u
+#define SUN_BIN_WORDS (MAX_SUN_LISTED / 32u)
+#define SUN_BIN_MARGIN (1.0 / 4096.0)
+uint sun_bins[SUN_BINS_SIDE * SUN_BINS_SIDE * SUN_BIN_WORDS];
+// The cone's axis and frame, and 1 / tan(sigma); sun_bins_valid false where the list is not binned (a delta sun).
+vec3 sun_bin_axes[3];
+float sun_bin_scale = 0.0;
+bool sun_bins_valid = false;
+
+// A direction's bin, or SUN_BINS_SIDE^2 outside the binned square (the ray then tests the whole list).
+uint sun_bin_of(vec3 direction) {
+    float along = dot(direction, sun_bin_axes[0]);
+    vec2 g = vec2(dot(direction, sun_bin_axes[1]), dot(direction, sun_bin_axes[2])) / along * sun_bin_scale;
+    vec2 cell = floor((g + 1.0) * (0.5 * float(SUN_BINS_SIDE)));
+    bool inside = along > 0.0 && all(greaterThanEqual(cell, vec2(0.0)))
+                  && all(lessThan(cell, vec2(float(SUN_BINS_SIDE))));
+    return inside ? uint(cell.x) + SUN_BINS_SIDE * uint(cell.y) : SUN_BINS_SIDE * SUN_BINS_SIDE;
+}
+
+// Bins the listed triangles over the cone of half-angle asin(sin_sigma) about l from origin (see sun_bins).
+void sun_list_bins(vec3 origin, vec3 l, float sin_sigma) {
+    float tan_sigma = sin_sigma / sqrt(max(1.0 - sin_sigma * sin_sigma, 0.0));
+    sun_bins_valid = tan_sigma > 0.0;
+    if (!sun_bins_valid) {
+        return;
+    }
+    vec3 t = orthonormal_to(l);
+    sun_bin_axes = vec3[3](l, t, cross(l, t));
+    sun_bin_scale = 1.0 / tan_sigma;
+    for (uint w = 0u; w < SUN_BINS_SIDE * SUN_BINS_SIDE * SUN_BIN_WORDS; ++w) {
+        sun_bins[w] = 0u;
+    }
+    for (uint e = 0u; e < sun_listed_count; ++e) {
+        uint i = sun_listed[e];
+        vec2 lo = vec2(1e30);
+        vec2 hi = vec2(-1e30);
+        bool in_front = true;
+        for (uint q = 0u; q < 3u; ++q) {
+            vec3 c = SUN_CELL_VEC4(i, q).xyz - origin;
+            float along = dot(c, l);
+            in_front = in_front && along > 0.5 * length(c);
+            vec2 g = vec2(dot(c, sun_bin_axes[1]), dot(c, sun_bin_axes[2])) / along * sun_bin_scale;
+            lo = min(lo, g);
+            hi = max(hi, g);
+        }
+        // Bins [first, last] along each axis, every bin where a corner is not in front.
+        float side = float(SUN_BINS_SIDE);
+        vec2 first = in_front ? floor((lo - SUN_BIN_MARGIN * sun_bin_scale + 1.0) * (0.5 * side)) : vec2(0.0);
+        vec2 last = in_front ? floor((hi + SUN_BIN_MARGIN * sun_bin_scale + 1.0) * (0.5 * side)) : vec2(side - 1.0);
+        uvec2 a = uvec2(clamp(first, vec2(0.0), vec2(side - 1.0)));
+        uvec2 b = uvec2(clamp(last, vec2(0.0), vec2(side - 1.0)));
+        bool overlaps = all(lessThanEqual(first, vec2(side - 1.0))) && all(greaterThanEqual(last, vec2(0.0)));
+        for (uint y = a.y; overlaps && y <= b.y; ++y) {
+            for (uint x = a.x; x <= b.x; ++x) {
+                sun_bins[(x + SUN_BINS_SIDE * y) * SUN_BIN_WORDS + e / 32u] |= 1u << (e % 32u);
+            }
+        }
+    }
+}
+
 // Lists the entries of origin's cell above it whose triangles the cone of half-angle asin(sin_sigma) about l does
 // not provably miss above the horizon of the surface's normal n (sun_triangle_class): the only triangles a ray of
 // the cone leaving above that horizon can meet, so that a penumbra's rays (its grid's, its lobe's) test them alone,
@@ -185,6 +256,10 @@ void sun_cone_list(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     }
     sun_listed_count = count;
     sun_listed_valid = fits;
+    sun_bins_valid = false;
+    if (fits && VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL) {
+        sun_list_bins(origin, l, sin_sigma);
+    }
 }
 
 // Whether the frame has cells and the triangles of `origin`'s cell above it are few enough to classify (at most
@@ -226,8 +301,34 @@ bool sun_cells_occluded(vec3 origin, vec3 n, vec3 direction) {
         // traversal, as all its rays would without the list.
         return occluded(origin, direction, RAY_T_INFINITE);
     }
-    for (uint e = range.x; e < range.y; ++e) {
-        uint i = listed ? sun_listed[e] : e;
+    // Where the list is binned, the entries of the ray's bin alone (sun_bins): each set bit of its words, in order.
+    bool use_bins = VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && listed && sun_bins_valid;
+    uint bin = use_bins ? sun_bin_of(direction) : SUN_BINS_SIDE * SUN_BINS_SIDE;
+    bool binned = bin < SUN_BINS_SIDE * SUN_BINS_SIDE;
+    uint words = (range.y + 31u) / 32u;
+    uint word = 0u;
+    uint bits = binned ? sun_bins[bin * SUN_BIN_WORDS] : 0u;
+    uint e = range.x;
+    while (true) {
+        uint i = 0u;
+        if (binned) {
+            while (bits == 0u && word + 1u < words) {
+                word += 1u;
+                bits = sun_bins[bin * SUN_BIN_WORDS + word];
+            }
+            if (bits == 0u) {
+                break;
+            }
+            uint j = uint(findLSB(bits));
+            bits &= bits - 1u;
+            i = sun_listed[32u * word + j];
+        } else {
+            if (e >= range.y) {
+                break;
+            }
+            i = listed ? sun_listed[e] : e;
+            e += 1u;
+        }
         vec3 c0 = SUN_CELL_VEC4(i, 0u).xyz;
         vec3 c1 = SUN_CELL_VEC4(i, 1u).xyz;
         vec3 c2 = SUN_CELL_VEC4(i, 2u).xyz;

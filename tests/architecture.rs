@@ -269,6 +269,13 @@ const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
     ),
     (
         "sun_cells.glsl",
+        "sun_list_bins",
+        "a penumbra's listed triangles binned over its cone's directions, so that each ray tests its bin's alone: \
+         the same answers as the whole list, which the Rust's sun_cells_occluded takes",
+    ),
+    ("sun_cells.glsl", "sun_bin_of", "a ray's bin among sun_list_bins' (GPU-only with it)"),
+    (
+        "sun_cells.glsl",
         "sun_cells_classify",
         "the bound sun_cone_class tests inline (its MAX_SUN_CELL_CLASSIFIED), for the list past the rays' bound",
     ),

@@ -308,7 +308,7 @@ const PINNED: &[Pinned] = &[
             TREE_LATER,
             MARK_BY_COLOUR,
         ],
-        budget: 6500, // 5877 when recorded
+        budget: 7200, // 6515 when recorded, with the penumbra's bins (CHANGELOG.md: what they save)
     },
     Pinned {
         name: "shadow rays by the BVH walk: Ward, every light",
