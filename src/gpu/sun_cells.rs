@@ -75,17 +75,17 @@ pub fn write(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 
     });
 }
 
-/// The buffer of `cells` as bytes ([`write()`] into memory of its own).
-pub fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
-    let mut texels = vec![[0u32; 4]; texel_count(cells)];
-    write(cells, triangles, records, &mut texels);
-    bytemuck::cast_slice(&texels).to_vec()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    /// The buffer of `cells` as bytes: [`write()`] into memory of its own.
+    fn bytes(cells: &SunCells, triangles: &[[glam::DVec3; 3]], records: &[[u32; 4]]) -> Vec<u8> {
+        let mut texels = vec![[0u32; 4]; texel_count(cells)];
+        write(cells, triangles, records, &mut texels);
+        bytemuck::cast_slice(&texels).to_vec()
+    }
 
     /// The header's texels are the shader's (vec4, vec4, vec4, uvec4, then the data from texel 4), the records
     /// follow the starts, and a cell's entries are its triangles' records.
