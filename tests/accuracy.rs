@@ -62,6 +62,37 @@ fn the_converged_reference_meets_its_claim_by_one_more_doubling() {
     assert!(c.unconverged.iter().all(|u| u.change >= accuracy / 10.0));
 }
 
+/// A frame rasterized once and shaded with several grids (the refinements' way) gives `cpu::render`'s images bit
+/// for bit: every pixel, and the selected pixels alone (the others left empty), with shadow rays by the grid and by
+/// slices, the occluders built once for all of them.
+#[test]
+fn a_frame_shades_as_the_reference_renders() {
+    for model in ["models/room.gltf", "models/sunset.glb"] {
+        let scene = common::load(std::path::Path::new(model));
+        let mut s = settings::resolve(&scene, 40, 30, &CameraOptions::default(), &SunOptions::default()).unwrap();
+        s.shading.shadows = Shadows::Ray;
+        let reference = ReferenceOptions::default();
+        let frame = cpu::Frame::new(&scene, &s, &reference);
+        let selected: Vec<bool> = (0..40 * 30).map(|i| i % 3 == 0).collect();
+        for (k, rule) in [(2, VisibilityRule::Grid), (5, VisibilityRule::Grid), (3, VisibilityRule::Slices)] {
+            let mut g = s.clone();
+            g.shading.shadow_samples_per_axis = k;
+            g.shading.visibility_rule = rule;
+            let whole = cpu::render(&scene, &g, &reference);
+            assert!(whole.covered_count() > 600, "{model}: the view must see the scene");
+            let bits = |image: &sunshade::film::Image| {
+                image.pixels().iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<u32>>()
+            };
+            assert_eq!(bits(&frame.render_selected(&g, None)), bits(&whole), "{model}, {k}² {rule:?}");
+            let part = frame.render_selected(&g, Some(&selected));
+            for (i, (p, w)) in part.pixels().iter().zip(whole.pixels()).enumerate() {
+                let expected = if selected[i] { *w } else { [0.0; 4] };
+                assert_eq!(p.map(f32::to_bits), expected.map(f32::to_bits), "{model}, {k}² {rule:?}, pixel {i}");
+            }
+        }
+    }
+}
+
 /// Grids that agree by chance: on overcast.glb with shadow rays, one pixel is identical on every grid from 8² to 51²
 /// (no ray meets the occluder a finer grid finds; 5.5% darker from 73² on), so it passes two doublings early. The
 /// final check (every pixel that stopped early, rendered once more with the finest grids reached) reports it, and

@@ -33,7 +33,7 @@
 
 use crate::accuracy::refinement::next_grid;
 use crate::compare::{default_floor, pixel_difference};
-use crate::cpu::{self, ReferenceOptions};
+use crate::cpu::{Frame, ReferenceOptions};
 use crate::film::Image;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
@@ -146,9 +146,8 @@ impl Converged {
 /// doubling) rendered with the finest grids (`finest`), each kept at that value; those it moved by `threshold` or
 /// more (a NaN or an infinity included), with their change.
 fn final_check(
-    scene: &Scene,
+    frame: &Frame,
     finest: &RenderSettings,
-    reference: &ReferenceOptions,
     image: &mut Image,
     early: &[bool],
     floor: f64,
@@ -157,7 +156,7 @@ fn final_check(
     if !early.contains(&true) {
         return Vec::new();
     }
-    let finer = cpu::render_selected(scene, finest, reference, early);
+    let finer = frame.render_selected(finest, Some(early));
     let width = image.width();
     let mut moved = Vec::new();
     for (i, _) in early.iter().enumerate().filter(|(_, &e)| e) {
@@ -204,7 +203,7 @@ pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
 
 /// Renders `scene` on the CPU with exact light models, refining the sample grids from those of `settings` until
 /// converged or `options.max_refinements` doublings (see the module's text). The first doubling renders the
-/// whole image; later ones only the pixels still moving (`cpu::render_selected`), so that the cost follows the
+/// whole image; later ones only the pixels still moving (`cpu::Frame::render_selected`), so that the cost follows the
 /// pixels that need it. Each pixel keeps the value of the finest render it got. Shadows are as
 /// `settings` asks (the reference casts rays for every technique but `none`).
 pub fn render_converged(
@@ -214,12 +213,13 @@ pub fn render_converged(
     options: &ConvergenceOptions,
 ) -> Converged {
     let s = with_exact_models(settings);
-    let image = cpu::render(scene, &s, reference);
+    let frame = Frame::new(scene, &s, reference);
+    let image = frame.render_selected(&s, None);
     // The floor of `sunshade diff`, from the starting image's peak (refinement moves the peak by far less than
     // the 1% the floor is of it).
     let floor = default_floor(&image);
     let moving: Vec<bool> = image.pixels().iter().map(|p| p[3] > 0.0).collect();
-    refine(scene, s, reference, (options, Criterion::TRUTH), (image, moving), floor)
+    refine(&frame, s, (options, Criterion::TRUTH), (image, moving), floor)
 }
 
 /// When a pixel counts as converged: two doublings in a row each changed it by less than `change_fraction` of the
@@ -253,13 +253,12 @@ pub fn with_exact_models(settings: &RenderSettings) -> RenderSettings {
 }
 
 /// The refinement of [`render_converged`] for the pixels flagged in `moving` alone: `image` holds their values at
-/// the grids of `s` (exact light models, [`with_exact_models`]), the other pixels whatever the caller put there
-/// (left as they are); `floor` is the diff's floor of the image they belong to \[W/(m²·sr)\]. `--tolerance` refines
-/// this way the pixels no bound covers.
+/// the grids of `s` (exact light models, [`with_exact_models`]) in `frame`'s view, the other pixels whatever the
+/// caller put there (left as they are); `floor` is the diff's floor of the image they belong to \[W/(m²·sr)\].
+/// `--tolerance` refines this way the pixels no bound covers.
 pub fn refine(
-    scene: &Scene,
+    frame: &Frame,
     mut s: RenderSettings,
-    reference: &ReferenceOptions,
     (options, criterion): (&ConvergenceOptions, Criterion),
     (mut image, mut moving): (Image, Vec<bool>),
     floor: f64,
@@ -281,7 +280,7 @@ pub fn refine(
     let mut stopped_at = vec![0u32; moving.len()];
     for k in 1..=options.max_refinements.max(1) {
         s.shading = doubled(&s.shading);
-        let finer = cpu::render_selected(scene, &s, reference, &moving);
+        let finer = frame.render_selected(&s, Some(&moving));
         result.refinements = k;
         result.last_change = 0.0;
         result.unconverged.clear();
@@ -308,7 +307,7 @@ pub fn refine(
     }
     if criterion.final_check {
         let early: Vec<bool> = stopped_at.iter().map(|&k| k > 0 && k < result.refinements).collect();
-        result.unconverged.extend(final_check(scene, &s, reference, &mut image, &early, floor, threshold));
+        result.unconverged.extend(final_check(frame, &s, &mut image, &early, floor, threshold));
     }
     result.unconverged.sort_by(|a, b| b.change.total_cmp(&a.change));
     result.image = image;

@@ -23,6 +23,7 @@ pub mod clip;
 mod cone_occluders;
 pub mod disk_costs;
 mod fragment;
+mod frame;
 pub mod interpolate;
 pub mod map_edges;
 mod occluders;
@@ -31,12 +32,15 @@ pub mod sun_costs;
 pub mod transform;
 pub mod viewport;
 
+use std::sync::OnceLock;
+
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use self::barycentric::{pixel_ndc, triangle_barycentrics};
 use self::clip::{clip_mask, clip_triangle, ClipVertex, ATTRIBUTES};
 use self::fragment::{covers, ray_frame, shade, surface_sample};
+pub use self::frame::Frame;
 use self::interpolate::Interpolator;
 pub use self::occluders::Occluders;
 use self::raster::RasterTriangle;
@@ -143,22 +147,48 @@ pub fn shadow_choice_where(scene_can_occlude: bool, settings: &RenderSettings) -
 /// The reference's shadow rays for a render: the occluders they test and the lights they shadow, both from
 /// [`shadow_choice`]'s technique (every light for rays; for maps, the lights with a map, as the GPU shadows them,
 /// also where `auto` resolved to maps).
-struct ShadowRays<'a> {
-    occluders: Occluders<'a>,
+struct ShadowRays<'o, 'a> {
+    occluders: OccludersRef<'o, 'a>,
     lights: ShadowedLights,
 }
 
-/// The render's [`ShadowRays`], or `None` where every light is unoccluded.
-fn occluders_for<'a>(scene: &'a Scene, settings: &RenderSettings) -> Option<ShadowRays<'a>> {
-    match shadow_choice(scene, settings).technique {
-        Shadows::None => None,
-        technique => Some(ShadowRays { occluders: Occluders::new(scene), lights: ShadowedLights::of(technique) }),
+/// Occluders built for one render, or borrowed from a [`Frame`] that keeps them.
+enum OccludersRef<'o, 'a> {
+    Owned(Occluders<'a>),
+    Borrowed(&'o Occluders<'a>),
+}
+
+impl<'a> std::ops::Deref for OccludersRef<'_, 'a> {
+    type Target = Occluders<'a>;
+    fn deref(&self) -> &Occluders<'a> {
+        match self {
+            Self::Owned(o) => o,
+            Self::Borrowed(o) => o,
+        }
     }
+}
+
+/// The render's [`ShadowRays`], or `None` where every light is unoccluded. The occluders are built for this render,
+/// or once in `kept` where the caller keeps them for several ([`Frame`]).
+fn occluders_for<'o, 'a>(
+    scene: &'a Scene,
+    settings: &RenderSettings,
+    kept: Option<&'o OnceLock<Occluders<'a>>>,
+) -> Option<ShadowRays<'o, 'a>> {
+    let lights = match shadow_choice(scene, settings).technique {
+        Shadows::None => return None,
+        technique => ShadowedLights::of(technique),
+    };
+    let occluders = match kept {
+        Some(kept) => OccludersRef::Borrowed(kept.get_or_init(|| Occluders::new(scene))),
+        None => OccludersRef::Owned(Occluders::new(scene)),
+    };
+    Some(ShadowRays { occluders, lights })
 }
 
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
-    let occluders = occluders_for(scene, settings);
+    let occluders = occluders_for(scene, settings, None);
     let shader = plain_shader(scene, settings, occluders.as_ref());
     render_inner(scene, settings, options, None, &shader).0
 }
@@ -168,11 +198,11 @@ pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptio
 fn plain_shader<'a>(
     scene: &'a Scene,
     settings: &'a RenderSettings,
-    rays: Option<&'a ShadowRays<'_>>,
+    rays: Option<&'a ShadowRays<'_, '_>>,
 ) -> impl Fn(&Prepared, (u32, u32), [f64; 3]) -> ([f64; 3], bool) + Sync + 'a {
     let viewer = settings.viewer();
     move |t, xy, w| {
-        (shade(scene, settings, t, xy, w, viewer, rays.map(|r| (&r.occluders as &dyn Occlusion, r.lights))), false)
+        (shade(scene, settings, t, xy, w, viewer, rays.map(|r| (&*r.occluders as &dyn Occlusion, r.lights))), false)
     }
 }
 
@@ -185,10 +215,7 @@ pub fn render_selected(
     options: &ReferenceOptions,
     selected: &[bool],
 ) -> Image {
-    assert_eq!(selected.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
-    let occluders = occluders_for(scene, settings);
-    let shader = plain_shader(scene, settings, occluders.as_ref());
-    render_inner(scene, settings, options, Some(selected), &shader).0
+    Frame::new(scene, settings, options).render_selected(settings, Some(selected))
 }
 
 /// For each pixel, the material of the surface it sees (`None` where it sees none), by the rasterization and
@@ -214,7 +241,7 @@ pub fn barycentric_sensitivity(
     radius: &(dyn Fn([glam::Vec4; 3], glam::Vec2) -> f64 + Sync),
 ) -> (Image, Image) {
     use std::sync::atomic::{AtomicU32, Ordering};
-    let occluders = occluders_for(scene, settings);
+    let occluders = occluders_for(scene, settings, None);
     let rays = occluders.as_ref();
     let viewer = settings.viewer();
     let (width, height) = (settings.width, settings.height);
@@ -222,7 +249,7 @@ pub fn barycentric_sensitivity(
     let centres: Vec<[AtomicU32; 3]> = (0..width as usize * height as usize).map(|_| Default::default()).collect();
     let shader = |t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
         let at = |w: [f64; 3]| {
-            shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (&r.occluders as &dyn Occlusion, r.lights)))
+            shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (&*r.occluders as &dyn Occlusion, r.lights)))
         };
         let centre = at(w);
         for (slot, value) in centres[(y * width + x) as usize].iter().zip(centre) {
@@ -287,7 +314,7 @@ pub fn render_with_fragile_pixels(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let occluders = occluders_for(scene, settings);
+    let occluders = occluders_for(scene, settings, None);
     let viewer = settings.viewer();
     let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
     render_inner(scene, settings, options, None, &|t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
@@ -322,11 +349,11 @@ pub fn render_with_map_edges(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let rays = occluders_for(scene, settings);
+    let rays = occluders_for(scene, settings, None);
     let reach = map_edges::MapReach::new(scene, settings);
     let viewer = settings.viewer();
     render_inner(scene, settings, options, None, &|t: &Prepared, xy: (u32, u32), w: [f64; 3]| {
-        let cast = rays.as_ref().map(|r| (&r.occluders as &dyn Occlusion, r.lights));
+        let cast = rays.as_ref().map(|r| (&*r.occluders as &dyn Occlusion, r.lights));
         let radiance = shade(scene, settings, t, xy, w, viewer, cast);
         let edge = match &rays {
             // Mapped lights: the render's technique is `map` (asked, or `auto` without ray queries).
@@ -375,6 +402,21 @@ fn render_inner(
     selected: Option<&[bool]>,
     shade_pixel: &PixelShader,
 ) -> (Image, Vec<bool>) {
+    shade_rasterized(&rasterize(scene, settings, options), selected, shade_pixel)
+}
+
+/// A frame rasterized: its triangles set up, and for each pixel the one it sees. Shading does not change it, so
+/// renders of one view with other sample grids share it ([`Frame`]).
+struct Rasterized {
+    triangles: Vec<Prepared>,
+    /// Per pixel (row-major), the index into `triangles` of the nearest triangle covering it (`u32::MAX`: none).
+    nearest: Vec<u32>,
+    width: u32,
+    height: u32,
+}
+
+/// Rasterization and visibility as the device does them (the first half of [`render_inner`]).
+fn rasterize(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Rasterized {
     let (width, height) = (settings.width, settings.height);
     let triangles = prepare(scene, settings, options);
 
@@ -410,6 +452,18 @@ fn render_inner(
             });
         }
     });
+    Rasterized { triangles, nearest, width, height }
+}
+
+/// The second half of [`render_inner`]: `shade_pixel` on each visible pixel of `rasterized` that `selected`
+/// flags (`None`: all).
+fn shade_rasterized(
+    rasterized: &Rasterized,
+    selected: Option<&[bool]>,
+    shade_pixel: &PixelShader,
+) -> (Image, Vec<bool>) {
+    let Rasterized { triangles, nearest, width, height } = rasterized;
+    let (width, height) = (*width, *height);
     // Shading, pixel by pixel: each shaded once, the pixels shared out among the threads as they go rather than
     // by bands, since the costly ones (a penumbra's, `--tolerance`'s refined pixels) gather in a few bands.
     let shaded: Vec<usize> =
@@ -420,7 +474,7 @@ fn render_inner(
         .map(|&k| {
             let (x, y) = (k as u32 % width, k as u32 / width);
             let t = &triangles[nearest[k] as usize];
-            let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, settings.height));
+            let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, height));
             shade_pixel(t, (x, y), w.to_array())
         })
         .collect();

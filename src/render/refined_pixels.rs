@@ -15,7 +15,7 @@
 //! - every covered pixel where the frame has no first draw (the sky through occluders, whose grid every pixel
 //!   casts; a sun whose cells hold too many triangles): no pixel of it is settled, and the GPU draws nothing.
 //!
-//! **How the rest are refined.** The reference renders them alone (`cpu::render_selected`) with exact light models,
+//! **How the rest are refined.** The reference renders them alone (`cpu::Frame`, rasterized once) with exact light models,
 //! the lights' visible fractions by slices where every occluder is opaque, then doubles every grid of the pixels
 //! still moving until two doublings in a row change each by less than a third of the tolerance
 //! (`accuracy::converged::refine` with `Criterion::TOLERANCE`: the converged reference's refinement, with Roache's
@@ -173,7 +173,8 @@ pub fn render(
             let start = slices_start(t).min(s.shading.shadow_samples_per_axis);
             s.shading.shadow_samples_per_axis = start;
         }
-        let first = cpu::render_selected(scene, &s, reference, &selected);
+        let frame = cpu::Frame::new(scene, &s, reference);
+        let first = frame.render_selected(&s, Some(&selected));
         for ((pixel, from), flag) in image.pixels_mut().iter_mut().zip(first.pixels()).zip(selected.iter_mut()) {
             if *flag {
                 *pixel = *from;
@@ -184,7 +185,7 @@ pub fn render(
         let count = selected.iter().filter(|&&f| f).count();
         let floor = default_floor(&image);
         let options = ConvergenceOptions { accuracy: t, max_refinements: MAX_PIXEL_REFINEMENTS };
-        let converged = refine(scene, s, reference, (&options, Criterion::TOLERANCE), (image, selected.clone()), floor);
+        let converged = refine(&frame, s, (&options, Criterion::TOLERANCE), (image, selected.clone()), floor);
         let worst = converged.unconverged.first().map_or(0.0, |u| u.change);
         prediction.add_refined_pixels(count, t, (converged.unconverged.len(), worst));
         image = converged.image;
