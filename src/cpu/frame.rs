@@ -32,14 +32,15 @@ impl<'a> Frame<'a> {
         }
     }
 
+    /// Whether `settings` has this frame's view (size and camera), which [`Frame::render_selected`] needs.
+    pub fn has_view_of(&self, settings: &RenderSettings) -> bool {
+        (settings.width, settings.height, settings.clip_from_world()) == self.view
+    }
+
     /// [`render_selected`](super::render_selected) of this view with `settings`' shading (`selected`: one flag a
     /// pixel; `None`: every pixel). Panics where `settings` has another view than the frame's: a caller's error.
     pub fn render_selected(&self, settings: &RenderSettings, selected: Option<&[bool]>) -> Image {
-        assert_eq!(
-            (settings.width, settings.height, settings.clip_from_world()),
-            self.view,
-            "a frame renders the view it was rasterized for"
-        );
+        assert!(self.has_view_of(settings), "a frame renders the view it was rasterized for");
         if let Some(flags) = selected {
             assert_eq!(flags.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
         }
