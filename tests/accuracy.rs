@@ -93,6 +93,40 @@ fn a_frame_shades_as_the_reference_renders() {
     }
 }
 
+/// A pixel refined grid after grid on one thread (`Frame::refine_pixels`, each light's walk and arcs kept from one
+/// grid to the next) gets the values the whole renders at those grids give it, bit for bit: the sky through
+/// occluders, a disk light and a low sun, all by slices, with the grids taken up and down again.
+#[test]
+fn a_pixel_refined_grid_after_grid_has_each_grids_value() {
+    for model in ["models/overcast.glb", "models/room.gltf", "models/sunset.glb"] {
+        let scene = common::load(std::path::Path::new(model));
+        let mut s = settings::resolve(&scene, 24, 18, &CameraOptions::default(), &SunOptions::default()).unwrap();
+        s.shading.shadows = Shadows::Ray;
+        s.shading.visibility_rule = VisibilityRule::Slices;
+        let reference = ReferenceOptions::default();
+        let frame = cpu::Frame::new(&scene, &s, &reference);
+        let levels: Vec<_> = [2, 3, 5, 3]
+            .map(|k| {
+                let mut g = s.clone();
+                g.shading.shadow_samples_per_axis = k;
+                g
+            })
+            .to_vec();
+        let wholes: Vec<_> = levels.iter().map(|g| frame.render_selected(g, None)).collect();
+        let pixels: Vec<usize> = (0..24 * 18).collect();
+        let refined = frame.refine_pixels(&levels, &pixels, |_, shade| [0, 1, 2, 3].map(shade));
+        let mut apart = 0;
+        for (&k, values) in pixels.iter().zip(&refined) {
+            for (level, value) in values.iter().enumerate() {
+                assert_eq!(value.map(f32::to_bits), wholes[level].pixels()[k].map(f32::to_bits), "{model}, pixel {k}");
+            }
+            apart += usize::from(values[0] != values[2]);
+        }
+        // Not vacuous: the grids move some pixels (penumbrae), so a value kept from the wrong grid would show.
+        assert!(apart > 0, "{model}: no pixel moves between 2² and 5²");
+    }
+}
+
 /// Grids that agree by chance: on overcast.glb with shadow rays, one pixel is identical on every grid from 8² to 51²
 /// (no ray meets the occluder a finer grid finds; 5.5% darker from 73² on), so it passes two doublings early. The
 /// final check (every pixel that stopped early, rendered once more with the finest grids reached) reports it, and

@@ -203,7 +203,7 @@ pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
 
 /// Renders `scene` on the CPU with exact light models, refining the sample grids from those of `settings` until
 /// converged or `options.max_refinements` doublings (see the module's text). The first doubling renders the
-/// whole image; later ones only the pixels still moving (`cpu::Frame::render_selected`), so that the cost follows the
+/// whole image; later ones only the pixels still moving (`cpu::Frame::refine_pixels`), so that the cost follows the
 /// pixels that need it. Each pixel keeps the value of the finest render it got. Shadows are as
 /// `settings` asks (the reference casts rays for every technique but `none`).
 pub fn render_converged(
@@ -260,7 +260,7 @@ pub fn refine(
     frame: &Frame,
     mut s: RenderSettings,
     (options, criterion): (&ConvergenceOptions, Criterion),
-    (mut image, mut moving): (Image, Vec<bool>),
+    (mut image, moving): (Image, Vec<bool>),
     floor: f64,
 ) -> Converged {
     let threshold = options.accuracy * criterion.change_fraction;
@@ -274,35 +274,45 @@ pub fn refine(
         unconverged: Vec::new(),
     };
     let width = image.width();
-    // Consecutive doublings each pixel has passed: it is done after two (see the module's text).
-    let mut passes = vec![0u8; moving.len()];
-    // The doubling after which each covered pixel stopped (0 while it moves).
-    let mut stopped_at = vec![0u32; moving.len()];
-    for k in 1..=options.max_refinements.max(1) {
-        s.shading = doubled(&s.shading);
-        let finer = frame.render_selected(&s, Some(&moving));
-        result.refinements = k;
-        result.last_change = 0.0;
-        result.unconverged.clear();
-        for (i, flag) in moving.iter_mut().enumerate() {
-            if !*flag {
-                continue;
-            }
-            let (old, new) = (image.pixels()[i], finer.pixels()[i]);
+    // Each pixel's doublings in turn, on one thread (`cpu::Frame::refine_pixels`): it is done after two in a row
+    // pass (see the module's text). The grids of doubling k are `levels[k - 1]`.
+    let max = options.max_refinements.max(1);
+    let levels: Vec<RenderSettings> = (0..max)
+        .scan(s.shading, |shading, _| {
+            *shading = doubled(shading);
+            Some(RenderSettings { shading: *shading, ..s.clone() })
+        })
+        .collect();
+    let pixels: Vec<usize> = (0..moving.len()).filter(|&i| moving[i]).collect();
+    let start = &image;
+    // Per pixel: its last value, the doubling it reached, that doubling's change, and whether it converged.
+    let outcomes = frame.refine_pixels(&levels, &pixels, |i, shade| {
+        let (mut value, mut passes) = (start.pixels()[i], 0u8);
+        for k in 1..=max {
+            let finer = shade(k as usize - 1);
             // The relative change as `sunshade diff` measures it (a NaN or an infinity never converges).
-            let change = pixel_difference(old, new, floor).rel;
-            image.pixels_mut()[i] = new;
-            result.last_change = result.last_change.max(change);
-            passes[i] = if change < threshold { passes[i] + 1 } else { 0 };
-            *flag = passes[i] < 2;
-            if *flag {
-                result.unconverged.push(Unconverged { x: i as u32 % width, y: i as u32 / width, change });
-            } else {
-                stopped_at[i] = k;
+            let change = pixel_difference(value, finer, floor).rel;
+            value = finer;
+            passes = if change < threshold { passes + 1 } else { 0 };
+            if passes >= 2 || k == max {
+                return (value, k, change, passes >= 2);
             }
         }
-        if result.unconverged.is_empty() {
-            break;
+        unreachable!("the last doubling returns")
+    });
+    result.refinements = outcomes.iter().map(|o| o.1).max().unwrap_or(1);
+    s = levels[result.refinements as usize - 1].clone();
+    // The doubling after which each covered pixel stopped (0 while it moves).
+    let mut stopped_at = vec![0u32; moving.len()];
+    for (&i, &(value, k, change, converged)) in pixels.iter().zip(&outcomes) {
+        image.pixels_mut()[i] = value;
+        if k == result.refinements {
+            result.last_change = result.last_change.max(change);
+        }
+        if converged {
+            stopped_at[i] = k;
+        } else {
+            result.unconverged.push(Unconverged { x: i as u32 % width, y: i as u32 / width, change });
         }
     }
     if criterion.final_check {

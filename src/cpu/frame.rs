@@ -7,10 +7,16 @@
 
 use std::sync::OnceLock;
 
-use super::{occluders_for, plain_shader, rasterize, shade_rasterized, Occluders, Rasterized, ReferenceOptions};
+use rayon::prelude::*;
+
+use super::{
+    occluders_for, plain_shader, rasterize, shade_covered, shade_rasterized, stored, Occluders, Rasterized,
+    ReferenceOptions,
+};
 use crate::film::Image;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
+use crate::shading::slice_buckets::with_pixel_cache;
 
 /// A view of `scene` rasterized once, its occluders built on the first render that casts shadow rays.
 pub struct Frame<'a> {
@@ -47,5 +53,38 @@ impl<'a> Frame<'a> {
         let rays = occluders_for(self.scene, settings, Some(&self.occluders));
         let shader = plain_shader(self.scene, settings, rays.as_ref());
         shade_rasterized(&self.rasterized, selected, &shader).0
+    }
+
+    /// `refine(k, shade)` for each of `pixels` (row-major indices), pixel by pixel across the
+    /// threads, where `shade(level)` is pixel `k` as [`Frame::render_selected`] with `levels[level]` gives it: a
+    /// pixel refined grid after grid on one thread, each light's walk and arcs kept from one grid to the next
+    /// (`shading::slice_buckets::with_pixel_cache`; the values are the same). The results in the order of `pixels`.
+    pub fn refine_pixels<T: Send>(
+        &self,
+        levels: &[RenderSettings],
+        pixels: &[usize],
+        refine: impl Fn(usize, &dyn Fn(usize) -> [f32; 4]) -> T + Sync,
+    ) -> Vec<T> {
+        for s in levels {
+            assert!(self.has_view_of(s), "a frame renders the view it was rasterized for");
+        }
+        let rays: Vec<_> = levels.iter().map(|s| occluders_for(self.scene, s, Some(&self.occluders))).collect();
+        let shaders: Vec<_> = levels.iter().zip(&rays).map(|(s, r)| plain_shader(self.scene, s, r.as_ref())).collect();
+        pixels
+            .par_iter()
+            .with_max_len(1)
+            .map(|&k| {
+                // A pixel no triangle covers stays empty, as `render_selected` leaves it.
+                let covered = self.rasterized.nearest[k] != u32::MAX;
+                let shade = |level: usize| {
+                    if covered {
+                        stored(shade_covered(&self.rasterized, k, &shaders[level]).0)
+                    } else {
+                        [0.0; 4]
+                    }
+                };
+                with_pixel_cache(|| refine(k, &shade))
+            })
+            .collect()
     }
 }

@@ -462,29 +462,35 @@ fn shade_rasterized(
     selected: Option<&[bool]>,
     shade_pixel: &PixelShader,
 ) -> (Image, Vec<bool>) {
-    let Rasterized { triangles, nearest, width, height } = rasterized;
+    let Rasterized { nearest, width, height, .. } = rasterized;
     let (width, height) = (*width, *height);
     // Shading, pixel by pixel: each shaded once, the pixels shared out among the threads as they go rather than
     // by bands, since the costly ones (a penumbra's, `--tolerance`'s refined pixels) gather in a few bands.
     let shaded: Vec<usize> =
         (0..nearest.len()).filter(|&k| nearest[k] != u32::MAX && selected.is_none_or(|m| m[k])).collect();
-    let values: Vec<([f64; 3], bool)> = shaded
-        .par_iter()
-        .with_max_len(64)
-        .map(|&k| {
-            let (x, y) = (k as u32 % width, k as u32 / width);
-            let t = &triangles[nearest[k] as usize];
-            let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, width, height));
-            shade_pixel(t, (x, y), w.to_array())
-        })
-        .collect();
+    let values: Vec<([f64; 3], bool)> =
+        shaded.par_iter().with_max_len(64).map(|&k| shade_covered(rasterized, k, shade_pixel)).collect();
     let mut image = Image::new(width, height);
     let mut mask = vec![false; (width * height) as usize];
     for (&k, (radiance, flag)) in shaded.iter().zip(values) {
         mask[k] = flag;
-        image.pixels_mut()[k] = [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0];
+        image.pixels_mut()[k] = stored(radiance);
     }
     (image, mask)
+}
+
+/// `shade_pixel` on covered pixel `k` (row-major) of `rasterized`: its triangle, position and barycentrics.
+fn shade_covered(rasterized: &Rasterized, k: usize, shade_pixel: &PixelShader) -> ([f64; 3], bool) {
+    let Rasterized { triangles, nearest, width, height } = rasterized;
+    let (x, y) = (k as u32 % width, k as u32 / width);
+    let t = &triangles[nearest[k] as usize];
+    let w = triangle_barycentrics(t.clip, pixel_ndc(x, y, *width, *height));
+    shade_pixel(t, (x, y), w.to_array())
+}
+
+/// A pixel's radiance as an image stores it (f32, alpha 1).
+fn stored(radiance: [f64; 3]) -> [f32; 4] {
+    [radiance[0] as f32, radiance[1] as f32, radiance[2] as f32, 1.0]
 }
 
 /// For each pixel, the distance \[pixels\] from its sample to the nearest edge of any triangle whose bounds

@@ -33,7 +33,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
 
-use super::slice_buckets::{midpoint_rows, RowBuckets};
+use super::slice_buckets::{keep_gathered, midpoint_rows, take_kept, RowBuckets};
 use super::visibility::{Shadowing, SliceReach};
 
 /// The slices' axis: along no direction a scene is likely built on (module text), `(√2 − 1, 1, (√5 − 1)/2)`
@@ -295,7 +295,9 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
 /// ([`RowBuckets::file`]: `frame` across the axis, `direction` a row's unit direction), and `row(i, row, buckets,
 /// blocked)` gives row `i`'s visible and unoccluded weights (`None` where the row gives nothing; `blocked` the
 /// rows' shared buffer), summed in the rows' order over those taken. `None` where the occluders cannot be sliced.
-/// (The GPU takes a light's rows in passes where one fragment cannot take them all, `gpu::slice_passes`.)
+/// Within [`with_pixel_cache`](super::slice_buckets::with_pixel_cache) the gathering of a walk is kept for the
+/// same walk at the next grid (only the filing is done again). (The GPU takes a light's rows in passes where one
+/// fragment cannot take them all, `gpu::slice_passes`.)
 pub fn sliced_rows_weights<R>(
     s: &Shadowing,
     reach: &SliceReach,
@@ -304,11 +306,18 @@ pub fn sliced_rows_weights<R>(
     taken: std::ops::Range<u32>,
     mut row: impl FnMut(usize, &R, &RowBuckets, &mut Vec<(f64, f64)>) -> Option<(f64, f64)>,
 ) -> Option<(f64, f64)> {
-    let mut buckets = RowBuckets::default();
-    if !buckets.gather(s, reach, keep) {
-        return None;
-    }
+    let mut buckets = match take_kept(reach, frame) {
+        Some(kept) => kept,
+        None => {
+            let mut fresh = RowBuckets::default();
+            if !fresh.gather(s, reach, keep) {
+                return None;
+            }
+            fresh
+        }
+    };
     if buckets.is_empty() {
+        keep_gathered(reach, frame, buckets);
         return Some((0.0, 0.0));
     }
     let rows = rows();
@@ -322,6 +331,7 @@ pub fn sliced_rows_weights<R>(
             total += w;
         }
     }
+    keep_gathered(reach, frame, buckets);
     Some((visible, total))
 }
 

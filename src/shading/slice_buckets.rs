@@ -13,6 +13,11 @@
 //! own triangles, which the exact per-row test (`sky_slices::blocked_interval`, `disk_slices`' clipped one) still
 //! decides.
 //!
+//! A point refined grid after grid (the converged reference, `--tolerance`'s refined pixels) walks the same tree
+//! with the same walk at each grid: [`with_pixel_cache`] keeps each light's gathered triangles and their arcs from
+//! one grid to the next, so that only their filing under the new rows is done again (the walk and the arcs were a
+//! third of overcast.glb's refined pixels, `perf`).
+//!
 //! The walk per row cost 42% of a sliced reference (overcast.glb at 128², 324 rows a pixel, `perf`), and grows
 //! with the rows, where this one walk does not.
 //!
@@ -96,6 +101,9 @@ pub struct RowBuckets {
     ranges: Vec<[(usize, usize); 2]>,
     /// The counting sort's next free slot a row.
     next: Vec<u32>,
+    /// Each gathered triangle's [`azimuth_arc`] in the frame `arcs_frame`, kept for the next filing in that frame.
+    arcs: Vec<Option<(f64, f64)>>,
+    arcs_frame: Option<(DVec3, DVec3)>,
 }
 
 impl RowBuckets {
@@ -104,6 +112,7 @@ impl RowBuckets {
     /// cannot be sliced. [`RowBuckets::file`] then files them under the rows.
     pub fn gather(&mut self, s: &Shadowing, walk: &SliceReach, keep: impl Fn(&[DVec3; 3]) -> bool) -> bool {
         self.triangles.clear();
+        self.arcs_frame = None;
         let origin = walk.origin;
         let triangles = &mut self.triangles;
         let gather = &mut |tri: [DVec3; 3]| {
@@ -117,8 +126,14 @@ impl RowBuckets {
 
     /// Files each gathered triangle under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair
     /// across the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
-    /// ascending in [0, 2π).
+    /// ascending in [0, 2π). The triangles' arcs are computed once a gathering and frame: filed again under other
+    /// rows (a finer grid of the same point, [`with_pixel_cache`]), only the rows' ranges are found anew.
     pub fn file(&mut self, (e1, e2): (DVec3, DVec3), rows: impl Iterator<Item = DVec3>) {
+        if self.arcs_frame != Some((e1, e2)) {
+            self.arcs.clear();
+            self.arcs.extend(self.triangles.iter().map(|tri| azimuth_arc(tri, e1, e2)));
+            self.arcs_frame = Some((e1, e2));
+        }
         self.row_angles.clear();
         self.row_angles.extend(rows.map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
         let rows = self.row_angles.len();
@@ -127,7 +142,7 @@ impl RowBuckets {
         let from = |x: f64| angles.partition_point(|&r| r < x);
         let to = |x: f64| angles.partition_point(|&r| r <= x);
         self.ranges.clear();
-        self.ranges.extend(self.triangles.iter().map(|tri| match azimuth_arc(tri, e1, e2) {
+        self.ranges.extend(self.arcs.iter().map(|&arc| match arc {
             None => [(0, rows), (0, 0)],
             Some((start, length)) => {
                 let lo = start.rem_euclid(4.0);
@@ -173,6 +188,74 @@ impl RowBuckets {
         let (a, b) = (self.start[i] as usize, self.start[i + 1] as usize);
         self.members[a..b].iter().map(|&t| &self.triangles[t as usize])
     }
+}
+
+/// What one light's walk gathered at one point: the walk ([`SliceReach`]) and the rows' frame, compared bit for bit.
+/// A point's lights differ in their walks (the sky's has no cone and no near side, the sun's a cone without a near
+/// side, a disk light's a near side), and the triangles a light keeps follow from its walk's geometry.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct GatherKey([u64; 30]);
+
+impl GatherKey {
+    /// The walk's and the frame's numbers as bits (an absent cone, near side or row as NaNs, which no present
+    /// one has).
+    fn new(r: &SliceReach, (e1, e2): (DVec3, DVec3)) -> Self {
+        let none = DVec3::splat(f64::NAN);
+        let (axis, cos, sin) = r.cone.unwrap_or((none, f64::NAN, f64::NAN));
+        let (k, b) = r.beyond.unwrap_or((none, f64::NAN));
+        let (p, m) = r.row.unwrap_or((none, none));
+        let vectors = [r.origin, r.above[0], r.above[1], axis, k, p, m, e1, e2];
+        let scalars = [cos, sin, b];
+        let mut key = [0u64; 30];
+        let numbers = vectors.iter().flat_map(|v| v.to_array()).chain(scalars);
+        for (slot, x) in key.iter_mut().zip(numbers) {
+            *slot = x.to_bits();
+        }
+        Self(key)
+    }
+}
+
+/// The most gatherings a pixel keeps (one a light: the sun, the sky, disk lights).
+const PIXEL_CACHE_ENTRIES: usize = 8;
+
+thread_local! {
+    /// The gatherings kept while a pixel is shaded at its grids in turn (`None` outside [`with_pixel_cache`]).
+    static PIXEL_CACHE: std::cell::RefCell<Option<Vec<(GatherKey, RowBuckets)>>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` (one pixel shaded at successive grids, on this thread: the refinements of `accuracy::converged`) with
+/// each light's gathering kept from one grid to the next: a finer grid of the same point walks the same tree
+/// with the same walk and keeps the same triangles with the same arcs, so only their filing under the new rows is
+/// done again. Nothing outlives `f`, so no other pixel, scene or occluders can meet what it kept.
+pub fn with_pixel_cache<T>(f: impl FnOnce() -> T) -> T {
+    let before = PIXEL_CACHE.with(|c| c.borrow_mut().replace(Vec::new()));
+    let result = f();
+    PIXEL_CACHE.with(|c| *c.borrow_mut() = before);
+    result
+}
+
+/// The gathering kept for this walk and frame, taken out of the cache (`None`: none kept, or no cache).
+pub(crate) fn take_kept(reach: &SliceReach, frame: (DVec3, DVec3)) -> Option<RowBuckets> {
+    let key = GatherKey::new(reach, frame);
+    PIXEL_CACHE.with(|c| {
+        let mut c = c.borrow_mut();
+        let entries = c.as_mut()?;
+        let i = entries.iter().position(|(k, _)| *k == key)?;
+        Some(entries.remove(i).1)
+    })
+}
+
+/// Keeps `buckets` for this walk and frame where a cache is on ([`with_pixel_cache`]), the oldest dropped past
+/// [`PIXEL_CACHE_ENTRIES`].
+pub(crate) fn keep_gathered(reach: &SliceReach, frame: (DVec3, DVec3), buckets: RowBuckets) {
+    PIXEL_CACHE.with(|c| {
+        if let Some(entries) = c.borrow_mut().as_mut() {
+            if entries.len() == PIXEL_CACHE_ENTRIES {
+                entries.remove(0);
+            }
+            entries.push((GatherKey::new(reach, frame), buckets));
+        }
+    });
 }
 
 /// The angles of `rows` midpoint rows over the whole circle \[rad\], ascending in (0, 2π).
