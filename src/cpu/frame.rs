@@ -1,9 +1,8 @@
 //! One view that the reference shades many times: the converged reference's doublings and `--tolerance`'s refined
 //! pixels render the same camera and size over and over with finer sample grids. Rasterization and visibility do
-//! not depend on the grids, nor does the occluders' BVH, so a [`Frame`] computes each once and every render of it
-//! only shades (on the BRDF chart's 45 632 triangles the BVH alone took a quarter of `--tolerance 1e-2`'s reference
-//! time, built again for each doubling). Its images are [`render`](super::render)'s and
-//! [`render_selected`](super::render_selected)'s, bit for bit.
+//! not depend on the grids, nor does the occluders' BVH (tens of milliseconds for a scene of tens of thousands of
+//! triangles), so a [`Frame`] computes each once and every render of it only shades. Its images are
+//! [`render`](super::render)'s and [`render_selected`](super::render_selected)'s, bit for bit.
 
 use std::sync::OnceLock;
 
