@@ -202,9 +202,9 @@ pub fn doubled(shading: &ShadingOptions) -> ShadingOptions {
 }
 
 /// Renders `scene` on the CPU with exact light models, refining the sample grids from those of `settings` until
-/// converged or `options.max_refinements` doublings (see the module's text). The first doubling renders the
-/// whole image; later ones only the pixels still moving (`cpu::Frame::refine_pixels`), so that the cost follows the
-/// pixels that need it. Each pixel keeps the value of the finest render it got. Shadows are as
+/// converged or `options.max_refinements` doublings (see the module's text). The starting grids render the whole
+/// image; then each pixel takes its doublings in turn until it has passed two (`cpu::Frame::refine_pixels`), so
+/// that the cost follows the pixels that need it. Each pixel keeps the value of the finest render it got. Shadows are as
 /// `settings` asks (the reference casts rays for every technique but `none`).
 pub fn render_converged(
     scene: &Scene,

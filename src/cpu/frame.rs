@@ -49,7 +49,7 @@ impl<'a> Frame<'a> {
         if let Some(flags) = selected {
             assert_eq!(flags.len(), (settings.width as usize) * (settings.height as usize), "one flag a pixel");
         }
-        let rays = occluders_for(self.scene, settings, Some(&self.occluders));
+        let rays = occluders_for(self.scene, settings, &self.occluders);
         let shader = plain_shader(self.scene, settings, rays.as_ref());
         shade_rasterized(&self.rasterized, selected, &shader).0
     }
@@ -67,7 +67,7 @@ impl<'a> Frame<'a> {
         for s in levels {
             assert!(self.has_view_of(s), "a frame renders the view it was rasterized for");
         }
-        let rays: Vec<_> = levels.iter().map(|s| occluders_for(self.scene, s, Some(&self.occluders))).collect();
+        let rays: Vec<_> = levels.iter().map(|s| occluders_for(self.scene, s, &self.occluders)).collect();
         let shaders: Vec<_> = levels.iter().zip(&rays).map(|(s, r)| plain_shader(self.scene, s, r.as_ref())).collect();
         pixels
             .par_iter()

@@ -148,47 +148,30 @@ pub fn shadow_choice_where(scene_can_occlude: bool, settings: &RenderSettings) -
 /// [`shadow_choice`]'s technique (every light for rays; for maps, the lights with a map, as the GPU shadows them,
 /// also where `auto` resolved to maps).
 struct ShadowRays<'o, 'a> {
-    occluders: OccludersRef<'o, 'a>,
+    occluders: &'o Occluders<'a>,
     lights: ShadowedLights,
 }
 
-/// Occluders built for one render, or borrowed from a [`Frame`] that keeps them.
-enum OccludersRef<'o, 'a> {
-    Owned(Occluders<'a>),
-    Borrowed(&'o Occluders<'a>),
-}
-
-impl<'a> std::ops::Deref for OccludersRef<'_, 'a> {
-    type Target = Occluders<'a>;
-    fn deref(&self) -> &Occluders<'a> {
-        match self {
-            Self::Owned(o) => o,
-            Self::Borrowed(o) => o,
-        }
-    }
-}
-
-/// The render's [`ShadowRays`], or `None` where every light is unoccluded. The occluders are built for this render,
-/// or once in `kept` where the caller keeps them for several ([`Frame`]).
+/// The render's [`ShadowRays`], or `None` where every light is unoccluded. The occluders are built in `kept` the
+/// first time a render casts rays: a render's own, or a [`Frame`]'s for all of its renders.
 fn occluders_for<'o, 'a>(
     scene: &'a Scene,
     settings: &RenderSettings,
-    kept: Option<&'o OnceLock<Occluders<'a>>>,
+    kept: &'o OnceLock<Occluders<'a>>,
 ) -> Option<ShadowRays<'o, 'a>> {
-    let lights = match shadow_choice(scene, settings).technique {
-        Shadows::None => return None,
-        technique => ShadowedLights::of(technique),
-    };
-    let occluders = match kept {
-        Some(kept) => OccludersRef::Borrowed(kept.get_or_init(|| Occluders::new(scene))),
-        None => OccludersRef::Owned(Occluders::new(scene)),
-    };
-    Some(ShadowRays { occluders, lights })
+    match shadow_choice(scene, settings).technique {
+        Shadows::None => None,
+        technique => Some(ShadowRays {
+            occluders: kept.get_or_init(|| Occluders::new(scene)),
+            lights: ShadowedLights::of(technique),
+        }),
+    }
 }
 
 /// Renders `scene` as the GPU path would, on the CPU; shadows by rays in f64 where [`shadow_choice`] says so.
 pub fn render(scene: &Scene, settings: &RenderSettings, options: &ReferenceOptions) -> Image {
-    let occluders = occluders_for(scene, settings, None);
+    let kept = OnceLock::new();
+    let occluders = occluders_for(scene, settings, &kept);
     let shader = plain_shader(scene, settings, occluders.as_ref());
     render_inner(scene, settings, options, None, &shader).0
 }
@@ -202,7 +185,7 @@ fn plain_shader<'a>(
 ) -> impl Fn(&Prepared, (u32, u32), [f64; 3]) -> ([f64; 3], bool) + Sync + 'a {
     let viewer = settings.viewer();
     move |t, xy, w| {
-        (shade(scene, settings, t, xy, w, viewer, rays.map(|r| (&*r.occluders as &dyn Occlusion, r.lights))), false)
+        (shade(scene, settings, t, xy, w, viewer, rays.map(|r| (r.occluders as &dyn Occlusion, r.lights))), false)
     }
 }
 
@@ -241,7 +224,8 @@ pub fn barycentric_sensitivity(
     radius: &(dyn Fn([glam::Vec4; 3], glam::Vec2) -> f64 + Sync),
 ) -> (Image, Image) {
     use std::sync::atomic::{AtomicU32, Ordering};
-    let occluders = occluders_for(scene, settings, None);
+    let kept = OnceLock::new();
+    let occluders = occluders_for(scene, settings, &kept);
     let rays = occluders.as_ref();
     let viewer = settings.viewer();
     let (width, height) = (settings.width, settings.height);
@@ -249,7 +233,7 @@ pub fn barycentric_sensitivity(
     let centres: Vec<[AtomicU32; 3]> = (0..width as usize * height as usize).map(|_| Default::default()).collect();
     let shader = |t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
         let at = |w: [f64; 3]| {
-            shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (&*r.occluders as &dyn Occlusion, r.lights)))
+            shade(scene, settings, t, (x, y), w, viewer, rays.map(|r| (r.occluders as &dyn Occlusion, r.lights)))
         };
         let centre = at(w);
         for (slot, value) in centres[(y * width + x) as usize].iter().zip(centre) {
@@ -314,7 +298,8 @@ pub fn render_with_fragile_pixels(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let occluders = occluders_for(scene, settings, None);
+    let kept = OnceLock::new();
+    let occluders = occluders_for(scene, settings, &kept);
     let viewer = settings.viewer();
     let eps = scene.bounds().map_or(0.0, |b| b.min.abs().max(b.max.abs()).max_element()) * FRAGILE_RAY_RELATIVE;
     render_inner(scene, settings, options, None, &|t: &Prepared, (x, y): (u32, u32), w: [f64; 3]| {
@@ -322,7 +307,7 @@ pub fn render_with_fragile_pixels(
         let radiance = match &occluders {
             Some(rays) => {
                 let rec =
-                    Recording { occluders: &rays.occluders, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
+                    Recording { occluders: rays.occluders, eps, fragile: std::sync::atomic::AtomicBool::new(false) };
                 let r = shade(scene, settings, t, (x, y), w, viewer, Some((&rec, rays.lights)));
                 flagged = rec.fragile.load(std::sync::atomic::Ordering::Relaxed);
                 r
@@ -349,17 +334,18 @@ pub fn render_with_map_edges(
     settings: &RenderSettings,
     options: &ReferenceOptions,
 ) -> (Image, Vec<bool>) {
-    let rays = occluders_for(scene, settings, None);
+    let kept = OnceLock::new();
+    let rays = occluders_for(scene, settings, &kept);
     let reach = map_edges::MapReach::new(scene, settings);
     let viewer = settings.viewer();
     render_inner(scene, settings, options, None, &|t: &Prepared, xy: (u32, u32), w: [f64; 3]| {
-        let cast = rays.as_ref().map(|r| (&*r.occluders as &dyn Occlusion, r.lights));
+        let cast = rays.as_ref().map(|r| (r.occluders as &dyn Occlusion, r.lights));
         let radiance = shade(scene, settings, t, xy, w, viewer, cast);
         let edge = match &rays {
             // Mapped lights: the render's technique is `map` (asked, or `auto` without ray queries).
             Some(r) if r.lights == ShadowedLights::MAPPED => {
                 let f = ray_frame(t, w);
-                reach.is_edge(&r.occluders, f.origin, f.face, f.position, f.normal)
+                reach.is_edge(r.occluders, f.origin, f.face, f.position, f.normal)
             }
             _ => false,
         };

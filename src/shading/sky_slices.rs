@@ -297,10 +297,11 @@ pub fn rows_fraction(visible: f64, total: f64) -> f64 {
 }
 
 /// The rows `taken` of a light's rows, the part the sky's, the sun's and disk lights' slices share: one walk within
-/// `reach` gathers the triangles `keep` keeps (a light's own test of a whole triangle, [`RowBuckets::gather`]);
+/// `reach` gathers the triangles `keep` keeps (a light's own test of a whole triangle, [`RowBuckets::gather`], with
+/// their arcs in `frame` across the axis);
 /// where it keeps none, `(0, 0)` at once, before any row is made (every row clear, whichever rows are taken: the
 /// fraction is 1, [`rows_fraction`]). Otherwise `rows()` makes the rows, each filed with its triangles
-/// ([`RowBuckets::file`]: `frame` across the axis, `direction` a row's unit direction), and `row(i, row, buckets,
+/// ([`RowBuckets::file`]: `direction` a row's unit direction), and `row(i, row, buckets,
 /// blocked)` gives row `i`'s visible and unoccluded weights (`None` where the row gives nothing; `blocked` the
 /// rows' shared buffer), summed in the rows' order over those taken. `None` where the occluders cannot be sliced.
 /// Within [`with_pixel_cache`](super::slice_buckets::with_pixel_cache) the gathering of a walk is kept for the
@@ -318,7 +319,7 @@ pub fn sliced_rows_weights<R>(
         Some(kept) => kept,
         None => {
             let mut fresh = RowBuckets::default();
-            if !fresh.gather(s, reach, keep) {
+            if !fresh.gather(s, reach, frame, keep) {
                 return None;
             }
             fresh
@@ -329,7 +330,7 @@ pub fn sliced_rows_weights<R>(
         return Some((0.0, 0.0));
     }
     let rows = rows();
-    buckets.file(frame, rows.iter().map(direction));
+    buckets.file(rows.iter().map(direction));
     let (mut visible, mut total) = (0.0, 0.0);
     let mut blocked = Vec::new();
     let taken = taken.start as usize..taken.end as usize;

@@ -100,18 +100,26 @@ pub struct RowBuckets {
     ranges: Vec<[(usize, usize); 2]>,
     /// The counting sort's next free slot a row.
     next: Vec<u32>,
-    /// Each gathered triangle's [`azimuth_arc`] in the frame `arcs_frame`, kept for the next filing in that frame.
+    /// The frame `(e1, e2)` across the axis, and each gathered triangle's [`azimuth_arc`] in it: found once a
+    /// gathering, whatever rows it is filed under.
+    frame: (DVec3, DVec3),
     arcs: Vec<Option<(f64, f64)>>,
-    arcs_frame: Option<(DVec3, DVec3)>,
 }
 
 impl RowBuckets {
     /// Gathers the triangles of one walk within `walk` (the slices' half-spaces, cone and near side) that `keep`
-    /// keeps (a light's own test of a whole triangle, once rather than once a row). False where the occluders
-    /// cannot be sliced. [`RowBuckets::file`] then files them under the rows.
-    pub fn gather(&mut self, s: &Shadowing, walk: &SliceReach, keep: impl Fn(&[DVec3; 3]) -> bool) -> bool {
+    /// keeps (a light's own test of a whole triangle, once rather than once a row), with their arcs about the axis
+    /// in `frame` (`(e1, e2)`, an orthonormal pair across the axis). False where the occluders cannot be sliced.
+    /// [`RowBuckets::file`] then files them under the rows, as often as a finer grid of the same point asks
+    /// ([`with_pixel_cache`]).
+    pub fn gather(
+        &mut self,
+        s: &Shadowing,
+        walk: &SliceReach,
+        frame: (DVec3, DVec3),
+        keep: impl Fn(&[DVec3; 3]) -> bool,
+    ) -> bool {
         self.triangles.clear();
-        self.arcs_frame = None;
         let origin = walk.origin;
         let triangles = &mut self.triangles;
         let gather = &mut |tri: [DVec3; 3]| {
@@ -120,19 +128,17 @@ impl RowBuckets {
                 triangles.push(tri);
             }
         };
-        s.occluders.slice_triangles(walk, gather)
+        let sliced = s.occluders.slice_triangles(walk, gather);
+        self.frame = frame;
+        self.arcs.clear();
+        self.arcs.extend(self.triangles.iter().map(|tri| azimuth_arc(tri, frame.0, frame.1)));
+        sliced
     }
 
-    /// Files each gathered triangle under the rows inside its arc about the axis, `(e1, e2)` an orthonormal pair
-    /// across the axis and `rows` the rows' unit directions `p` across it, their azimuths from `e1` towards `e2`
-    /// ascending in [0, 2π). The triangles' arcs are computed once a gathering and frame: filed again under other
-    /// rows (a finer grid of the same point, [`with_pixel_cache`]), only the rows' ranges are found anew.
-    pub fn file(&mut self, (e1, e2): (DVec3, DVec3), rows: impl Iterator<Item = DVec3>) {
-        if self.arcs_frame != Some((e1, e2)) {
-            self.arcs.clear();
-            self.arcs.extend(self.triangles.iter().map(|tri| azimuth_arc(tri, e1, e2)));
-            self.arcs_frame = Some((e1, e2));
-        }
+    /// Files each gathered triangle under the rows inside its arc about the axis, `rows` the rows' unit directions
+    /// `p` across it, their azimuths in the gathering's frame from `e1` towards `e2` ascending in [0, 2π).
+    pub fn file(&mut self, rows: impl Iterator<Item = DVec3>) {
+        let (e1, e2) = self.frame;
         self.row_angles.clear();
         self.row_angles.extend(rows.map(|p| diamond_angle(p.dot(e1), p.dot(e2))));
         let rows = self.row_angles.len();
@@ -235,10 +241,10 @@ pub fn with_pixel_cache<T>(f: impl FnOnce() -> T) -> T {
 
 /// The gathering kept for this walk and frame, taken out of the cache (`None`: none kept, or no cache).
 pub(crate) fn take_kept(reach: &SliceReach, frame: (DVec3, DVec3)) -> Option<RowBuckets> {
-    let key = GatherKey::new(reach, frame);
     PIXEL_CACHE.with(|c| {
         let mut c = c.borrow_mut();
         let entries = c.as_mut()?;
+        let key = GatherKey::new(reach, frame);
         let i = entries.iter().position(|(k, _)| *k == key)?;
         Some(entries.remove(i).1)
     })
