@@ -541,7 +541,19 @@ fn variant_sizes_stay_within_their_budgets() {
         let spirv = sunshade_glsl::instruction_count(&words).unwrap();
         println!("{n:>6} of {:>6} instructions inlined ({spirv:>6} SPIR-V): {}", p.budget, p.name);
         if n > p.budget {
-            over.push(format!("{}: {n} instructions inlined, over its budget of {}", p.name, p.budget));
+            // The largest shares, so that the message says where the growth may be.
+            let largest: Vec<String> = sunshade_glsl::inlined_profile(&words)
+                .unwrap()
+                .iter()
+                .take(5)
+                .map(|f| format!("{} ({} × {})", f.name.split('(').next().unwrap_or(&f.name), f.own, f.copies))
+                .collect();
+            over.push(format!(
+                "{}: {n} instructions inlined, over its budget of {}; largest shares (own × copies): {}",
+                p.name,
+                p.budget,
+                largest.join(", ")
+            ));
         }
     }
     assert!(

@@ -283,6 +283,17 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
                 p.inlined,
                 p.time.as_secs_f64() * 1e3
             );
+            if !p.largest.is_empty() {
+                let shares: Vec<String> = p
+                    .largest
+                    .iter()
+                    .map(|f| format!("{} {} × {}", f.name.split('(').next().unwrap_or(&f.name), f.own, f.copies))
+                    .collect();
+                eprintln!(
+                    "sunshade:   its largest functions inlined (own instructions × copies): {}",
+                    shares.join(", ")
+                );
+            }
         }
         match (&cache_dir, renderer.pipeline_cache_loaded_bytes()) {
             (None, _) => eprintln!("sunshade: pipeline cache: off"),

@@ -34,8 +34,14 @@ pub struct CreatedPipeline {
     pub what: String,
     pub instructions: usize,
     pub inlined: usize,
+    /// The fragment stage's functions with the largest shares of `inlined` (`sunshade_glsl::inlined_profile`), the
+    /// first [`LARGEST_SHARES`].
+    pub largest: Vec<sunshade_glsl::InlinedFunction>,
     pub time: std::time::Duration,
 }
+
+/// How many of a pipeline's largest functions [`CreatedPipeline`] keeps (`render -v` prints them).
+pub const LARGEST_SHARES: usize = 4;
 
 pub(crate) struct ScenePipeline {
     dev: Arc<Device>,
@@ -408,7 +414,7 @@ unsafe fn create_pipeline(
 ) -> Result<(vk::Pipeline, CreatedPipeline), GpuError> {
     let started = std::time::Instant::now();
     let constants = variant.map_or([0; VARIANT_CONSTANTS], |v| v.constants());
-    let (mut instructions, mut inlined) = (0, 0);
+    let (mut instructions, mut inlined, mut largest) = (0, 0, Vec::new());
     let module = match fs {
         Some(words) => {
             let specialized;
@@ -420,7 +426,10 @@ unsafe fn create_pipeline(
                 &specialized[..]
             };
             instructions = sunshade_glsl::instruction_count(code).map_err(GpuError::ShaderCompile)?;
-            inlined = sunshade_glsl::inlined_instruction_count(code).map_err(GpuError::ShaderCompile)?;
+            let mut profile = sunshade_glsl::inlined_profile(code).map_err(GpuError::ShaderCompile)?;
+            inlined = profile.iter().map(sunshade_glsl::InlinedFunction::inlined).sum();
+            profile.truncate(LARGEST_SHARES);
+            largest = profile;
             // SAFETY: valid device; SPIR-V built by build.rs, specialized (spirv-val checks both in tests).
             unsafe { d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None) }
                 .vk("vkCreateShaderModule")?
@@ -432,7 +441,7 @@ unsafe fn create_pipeline(
     unsafe {
         let pipeline = create_pipeline_from(d, cache, layout, (vs, module), with_normals, &constants, depth_only);
         d.destroy_shader_module(module, None);
-        let made = CreatedPipeline { what: String::new(), instructions, inlined, time: started.elapsed() };
+        let made = CreatedPipeline { what: String::new(), instructions, inlined, largest, time: started.elapsed() };
         pipeline.map(|p| (p, made))
     }
 }

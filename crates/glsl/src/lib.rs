@@ -41,8 +41,10 @@ pub fn compile(name: &str, sources: &[(&str, &str)], defines: &[&str]) -> Result
     Ok(artifact.as_binary().to_vec())
 }
 
+pub mod inlined;
 pub mod specialize;
-pub use specialize::{inlined_instruction_count, instruction_count, specialize};
+pub use inlined::{inlined_instruction_count, inlined_profile, InlinedFunction};
+pub use specialize::{instruction_count, specialize};
 
 /// Runs Debian's `spirv-val` (package spirv-tools, installed by sunshade's `make setup`) on a module with Vulkan
 /// 1.3's rules: `Err` holds its message, or says that the tool is missing. For tests.

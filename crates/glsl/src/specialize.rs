@@ -26,9 +26,9 @@
 use std::collections::{HashMap, HashSet};
 
 const OP_UNDEF: u16 = 1;
-const OP_NAME: u16 = 5;
-const OP_LINE: u16 = 8;
-const OP_NO_LINE: u16 = 317;
+pub(crate) const OP_NAME: u16 = 5;
+pub(crate) const OP_LINE: u16 = 8;
+pub(crate) const OP_NO_LINE: u16 = 317;
 const OP_DECORATE: u16 = 71;
 const OP_DECORATE_ID: u16 = 332;
 const OP_DECORATE_STRING: u16 = 5632;
@@ -41,13 +41,13 @@ const OP_SPEC_CONSTANT_TRUE: u16 = 48;
 const OP_SPEC_CONSTANT_FALSE: u16 = 49;
 const OP_SPEC_CONSTANT: u16 = 50;
 const OP_SPEC_CONSTANT_OP: u16 = 52;
-const OP_FUNCTION: u16 = 54;
-const OP_FUNCTION_END: u16 = 56;
-const OP_FUNCTION_CALL: u16 = 57;
+pub(crate) const OP_FUNCTION: u16 = 54;
+pub(crate) const OP_FUNCTION_END: u16 = 56;
+pub(crate) const OP_FUNCTION_CALL: u16 = 57;
 const OP_VARIABLE: u16 = 59;
 const OP_LOAD: u16 = 61;
 const OP_STORE: u16 = 62;
-const OP_ENTRY_POINT: u16 = 15;
+pub(crate) const OP_ENTRY_POINT: u16 = 15;
 const OP_EXTENSION: u16 = 10;
 const OP_CAPABILITY: u16 = 17;
 const OP_EXECUTION_MODE: u16 = 16;
@@ -105,12 +105,12 @@ const NO_RESULT: &[u16] = &[
 
 /// One instruction: its opcode and its words (the first word included).
 #[derive(Clone, Copy)]
-struct Inst<'a> {
-    op: u16,
-    words: &'a [u32],
+pub(crate) struct Inst<'a> {
+    pub(crate) op: u16,
+    pub(crate) words: &'a [u32],
 }
 
-fn instructions(words: &[u32]) -> Result<Vec<Inst<'_>>, String> {
+pub(crate) fn instructions(words: &[u32]) -> Result<Vec<Inst<'_>>, String> {
     if words.len() < 5 || words[0] != 0x0723_0203 {
         return Err("not a SPIR-V module (magic number missing)".into());
     }
@@ -139,58 +139,6 @@ fn instructions_from(words: &[u32], first: usize) -> Result<Vec<Inst<'_>>, Strin
 /// The number of instructions in a SPIR-V module (what [`specialize`] leaves is measured with it).
 pub fn instruction_count(words: &[u32]) -> Result<usize, String> {
     instructions(words).map(|v| v.len())
-}
-
-/// The instructions of a module's entry points' functions with every call replaced by the callee's body, as a driver
-/// that inlines all calls (lavapipe) first sees them: each function's own body counts once per call of it. Names,
-/// `OpLine`s and the module's declarations do not count. What a pipeline's creation on lavapipe grows with
-/// (docs/platform.md, "What the driver compiles").
-pub fn inlined_instruction_count(words: &[u32]) -> Result<usize, String> {
-    let insts = instructions(words)?;
-    let mut own: HashMap<u32, (usize, Vec<u32>)> = HashMap::new();
-    let mut current = None;
-    for i in &insts {
-        match i.op {
-            OP_FUNCTION => current = Some(i.words[2]),
-            OP_FUNCTION_END => current = None,
-            OP_NAME | OP_LINE | OP_NO_LINE => {}
-            op => {
-                if let Some(f) = current {
-                    let entry = own.entry(f).or_default();
-                    entry.0 += 1;
-                    if op == OP_FUNCTION_CALL {
-                        entry.1.push(i.words[3]);
-                    }
-                }
-            }
-        }
-    }
-    // Depth first from the entry points; SPIR-V forbids recursion, and a call cycle is refused rather than followed.
-    fn total(
-        f: u32,
-        own: &HashMap<u32, (usize, Vec<u32>)>,
-        memo: &mut HashMap<u32, Option<usize>>,
-    ) -> Result<usize, String> {
-        match memo.get(&f) {
-            Some(Some(n)) => return Ok(*n),
-            Some(None) => return Err(format!("malformed SPIR-V: function %{f} calls itself")),
-            None => {}
-        }
-        memo.insert(f, None);
-        let (count, calls) = own.get(&f).ok_or_else(|| format!("malformed SPIR-V: no function %{f}"))?;
-        let mut n = *count;
-        for c in calls {
-            n += total(*c, own, memo)?;
-        }
-        memo.insert(f, Some(n));
-        Ok(n)
-    }
-    let mut memo = HashMap::new();
-    let mut sum = 0;
-    for i in insts.iter().filter(|i| i.op == OP_ENTRY_POINT) {
-        sum += total(i.words[2], &own, &mut memo)?;
-    }
-    Ok(sum)
 }
 
 /// A function's block: where its instructions start (the `OpLabel`) and end (one past the terminator).
@@ -829,18 +777,6 @@ void main() {
         assert_eq!(evaluate_partly(169, &[Some(0), None, Some(4)]), Some(4));
         assert_eq!(evaluate_partly(169, &[Some(1), None, Some(4)]), None);
         assert_eq!(evaluate_partly(170, &[None, Some(4)]), None);
-    }
-
-    #[test]
-    fn the_inlined_count_takes_a_function_once_a_call() {
-        let words = module();
-        let count = |w: &[u32]| inlined_instruction_count(w).unwrap();
-        // MODE 0: light; 1: heavy; 2: light, and heavy in a loop. heavy's body (a loop of sines) is larger than
-        // light's one multiplication.
-        let [light, heavy, both] = [0, 1, 2].map(|mode| specialize(&words, &[(0, mode), (1, 0)]).unwrap());
-        assert!(count(&both) > count(&heavy) && count(&heavy) > count(&light));
-        assert!(count(&light) < instruction_count(&light).unwrap());
-        assert!(inlined_instruction_count(&[1, 2, 3]).is_err());
     }
 
     #[test]
