@@ -204,6 +204,12 @@ MaterialGpu material_at(uint m) {
     return g;
 }
 
+// Material m's kind alone (MaterialGpu::kind: its fourth texel), for a test that needs no more of it: each call of
+// material_at compiles its twenty fetches.
+uvec4 material_kind_at(uint m) {
+    return texelFetch(material_texels, int(MATERIAL_TEXELS * m) + 3);
+}
+
 layout(std430, set = 0, binding = 1) readonly buffer LightBuffer {
     SunGpu sun;
     vec4 sky;     // rgb: overcast sky radiance [W/(m^2 sr)]; w: 1 if present

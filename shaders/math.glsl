@@ -30,16 +30,17 @@ float atan_accurate(float x) {
     return x < 0.0 ? -r : r;
 }
 
-// atan2(y, x) in (-pi, pi] from atan_accurate; 0 for (0, 0).
+// atan2(y, x) in (-pi, pi] from atan_accurate; 0 for (0, 0). atan_accurate is called once, on y/x or x/y (the
+// smaller over the larger), as the driver inlines each call: a call in each branch would compile it twice.
 float atan2_accurate(float y, float x) {
     if (x == 0.0 && y == 0.0) {
         return 0.0;
     }
-    if (abs(x) >= abs(y)) {
-        float r = atan_accurate(y / x);
+    bool by_x = abs(x) >= abs(y);
+    float r = atan_accurate(by_x ? y / x : x / y);
+    if (by_x) {
         return x > 0.0 ? r : (y >= 0.0 ? r + PI : r - PI);
     }
-    float r = atan_accurate(x / y);
     return y > 0.0 ? HALF_PI - r : -HALF_PI - r;
 }
 
@@ -104,10 +105,21 @@ float exp_minus_one(float x) {
 }
 
 // asinh(x) without cancellation: sign(x) log1p(|x| + x^2 / (1 + sqrt(1 + x^2))) (the device's asinh goes through
-// log(x + sqrt(x^2 + 1)), which loses the digits of small x); ln(2|x|) where x^2 would overflow.
+// log(x + sqrt(x^2 + 1)), which loses the digits of small x); ln(2|x|) where x^2 would overflow. log1p_accurate's
+// steps written out, so that both branches take their logarithm from one call of log_accurate (the driver inlines
+// each call): the same operations on the same values.
 float asinh_accurate(float x) {
     float a = abs(x);
-    float r = a > 1e18 ? log_accurate(a) + 0.69314718055994530942 : log1p_accurate(a + a * a / (1.0 + sqrt(1.0 + a * a)));
+    bool huge = a > 1e18;
+    float t = a + a * a / (1.0 + sqrt(1.0 + a * a));
+#ifdef SUNSHADE_NAIVE_MATH
+    float r = huge ? log_accurate(a) + 0.69314718055994530942 : log1p_accurate(t);
+#else
+    precise float u = 1.0 + t;
+    precise float um1 = u - 1.0;
+    float ln = log_accurate(huge ? a : u);
+    float r = huge ? ln + 0.69314718055994530942 : (u == 1.0 ? t : ln * t / um1);
+#endif
     return x < 0.0 ? -r : r;
 }
 

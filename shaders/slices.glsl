@@ -243,7 +243,7 @@ bool within_reach(BvhNode node, SliceReach r) {
 #define GATHER_LEAF(leaf) \
     { \
         uvec4 tri = WALK_RECORD((leaf).first); \
-        if (material_at(tri.w & 0x7fffffffu).kind.z != 0u) { \
+        if (material_kind_at(tri.w & 0x7fffffffu).z != 0u) { \
             return -1; \
         } \
         if (count >= MAX_SLICE_TRIANGLES) { \
@@ -692,7 +692,7 @@ uint row_leaves[MAX_SLICE_TRIANGLES];
 #define SKY_ROW_LEAF(w) \
     if (!hidden && (w) < leaves) { \
         uvec4 tri = WALK_RECORD(row_leaves[w]); \
-        if (material_at(tri.w & 0x7fffffffu).kind.z != 0u) { \
+        if (material_kind_at(tri.w & 0x7fffffffu).z != 0u) { \
             return vec2(SLICES_UNSLICEABLE, 0.0); \
         } \
         vec2 e0; \

@@ -109,6 +109,19 @@ uvec2 sun_cell_range(vec3 origin) {
     return uvec2(start, lo);
 }
 
+// The shaded point's entries above it: sun_cell_range of its shadow rays' origin, found once a pixel by
+// sun_cells_at before the functions below read it (they are only asked about that origin). The driver inlines
+// every call, so a bisection in each of them compiled it once a caller (six times in a glTF variant).
+uvec2 sun_cell_range_here = uvec2(0u);
+
+// Finds sun_cell_range_here for the shaded point's shadow-ray origin (sun_irradiance_visible, before any other of
+// the sun's terms asks).
+void sun_cells_at(vec3 origin) {
+    if (VARIANT_SUN_CELLS != SUN_CELLS_NONE) {
+        sun_cell_range_here = sun_cell_range(origin);
+    }
+}
+
 // What the cell's triangles above `origin` do to the sun's cone (direction l, half-angle asin(sin_sigma)) from it
 // on a surface of normal n: SUN_CONE_COVERED where one opaque triangle holds it (an alpha-masked one may let light
 // through), MISSES where all miss its rays above the surface's horizon, PARTIAL otherwise; SUN_CONE_UNKNOWN where
@@ -118,16 +131,9 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
     if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
         return SUN_CONE_UNKNOWN;
     }
-    // Partial cells need the count of the entries above the point (sun_cell_range's bisection); complete ones
-    // scan the cell's entries from its highest and stop at the first at or below the point's depth, the same
-    // entries in the same order without the bisection's loop.
-    uvec2 range = uvec2(0u);
-    if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL) {
-        range = sun_cell_range(origin);
-    } else {
-        uint c = sun_cell_of(origin);
-        range = c == NO_SUN_CELL ? uvec2(0u) : uvec2(SUN_CELL_START(c), SUN_CELL_START(c + 1u));
-    }
+    // The entries above the point (sun_cell_range_here): the scan's stop at the first at or below its depth then
+    // never comes early.
+    uvec2 range = sun_cell_range_here;
     if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_CLASSIFIED) {
         return SUN_CONE_UNKNOWN;
     }
@@ -141,7 +147,7 @@ uint sun_cone_class(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
         }
         uint cls = sun_triangle_class(origin, n, l, sin_sigma, c0_top.xyz, SUN_CELL_VEC4(i, 1u).xyz,
                                       SUN_CELL_VEC4(i, 2u).xyz);
-        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || material_at(SUN_CELL_RECORD(i).w & 0x7fffffffu).kind.z == 0u;
+        bool opaque = VARIANT_OCCLUDERS_MASKED == 0u || material_kind_at(SUN_CELL_RECORD(i).w & 0x7fffffffu).z == 0u;
         if (cls == SUN_CONE_COVERED && opaque) {
             return SUN_CONE_COVERED;
         }
@@ -240,7 +246,7 @@ void sun_list_bins(vec3 origin, vec3 l, float sin_sigma) {
 // with the same answers as the whole range (sun_cells_occluded; a ray leaving below takes the whole range). Leaves
 // sun_listed_valid false where they are more than MAX_SUN_LISTED.
 void sun_cone_list(vec3 origin, vec3 n, vec3 l, float sin_sigma) {
-    uvec2 range = sun_cell_range(origin);
+    uvec2 range = sun_cell_range_here;
     uint count = 0u;
     bool fits = true;
     for (uint i = range.x; i < range.y && fits; ++i) {
@@ -268,7 +274,7 @@ bool sun_cells_classify(vec3 origin) {
     if (VARIANT_SUN_CELLS == SUN_CELLS_NONE) {
         return false;
     }
-    uvec2 range = sun_cell_range(origin);
+    uvec2 range = sun_cell_range_here;
     return range.y - range.x <= MAX_SUN_CELL_CLASSIFIED;
 }
 
@@ -278,7 +284,7 @@ bool sun_cells_usable(vec3 origin) {
     if (VARIANT_SUN_CELLS != SUN_CELLS_PARTIAL) {
         return VARIANT_SUN_CELLS == SUN_CELLS_COMPLETE;
     }
-    uvec2 range = sun_cell_range(origin);
+    uvec2 range = sun_cell_range_here;
     return range.y - range.x <= MAX_SUN_CELL_TRIANGLES;
 }
 
@@ -295,7 +301,7 @@ bool sun_cells_occluded(vec3 origin, vec3 n, vec3 direction) {
     WatertightRay r = watertight_ray(origin, direction);
     bool leaves_above = dot(n, direction) > 0.0;
     bool listed = sun_listed_valid && leaves_above;
-    uvec2 range = listed ? uvec2(0u, sun_listed_count) : sun_cell_range(origin);
+    uvec2 range = listed ? uvec2(0u, sun_listed_count) : sun_cell_range_here;
     if (VARIANT_SUN_CELLS == SUN_CELLS_PARTIAL && range.y - range.x > MAX_SUN_CELL_TRIANGLES) {
         // A point past its cell's bound whose list serves only the rays above its horizon: this one takes the
         // traversal, as all its rays would without the list.

@@ -281,6 +281,18 @@ const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
     ),
     ("ray_triangle.glsl", "watertight_ray", "the Rust's `WatertightRay::new`: GLSL has no methods"),
     (
+        "lights/sun.glsl",
+        "sun_disk_factor",
+        "sun_irradiance_disk over E⊥, found once a pixel and reused by the specular term's projected solid angle, as \
+         the driver inlines each call; the Rust calls sun_irradiance_disk for both",
+    ),
+    (
+        "sun_cells.glsl",
+        "sun_cells_at",
+        "the shaded point's sun_cell_range, found once a pixel for every function that reads it, as the driver \
+         inlines each call; the Rust calls sun_cell_range where it is used",
+    ),
+    (
         "surface.glsl",
         "surface_texels",
         "a draw's textures looked up by one call in a loop, as the driver inlines each call; the Rust looks each up \

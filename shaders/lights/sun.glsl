@@ -30,16 +30,18 @@ float atan_minus_identity(float t) {
     return sum * t2 * t;
 }
 
-// Irradiance [W/m^2] from the sun as a disk of angular diameter `angular_diameter`, exact also while it sets
-// (see the Rust for the derivation and the rewriting that avoids the cancellation of two terms of ~1/sigma).
-vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_diameter) {
+// The disk sun's irradiance over its normal irradiance E_perp (angular diameter `angular_diameter`, the angle theta
+// from the normal): cos theta while the whole disk is above the horizon, 0 below, the cap's share while it sets
+// (see the Rust's sun_irradiance_disk for the derivation and the rewriting that avoids the cancellation of two
+// terms of ~1/sigma).
+float sun_disk_factor(float cos_theta, float angular_diameter) {
     float s = sin(0.5 * angular_diameter);
     float c = cos(0.5 * angular_diameter);
     if (cos_theta >= s) {
-        return irradiance_normal * cos_theta;
+        return cos_theta;
     }
     if (cos_theta <= -s) {
-        return vec3(0.0);
+        return 0.0;
     }
     float sin_theta = sqrt((1.0 - cos_theta) * (1.0 + cos_theta));
     float k = clamp((c * cos_theta) / (s * sin_theta), -1.0, 1.0);
@@ -47,13 +49,18 @@ vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_
     float pi_minus_phi0 = atan2_accurate(sin_phi0, -k);
     float t = s * sin_theta * sin_phi0 / c;
     float projected = s * s * (cos_theta * pi_minus_phi0 + t) + atan_minus_identity(t);
-    return irradiance_normal * (projected / (PI * s * s));
+    return projected / (PI * s * s);
+}
+
+// Irradiance [W/m^2] from the sun as a disk of angular diameter `angular_diameter`, exact also while it sets.
+vec3 sun_irradiance_disk(vec3 irradiance_normal, float cos_theta, float angular_diameter) {
+    return irradiance_normal * sun_disk_factor(cos_theta, angular_diameter);
 }
 
 // The projected solid angle [sr] of the sun's cap above the horizon: pi sin^2(delta/2) E / E_perp.
 float sun_projected_solid_angle_above(float n_dot_l, float angular_diameter) {
     float s = sin(0.5 * angular_diameter);
-    return PI * s * s * sun_irradiance_disk(vec3(1.0), n_dot_l, angular_diameter).x;
+    return PI * s * s * sun_disk_factor(n_dot_l, angular_diameter);
 }
 
 // The cosine-weighted visible fraction of the sun's disk (direction l, angular diameter [rad]). Where the frame
@@ -86,6 +93,10 @@ float sun_visible_fraction(vec3 origin, uint k, vec3 n, vec3 l, float angular_di
     return grid_fraction(origin, k, L);
 }
 
+// The disk sun's sun_disk_factor at the shaded point, found by sun_irradiance_visible and reused by
+// sun_specular_visible for the cap's projected solid angle (sun_projected_solid_angle_above: pi sin^2(delta/2)
+// times it), so that the driver, which inlines every call, compiles the formula once.
+float sun_disk_factor_here = 0.0;
 // The sun's visible fraction from the shadow rays' located grid, found by sun_irradiance_visible: the specular
 // term casts its lobe samples' rays only where it is strictly between 0 and 1 (see sun_specular_visible).
 float sun_ray_fraction = 1.0;
@@ -104,10 +115,15 @@ vec3 sun_irradiance_visible(Frame p) {
     if (VARIANT_SUN == SUN_DELTA) {
         unoccluded = sun_irradiance_delta(lights.sun.irradiance.rgb, n_dot_l);
     } else {
-        unoccluded = sun_irradiance_disk(lights.sun.irradiance.rgb, n_dot_l, delta);
+        // sun_irradiance_disk, its factor kept for the specular term.
+        sun_disk_factor_here = sun_disk_factor(n_dot_l, delta);
+        unoccluded = lights.sun.irradiance.rgb * sun_disk_factor_here;
     }
     float v = 1.0;
     if (SHADOWS_ON && any(greaterThan(unoccluded, vec3(0.0)))) {
+#ifdef SUNSHADE_SHADOW_RAYS
+        sun_cells_at(p.shadow_origin);
+#endif
         if (VARIANT_SUN == SUN_DELTA) {
             v = sun_visible_along(p.shadow_origin, normal, l) ? 1.0 : 0.0;
         } else {
@@ -158,7 +174,8 @@ vec3 sun_specular_visible(MaterialGpu material, Frame p) {
     bool penumbra = VARIANT_PENUMBRAE != PENUMBRAE_LATER && sun_ray_fraction > 0.0 && sun_ray_fraction < 1.0;
     SegmentSums sums = segment_lobe_integral_visible(material, p, l, -l, radius, pc.sun_samples,
         SHADOWS_ON && penumbra ? RAYS_ALONG : RAYS_NONE);
-    vec3 integral = normalized_lobe_integral(sums, sun_projected_solid_angle_above(dot(p.normal, l), delta));
+    // sun_projected_solid_angle_above(dot(p.normal, l), delta), from the factor sun_irradiance_visible found.
+    vec3 integral = normalized_lobe_integral(sums, PI * s * s * sun_disk_factor_here);
     if (SHADOWS_ON && sun_ray_fraction == 0.0) {
         integral = vec3(0.0);
     }
