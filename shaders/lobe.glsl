@@ -207,6 +207,21 @@ struct SegmentSums {
     float uniformity;
 };
 
+// The segment a light's specular term integrates its lobe over (segment_lobe_integral_visible's arguments:
+// `wanted` false where it needs none, a delta sun and a small-source disk), asked by sun_specular_segment and
+// disk_specular_segment so that radiance_out integrates every light's by one call: the driver inlines each call,
+// and a call in each light's term compiled the lobe's grid, its BRDF and its rays once a kind of light.
+struct SegmentAsk {
+    bool wanted;
+    vec3 q;
+    vec3 d;
+    float radius;
+    uint per_axis;
+    uint rays;
+};
+const SegmentAsk NO_SEGMENT = SegmentAsk(false, vec3(0.0), vec3(0.0), 0.0, 0u, RAYS_NONE);
+const SegmentSums NO_SEGMENT_SUMS = SegmentSums(vec3(0.0), 0.0, 0.0);
+
 // The lobe integral with the grid's weights normalised, as far as the grid is uniform, to integrate the cosine
 // exactly: lobe (1 + uniformity (exact/projected - 1)) (a ratio estimator; see the Rust).
 vec3 normalized_lobe_integral(SegmentSums sums, float exact) {

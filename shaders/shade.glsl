@@ -12,17 +12,31 @@
 
 // Irradiance [W/m^2] per channel from the visible part of every light (which, and their models: the pipeline
 // variant), in the order of the Rust's Lights::iter: each light's exact unoccluded irradiance times its visible
-// fraction (a single ray for a delta sun and a small-source disk); every fraction is 1 without shadows.
+// fraction (a single ray for a delta sun and a small-source disk); every fraction is 1 without shadows. One loop
+// over the lights (light j: the sun at 0, disk light j - 1 from 1, the sky after them), each light's term and
+// then, where it leaves one, its located grid, so that the grid and its rays are compiled once (LightTerm).
 vec3 irradiance_visible(Frame p) {
     vec3 e = vec3(0.0);
-    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
-        e += sun_irradiance_visible(p);
-    }
-    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
-        e += disk_irradiance_visible(i, p);
-    }
-    if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
-        e += sky_irradiance_visible(p);
+    bool sun = VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0;
+    uint disks = VARIANT_DISKS != LIGHT_ABSENT ? lights.counts.x : 0u;
+    bool sky = VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0;
+    for (uint j = sun ? 0u : 1u; j < (sky ? disks + 2u : disks + 1u); ++j) {
+        // Each call behind its kind's constant, so that a variant compiles only its lights' terms.
+        LightTerm term = LightTerm(vec3(0.0), 0.0, false, 1.0, 0u, NO_GRID_LIGHT);
+        if (VARIANT_SUN != LIGHT_ABSENT && j == 0u) {
+            term = sun_term(p);
+        } else if (VARIANT_DISKS != LIGHT_ABSENT && j <= disks) {
+            term = disk_term(j - 1u, p);
+        } else if (VARIANT_SKY != LIGHT_ABSENT) {
+            term = sky_term(p);
+        }
+        if (SHADOWS_ON && term.v < 0.0) {
+            term.v = grid_fraction(p.shadow_origin, term.k, term.grid);
+        }
+        if (SHADOWS_ON && j == 0u) {
+            sun_ray_fraction = term.v;
+        }
+        e += term.by_omega ? term.e * (term.omega * term.v) : term.e * term.v;
     }
     return e;
 }
@@ -45,12 +59,30 @@ vec3 radiance_out(MaterialGpu material, Frame p) {
     case BRDF_GLTF:
         break;
     }
+    // The sun's and the disk lights' terms in one loop, as irradiance_visible's (light j: the sun at 0, disk light
+    // j - 1 from 1), each light's lobe integrated by one call of segment_lobe_integral_visible (SegmentAsk).
     vec3 specular = vec3(0.0);
-    if (VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0) {
-        specular += sun_specular_visible(material, p);
-    }
-    for (uint i = 0u; VARIANT_DISKS != LIGHT_ABSENT && i < lights.counts.x; ++i) {
-        specular += disk_specular_visible(i, material, p);
+    bool sun = VARIANT_SUN != LIGHT_ABSENT && lights.sun.irradiance.w != 0.0;
+    uint disks = VARIANT_DISKS != LIGHT_ABSENT ? lights.counts.x : 0u;
+    for (uint j = sun ? 0u : 1u; j < disks + 1u; ++j) {
+        bool sun_here = VARIANT_SUN != LIGHT_ABSENT && j == 0u;
+        SegmentAsk segment = NO_SEGMENT;
+        if (sun_here) {
+            segment = sun_specular_segment();
+        } else if (VARIANT_DISKS != LIGHT_ABSENT) {
+            segment = disk_specular_segment(j - 1u, p);
+        }
+        SegmentSums sums = NO_SEGMENT_SUMS;
+        // Only a disk sun and exact disk lights integrate a segment: the others' variants compile none.
+        if ((VARIANT_SUN == SUN_DISK || VARIANT_DISKS == DISKS_EXACT) && segment.wanted) {
+            sums = segment_lobe_integral_visible(material, p, segment.q, segment.d, segment.radius,
+                                                 segment.per_axis, segment.rays);
+        }
+        if (sun_here) {
+            specular += sun_specular_visible(material, p, sums);
+        } else if (VARIANT_DISKS != LIGHT_ABSENT) {
+            specular += disk_specular_visible(j - 1u, material, p, sums);
+        }
     }
     if (VARIANT_SKY != LIGHT_ABSENT && lights.sky.w != 0.0) {
         specular += sky_specular_visible(material, p);

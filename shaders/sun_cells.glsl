@@ -114,7 +114,7 @@ uvec2 sun_cell_range(vec3 origin) {
 // every call, so a bisection in each of them compiled it once a caller (six times in a glTF variant).
 uvec2 sun_cell_range_here = uvec2(0u);
 
-// Finds sun_cell_range_here for the shaded point's shadow-ray origin (sun_irradiance_visible, before any other of
+// Finds sun_cell_range_here for the shaded point's shadow-ray origin (sun_term, before any other of
 // the sun's terms asks).
 void sun_cells_at(vec3 origin) {
     if (VARIANT_SUN_CELLS != SUN_CELLS_NONE) {

@@ -208,6 +208,24 @@ struct VisibilityLight {
     float tilt;
 };
 
+// A grid that samples nothing: the light of a LightTerm that leaves no grid.
+const VisibilityLight NO_GRID_LIGHT = VisibilityLight(GRID_LIGHT_SUN, vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0),
+                                                      vec3(0.0), vec3(0.0), 0.0, 0.0);
+
+// A light's term in a shading point's irradiance (sun_term, disk_term, sky_term): `e v`, or `e (omega v)` where
+// `by_omega` (a disk light's radiance and projected solid angle, multiplied in that order), v its visible fraction,
+// or -1 where the located grid over `grid` (k^2 squares, from the shadow rays' origin) is to find it.
+// irradiance_visible takes every light's grid by one call of grid_fraction: the driver inlines each call, and a
+// call in each light's term compiled the grid and its rays once a kind of light.
+struct LightTerm {
+    vec3 e;
+    float omega;
+    bool by_omega;
+    float v;
+    uint k;
+    VisibilityLight grid;
+};
+
 // The sky's lune above a surface of unit normal n (sky_lune in the Rust): the tilt as atan2(|n - n_y y|, n_y),
 // a floor's lune the whole hemisphere about a = x cross y.
 VisibilityLight sky_lune(vec3 n) {

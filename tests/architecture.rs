@@ -287,6 +287,34 @@ const GPU_ONLY_FUNCTIONS: &[(&str, &str, &str)] = &[
          the driver inlines each call; the Rust calls sun_irradiance_disk for both",
     ),
     (
+        "lights/sun.glsl",
+        "sun_term",
+        "sun_irradiance_visible up to its grid, which irradiance_visible casts for every light by one call (the \
+         driver inlines each call); the Rust's returns the irradiance",
+    ),
+    (
+        "lights/disk.glsl",
+        "disk_term",
+        "disk_irradiance_visible up to its grid, as sun_term's; the Rust's returns the irradiance",
+    ),
+    (
+        "lights/sky.glsl",
+        "sky_term",
+        "sky_irradiance_visible up to its grid, as sun_term's; the Rust's returns the irradiance",
+    ),
+    (
+        "lights/sun.glsl",
+        "sun_specular_segment",
+        "the arguments of sun_specular_visible's lobe integral, which radiance_out takes for every light by one \
+         call (the driver inlines each call); the Rust integrates in sun_lobe_integral",
+    ),
+    (
+        "lights/disk.glsl",
+        "disk_specular_segment",
+        "the arguments of disk_specular_visible's lobe integral, as sun_specular_segment's; the Rust integrates in \
+         disk_lobe_integral",
+    ),
+    (
         "sun_cells.glsl",
         "sun_cells_at",
         "the shaded point's sun_cell_range, found once a pixel for every function that reads it, as the driver \

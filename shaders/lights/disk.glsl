@@ -190,26 +190,27 @@ uint disk_rays_gather(vec3 origin, vec3 x, vec3 n, vec3 center, vec3 d, float ra
 #endif
 }
 
-// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n; its rays test
-// only the triangles the walk listed where `listed` (disk_rays_gather).
-float disk_visible_fraction(vec3 origin, uint k, vec3 x, vec3 n, vec3 center, vec3 d, float radius,
-                            bool listed) {
+// The visible fraction of a disk light, weighted by projected solid angle, from x with normal n: -1, the located
+// grid over `grid` to find it (irradiance_visible); its rays test only the triangles the walk listed where `listed`
+// (disk_rays_gather).
+float disk_visible_fraction(vec3 x, vec3 n, vec3 center, vec3 d, float radius, bool listed,
+                            out VisibilityLight grid) {
     vec3 a = orthonormal_to(d);
-    VisibilityLight L = VisibilityLight(listed ? GRID_LIGHT_DISK_LISTED : GRID_LIGHT_DISK, x, n, center, d, a,
-                                        cross(d, a), radius, 0.0);
-    return grid_fraction(origin, k, L);
+    grid = VisibilityLight(listed ? GRID_LIGHT_DISK_LISTED : GRID_LIGHT_DISK, x, n, center, d, a, cross(d, a),
+                           radius, 0.0);
+    return -1.0;
 }
 
-// The first disks' visible fractions from their maps, found by disk_irradiance_visible and reused by the specular
-// term.
+// The first disks' visible fractions from their maps, found by disk_term and reused by the specular term.
 float disk_map_fraction[MAX_DISK_MAPS] = float[](1.0, 1.0, 1.0, 1.0);
-// Bit i: the rays of disk light i (the first 32) proven clear by disk_irradiance_visible (disk_rays_gather): its
+// Bit i: the rays of disk light i (the first 32) proven clear by disk_term (disk_rays_gather): its
 // lobe's samples then cast none, every one of them getting through.
 uint disk_rays_clear = 0u;
 
-// Disk light i's irradiance [W/m^2] per channel from its visible part, L0 Omega v (the exact or the small-source
-// model, the pipeline variant's); keeps what its specular term reuses (disk_map_fraction, disk_rays_clear).
-vec3 disk_irradiance_visible(uint i, Frame p) {
+// Disk light i's term of the irradiance [W/m^2] per channel from its visible part, L0 (Omega v) (the exact or the
+// small-source model, the pipeline variant's; disk_irradiance_visible in the Rust), v left to irradiance_visible's
+// grid where the light needs one; keeps what its specular term reuses (disk_map_fraction, disk_rays_clear).
+LightTerm disk_term(uint i, Frame p) {
     vec3 position = p.position;
     vec3 normal = p.normal;
     uint k = lights.sampling.y;
@@ -217,47 +218,59 @@ vec3 disk_irradiance_visible(uint i, Frame p) {
     float omega = VARIANT_DISKS == DISKS_SMALL_SOURCE
         ? disk_projected_solid_angle_small_source(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w)
         : disk_projected_solid_angle(position, normal, d.center_radius.xyz, d.direction.xyz, d.center_radius.w);
-    float v = 1.0;
+    LightTerm term = LightTerm(d.radiance.rgb, omega, true, 1.0, k, NO_GRID_LIGHT);
     if (SHADOWS_ON && omega > 0.0) {
         if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
-            v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
+            term.v = visible_to(p.shadow_origin, d.center_radius.xyz) ? 1.0 : 0.0;
         } else {
             // By slices where asked and the shader walks the BVH itself, or by their passes, as the sun's.
-            v = -1.0;
+            term.v = -1.0;
 #ifdef SUNSHADE_SLICES
             if (VARIANT_VISIBILITY == VISIBILITY_SLICES) {
-                v = (lights.light_rows.w & READ_DISKS) != 0u
+                term.v = (lights.light_rows.w & READ_DISKS) != 0u
                     ? PASSED_FRACTION(ROWS_OF_DISK + i)
                     : disk_visible_fraction_sliced(p.shadow_origin, normal, d.center_radius.xyz, d.direction.xyz,
                                                    d.center_radius.w, 4u * k * k);
             }
 #endif
-            if (v < 0.0) {
+            if (term.v < 0.0) {
                 uint gathered = disk_rays_gather(p.shadow_origin, position, normal, d.center_radius.xyz,
                                                  d.direction.xyz, d.center_radius.w);
                 if (gathered == DISK_CONE_CLEAR) {
-                    v = 1.0;
+                    term.v = 1.0;
                     disk_rays_clear |= i < 32u ? 1u << i : 0u;
                 } else {
-                    v = disk_visible_fraction(p.shadow_origin, k, position, normal, d.center_radius.xyz,
-                                              d.direction.xyz, d.center_radius.w, gathered == DISK_CONE_LIST);
+                    term.v = disk_visible_fraction(position, normal, d.center_radius.xyz, d.direction.xyz,
+                                                   d.center_radius.w, gathered == DISK_CONE_LIST, term.grid);
                 }
             }
         }
     }
     if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS && lights.disk_map[i].w > 0.0 && omega > 0.0) {
         bool pcss = VARIANT_DISKS != DISKS_SMALL_SOURCE && lights.sampling.z == 1u;
-        v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal, d.center_radius.xyz,
-            d.direction.xyz, d.center_radius.w, pcss);
-        disk_map_fraction[i] = v;
+        term.v = disk_visible_fraction_map(i, p.shadow_origin, k, position, normal, p.face_normal,
+            d.center_radius.xyz, d.direction.xyz, d.center_radius.w, pcss);
+        disk_map_fraction[i] = term.v;
     }
-    omega = omega * v;
-    return d.radiance.rgb * omega;
+    return term;
 }
 
-// Disk light i's specular term [W/(m^2 sr)] per channel, to be scaled by ks: the lobe over the disk (exact) or
-// towards its centre (small source), visible part only (see the Rust).
-vec3 disk_specular_visible(uint i, MaterialGpu material, Frame p) {
+// The segment disk light i's specular term integrates the lobe over (the disk, exact model), for radiance_out's one
+// call of segment_lobe_integral_visible; none for a small source.
+SegmentAsk disk_specular_segment(uint i, Frame p) {
+    if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
+        return NO_SEGMENT;
+    }
+    DiskGpu d = lights.disks[i];
+    // The grid's sum as it is (see disk_lobe_integral in the Rust); no rays where they are proven clear.
+    bool clear = i < 32u && (disk_rays_clear & (1u << i)) != 0u;
+    return SegmentAsk(true, d.center_radius.xyz - p.position, d.direction.xyz, d.center_radius.w, pc.lobe_samples,
+                      SHADOWS_ON && !clear ? RAYS_TO_POINT : RAYS_NONE);
+}
+
+// Disk light i's specular term [W/(m^2 sr)] per channel, to be scaled by ks: the lobe over the disk (exact:
+// `sums`, disk_specular_segment's) or towards its centre (small source), visible part only (see the Rust).
+vec3 disk_specular_visible(uint i, MaterialGpu material, Frame p, SegmentSums sums) {
     DiskGpu d = lights.disks[i];
     vec3 integral;
     if (VARIANT_DISKS == DISKS_SMALL_SOURCE) {
@@ -268,10 +281,7 @@ vec3 disk_specular_visible(uint i, MaterialGpu material, Frame p) {
             integral = vec3(0.0);
         }
     } else {
-        // The grid's sum as it is (see disk_lobe_integral in the Rust); no rays where they are proven clear.
-        bool clear = i < 32u && (disk_rays_clear & (1u << i)) != 0u;
-        integral = segment_lobe_integral_visible(material, p, d.center_radius.xyz - p.position, d.direction.xyz,
-            d.center_radius.w, pc.lobe_samples, SHADOWS_ON && !clear ? RAYS_TO_POINT : RAYS_NONE).lobe;
+        integral = sums.lobe;
     }
     if (SHADOWS_MAP_ON && i < MAX_DISK_MAPS) {
         integral *= disk_map_fraction[i];

@@ -15,10 +15,11 @@ vec3 sky_irradiance(vec3 radiance, float n_dot_up) {
     return PI * radiance * (0.5 * (1.0 + n_dot_up));
 }
 
-// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: the
-// located grid over the sky's lune (sky_visible_fraction in the Rust).
-float sky_visible_fraction(vec3 origin, uint k, vec3 n) {
-    return grid_fraction(origin, k, sky_lune(n));
+// The visible fraction of the sky (directions with y > 0), cosine-weighted, from a point with normal n: -1, the
+// located grid over the sky's lune (`grid`) to find it (irradiance_visible; sky_visible_fraction in the Rust).
+float sky_visible_fraction(vec3 n, out VisibilityLight grid) {
+    grid = sky_lune(n);
+    return -1.0;
 }
 
 // integral of lobe (n.w)+ over the whole hemisphere about n, per unit radiance: a stratified grid through the
@@ -74,24 +75,25 @@ vec3 sky_lobe_integral_visible(MaterialGpu m, Frame p, uint per_axis, bool shado
     return (1.0 - s) * by_difference + s * direct;
 }
 
-// The sky's irradiance [W/m^2] per channel from its visible part, pi L0 (1 + cos t)/2 v.
-vec3 sky_irradiance_visible(Frame p) {
+// The sky's term of the irradiance [W/m^2] per channel from its visible part, pi L0 (1 + cos t)/2 v
+// (sky_irradiance_visible in the Rust), v left to irradiance_visible's grid where it needs one.
+LightTerm sky_term(Frame p) {
     vec3 normal = p.normal;
-    uint k = lights.sampling.y;
-    float v = 1.0;
+    LightTerm term = LightTerm(sky_irradiance(lights.sky.rgb, normal.y), 0.0, false, 1.0, lights.sampling.y,
+                               NO_GRID_LIGHT);
     if (SHADOWS_ON && normal.y > -1.0) {
         // By the slices the sky's passes took before this one, where they did (gpu::slice_passes).
-        v = -1.0;
+        term.v = -1.0;
 #ifdef SUNSHADE_SLICES
         if ((lights.light_rows.w & READ_SKY) != 0u) {
-            v = PASSED_FRACTION(ROWS_OF_SKY);
+            term.v = PASSED_FRACTION(ROWS_OF_SKY);
         }
 #endif
-        if (v < 0.0) {
-            v = sky_visible_fraction(p.shadow_origin, k, normal);
+        if (term.v < 0.0) {
+            term.v = sky_visible_fraction(normal, term.grid);
         }
     }
-    return sky_irradiance(lights.sky.rgb, normal.y) * v;
+    return term;
 }
 
 // The sky's specular term [W/(m^2 sr)] per channel, to be scaled by ks (each lobe sample with its shadow ray).
