@@ -1,6 +1,6 @@
 // Disk lights in f32: the projected solid angle (the small-source estimate, and the exact value by Stokes' theorem,
 // the disk cut by the horizon included), the visible fraction, and its two terms in a shading point's sum
-// (disk_irradiance_visible, disk_specular_visible). Mirrors src/shading/lights/disk.rs name for name
+// (disk_term, disk_specular_visible). Mirrors src/shading/lights/disk.rs name for name
 // (the Rust is the specification; its doc comments derive the formulas and say where precision is at stake).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_LIGHTS_DISK_GLSL

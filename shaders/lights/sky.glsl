@@ -1,5 +1,5 @@
 // The overcast sky in f32: the irradiance it gives a tilted surface, its visible fraction, and the specular lobe
-// integrated over it, and its two terms in a shading point's sum (sky_irradiance_visible, sky_specular_visible).
+// integrated over it, and its two terms in a shading point's sum (sky_term, sky_specular_visible).
 // Mirrors src/shading/lights/sky.rs name for name (see it for the derivations).
 // Units: radians, steradians, W/m^2 (irradiance), W/(m^2 sr) (radiance).
 #ifndef SUNSHADE_LIGHTS_SKY_GLSL
