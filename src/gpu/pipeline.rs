@@ -35,7 +35,7 @@ pub struct CreatedPipeline {
     pub instructions: usize,
     pub inlined: usize,
     /// The fragment stage's functions with the largest shares of `inlined` (`sunshade_glsl::inlined_profile`), the
-    /// first [`LARGEST_SHARES`].
+    /// first `LARGEST_SHARES`.
     pub largest: Vec<sunshade_glsl::InlinedFunction>,
     pub time: std::time::Duration,
 }
