@@ -546,7 +546,7 @@ fn variant_sizes_stay_within_their_budgets() {
                 .unwrap()
                 .iter()
                 .take(5)
-                .map(|f| format!("{} ({} × {})", f.name.split('(').next().unwrap_or(&f.name), f.own, f.copies))
+                .map(|f| format!("{} ({} × {})", f.short_name(), f.own, f.copies))
                 .collect();
             over.push(format!(
                 "{}: {n} instructions inlined, over its budget of {}; largest shares (own × copies): {}",

@@ -284,11 +284,8 @@ pub fn run(a: &RenderArgs) -> Result<(), CliError> {
                 p.time.as_secs_f64() * 1e3
             );
             if !p.largest.is_empty() {
-                let shares: Vec<String> = p
-                    .largest
-                    .iter()
-                    .map(|f| format!("{} {} × {}", f.name.split('(').next().unwrap_or(&f.name), f.own, f.copies))
-                    .collect();
+                let shares: Vec<String> =
+                    p.largest.iter().map(|f| format!("{} {} × {}", f.short_name(), f.own, f.copies)).collect();
                 eprintln!(
                     "sunshade:   its largest functions inlined (own instructions × copies): {}",
                     shares.join(", ")

@@ -7,7 +7,8 @@
 use std::collections::HashMap;
 
 use crate::specialize::{
-    instructions, Inst, OP_ENTRY_POINT, OP_FUNCTION, OP_FUNCTION_CALL, OP_FUNCTION_END, OP_LINE, OP_NAME, OP_NO_LINE,
+    instructions, literal_string, Inst, OP_ENTRY_POINT, OP_FUNCTION, OP_FUNCTION_CALL, OP_FUNCTION_END, OP_LINE,
+    OP_NAME, OP_NO_LINE,
 };
 
 /// One function of a module as the inlining driver sees it.
@@ -25,6 +26,11 @@ impl InlinedFunction {
     /// Its share of the inlined count: `own × copies`.
     pub fn inlined(&self) -> usize {
         self.own * self.copies
+    }
+
+    /// Its name without the parameters' types glslang appends (`atan_accurate` for `atan_accurate(f1;`).
+    pub fn short_name(&self) -> &str {
+        self.name.split('(').next().unwrap_or(&self.name)
     }
 }
 
@@ -131,10 +137,7 @@ fn function_names(insts: &[Inst<'_>]) -> HashMap<u32, String> {
     insts
         .iter()
         .filter(|i| i.op == OP_NAME && i.words.len() > 2)
-        .map(|i| {
-            let bytes: Vec<u8> = i.words[2..].iter().flat_map(|w| w.to_le_bytes()).collect();
-            (i.words[1], String::from_utf8_lossy(&bytes).trim_end_matches('\0').to_string())
-        })
+        .map(|i| (i.words[1], literal_string(&i.words[2..]).0))
         .collect()
 }
 
@@ -180,8 +183,7 @@ void main() {
     }
 
     fn copies_of(profile: &[InlinedFunction], name: &str) -> usize {
-        // glslang names a function `name(` and its parameters' types, and main `main`.
-        profile.iter().find(|f| f.name.split('(').next() == Some(name)).map_or(0, |f| f.copies)
+        profile.iter().find(|f| f.short_name() == name).map_or(0, |f| f.copies)
     }
 
     #[test]

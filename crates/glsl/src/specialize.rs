@@ -365,7 +365,7 @@ fn analyse(
 }
 
 /// The literal string that starts at `words[0]` (nul-terminated, padded to whole words), and the words it takes.
-fn literal_string(words: &[u32]) -> (String, usize) {
+pub(crate) fn literal_string(words: &[u32]) -> (String, usize) {
     let mut bytes = Vec::new();
     for (n, w) in words.iter().enumerate() {
         for b in w.to_le_bytes() {
