@@ -210,7 +210,7 @@ struct SegmentSums {
 // The segment a light's specular term integrates its lobe over (segment_lobe_integral_visible's arguments:
 // `wanted` false where it needs none, a delta sun and a small-source disk), asked by sun_specular_segment and
 // disk_specular_segment so that radiance_out integrates every light's by one call: the driver inlines each call,
-// and a call in each light's term compiled the lobe's grid, its BRDF and its rays once a kind of light.
+// and a call in each light's term would compile the lobe's grid, its BRDF and its rays once a kind of light.
 struct SegmentAsk {
     bool wanted;
     vec3 q;

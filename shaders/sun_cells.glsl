@@ -111,7 +111,7 @@ uvec2 sun_cell_range(vec3 origin) {
 
 // The shaded point's entries above it: sun_cell_range of its shadow rays' origin, found once a pixel by
 // sun_cells_at before the functions below read it (they are only asked about that origin). The driver inlines
-// every call, so a bisection in each of them compiled it once a caller (six times in a glTF variant).
+// every call, so a bisection in each of them would be compiled once a caller.
 uvec2 sun_cell_range_here = uvec2(0u);
 
 // Finds sun_cell_range_here for the shaded point's shadow-ray origin (sun_term, before any other of

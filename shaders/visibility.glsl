@@ -216,7 +216,7 @@ const VisibilityLight NO_GRID_LIGHT = VisibilityLight(GRID_LIGHT_SUN, vec3(0.0),
 // `by_omega` (a disk light's radiance and projected solid angle, multiplied in that order), v its visible fraction,
 // or -1 where the located grid over `grid` (k^2 squares, from the shadow rays' origin) is to find it.
 // irradiance_visible takes every light's grid by one call of grid_fraction: the driver inlines each call, and a
-// call in each light's term compiled the grid and its rays once a kind of light.
+// call in each light's term would compile the grid and its rays once a kind of light.
 struct LightTerm {
     vec3 e;
     float omega;
